@@ -1,0 +1,85 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "tests/test_support.h"
+
+namespace rigc {
+namespace {
+
+using testing::run_rigc;
+using testing::source_path;
+
+TEST(Cli, CheckAcceptsThePaperScene) {
+  auto result = run_rigc({"check", source_path("scenes/paper-turntable.yaml")});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("ok: 'paper-turntable', 18 shots"), std::string::npos) << result.out;
+}
+
+TEST(Cli, CheckReportsErrorsWithExitCodeOne) {
+  auto result = run_rigc({"check", source_path("tests/bad_scenes/out_of_range.yaml")});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find(":8:24: error: aperture f/0.8 is outside f/1.2..f/64"),
+            std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find("4 errors in"), std::string::npos) << result.err;
+}
+
+TEST(Cli, CheckJsonListsDiagnostics) {
+  auto result = run_rigc({"check", "--json", source_path("tests/bad_scenes/unknown_keys.yaml")});
+  EXPECT_EQ(result.exit_code, 1);
+  auto json = nlohmann::json::parse(result.out);
+  EXPECT_FALSE(json["ok"].get<bool>());
+  ASSERT_EQ(json["diagnostics"].size(), 3u);
+  EXPECT_EQ(json["diagnostics"][0]["line"], 8);
+}
+
+TEST(Cli, MissingSceneFileIsAUserError) {
+  auto result = run_rigc({"check", "/nonexistent/rig.yaml"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("/nonexistent/rig.yaml: error: cannot read the scene file"),
+            std::string::npos)
+      << result.err;
+}
+
+TEST(Cli, CompileEmitsIrJsonAtomically) {
+  testing::TempDir dir;
+  const std::string out = dir.file("paper.ir.json");
+  auto result = run_rigc(
+      {"compile", source_path("scenes/paper-turntable.yaml"), "--target", "ir", "-o", out});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  auto ir = nlohmann::json::parse(testing::read_text(out));
+  EXPECT_EQ(ir["shots"].size(), 18u);
+  EXPECT_EQ(ir["camera"]["width_px"], 5472);
+  EXPECT_FALSE(std::filesystem::exists(out + ".tmp"));
+  // An unwritable destination is a clear user error, with nothing left behind.
+  auto bad = run_rigc({"compile", source_path("scenes/paper-turntable.yaml"), "-o",
+                       dir.file("no/such/folder/ir.json")});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+}
+
+TEST(Cli, UnknownVerbAndTargetAreUserErrors) {
+  auto verb = run_rigc({"chekc"});
+  EXPECT_EQ(verb.exit_code, 1);
+  EXPECT_NE(verb.err.find("did you mean 'check'?"), std::string::npos) << verb.err;
+  auto target =
+      run_rigc({"compile", source_path("scenes/paper-turntable.yaml"), "--target", "vray"});
+  EXPECT_EQ(target.exit_code, 1);
+}
+
+TEST(Cli, VersionAndHelp) {
+  auto version = run_rigc({"version"});
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.out.find("rigc "), std::string::npos);
+  auto help = run_rigc({"check", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--json"), std::string::npos);
+  auto top = run_rigc({"--help"});
+  EXPECT_EQ(top.exit_code, 0);
+  EXPECT_NE(top.out.find("compile"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rigc

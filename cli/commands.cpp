@@ -1,0 +1,193 @@
+#include "cli/commands.h"
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "compiler/frontend.h"
+#include "compiler/ir_json.h"
+#include "compiler/units.h"
+
+namespace rigc::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Parses a verb's options with CLI11; returns an exit code if parsing ended the run (help, error).
+std::optional<int> parse_options(CLI::App& app, std::vector<std::string> args) {
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUserError;
+  }
+  return std::nullopt;
+}
+
+nlohmann::json diagnostics_json(const DiagnosticEngine& diag) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& d : diag.diagnostics()) {
+    const char* severity = d.severity == Severity::kError     ? "error"
+                           : d.severity == Severity::kWarning ? "warning"
+                                                              : "note";
+    out.push_back({{"severity", severity},
+                   {"file", d.loc.file},
+                   {"line", d.loc.line},
+                   {"col", d.loc.col},
+                   {"message", d.message}});
+  }
+  return out;
+}
+
+// Writes text to `path` atomically: a temporary file beside it, then a rename.
+bool write_file_atomically(const std::string& path, const std::string& text, std::string* error) {
+  const fs::path target(path);
+  const fs::path temporary = target.string() + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    if (!out) {
+      *error = fmt::format("{}: cannot write (does the folder exist and is it writable?)", path);
+      return false;
+    }
+    out << text;
+    if (!out.flush()) {
+      *error = fmt::format("{}: write failed", path);
+      return false;
+    }
+  }
+  std::error_code ec;
+  fs::rename(temporary, target, ec);
+  if (ec) {
+    fs::remove(temporary, ec);
+    *error = fmt::format("{}: cannot rename the temporary file into place", path);
+    return false;
+  }
+  return true;
+}
+
+int run_check(std::vector<std::string> args) {
+  CLI::App app{"Check a scene: report every error and capture warning, like a compiler."};
+  std::string scene_path;
+  bool json = false;
+  app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  app.add_flag("--json", json, "print diagnostics and a summary as JSON");
+  if (auto code = parse_options(app, args)) return *code;
+
+  DiagnosticEngine diag;
+  if (json) diag.set_handler([](const Diagnostic&, const std::string&) {});
+  auto scene = compile_scene_file(scene_path, diag);
+  if (json) {
+    nlohmann::json out{{"ok", scene.has_value()}, {"diagnostics", diagnostics_json(diag)}};
+    if (scene) out["scene"] = ir_to_json(*scene, false);
+    std::cout << out.dump(2) << '\n';
+    return scene ? kExitOk : kExitUserError;
+  }
+  if (!scene) {
+    std::cerr << fmt::format("{} error{} in {}\n", diag.error_count(),
+                             diag.error_count() == 1 ? "" : "s", scene_path);
+    return kExitUserError;
+  }
+  const ir::Camera& c = scene->camera;
+  std::cout << fmt::format(
+      "{}: ok: '{}', {} shots, object {} ({} triangles, {:.1f} x {:.1f} x {:.1f} cm), {} "
+      "{:.0f}mm {} {} ISO {:.0f}, {} lights, {} warning{}\n",
+      scene_path, scene->name, scene->shots.size(), scene->object.source,
+      scene->object.mesh.triangles.size(),
+      100 * (scene->object.bounds_max_object.x() - scene->object.bounds_min_object.x()),
+      100 * (scene->object.bounds_max_object.y() - scene->object.bounds_min_object.y()),
+      100 * (scene->object.bounds_max_object.z() - scene->object.bounds_min_object.z()),
+      c.model.rfind(c.make, 0) == 0 ? c.model : c.make + " " + c.model, c.focal_length_m * 1000, format_quantity(c.aperture_f_number, QuantityKind::kFNumber),
+      format_quantity(c.shutter_s, QuantityKind::kTime), c.iso, scene->studio.lights.size(),
+      diag.warning_count(), diag.warning_count() == 1 ? "" : "s");
+  return kExitOk;
+}
+
+int run_compile(std::vector<std::string> args) {
+  CLI::App app{"Compile a scene for a target: the IR as JSON (more targets come with backends)."};
+  std::string scene_path, target = "ir", output;
+  bool no_geometry = false;
+  app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  app.add_option("--target,--emit", target, "what to emit")
+      ->check(CLI::IsMember({"ir"}))
+      ->capture_default_str();
+  app.add_option("-o,--output", output, "output file (default: standard output)");
+  app.add_flag("--no-geometry", no_geometry, "leave vertex and triangle arrays out of the IR");
+  if (auto code = parse_options(app, args)) return *code;
+
+  DiagnosticEngine diag;
+  auto scene = compile_scene_file(scene_path, diag);
+  if (!scene) return kExitUserError;
+  const std::string text = ir_to_json(*scene, !no_geometry).dump(1) + "\n";
+  if (output.empty()) {
+    std::cout << text;
+    return kExitOk;
+  }
+  std::string error;
+  if (!write_file_atomically(output, text, &error)) {
+    std::cerr << "rigc: error: " << error << '\n';
+    return kExitUserError;
+  }
+  return kExitOk;
+}
+
+int run_version(std::vector<std::string> args) {
+  CLI::App app{"Print the version of rigc and of the scene language."};
+  if (auto code = parse_options(app, args)) return *code;
+  std::cout << fmt::format("rigc {} (scene language 1, IR 1)\n", RIGC_VERSION);
+  return kExitOk;
+}
+
+}  // namespace
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> table = {
+      {"check", "check a scene and report errors and capture warnings", run_check},
+      {"compile", "compile a scene to a target (ir)", run_compile},
+      {"version", "print the version", run_version},
+  };
+  return table;
+}
+
+int run_main(std::vector<std::string> args) {
+  auto usage = [] {
+    std::string text = "usage: rigc <command> [options]\n\ncommands:\n";
+    for (const auto& c : commands()) text += fmt::format("  {:<10} {}\n", c.name, c.summary);
+    text += "\n`rigc <command> --help` describes a command's options.\n";
+    return text;
+  };
+  if (args.size() < 2) {
+    std::cerr << usage();
+    return kExitUserError;
+  }
+  const std::string verb = args[1];
+  if (verb == "-h" || verb == "--help" || verb == "help") {
+    std::cout << usage();
+    return kExitOk;
+  }
+  if (verb == "--version") return run_version({"rigc version"});
+  for (const auto& command : commands()) {
+    if (command.name != verb) continue;
+    std::vector<std::string> verb_args = {"rigc " + verb};
+    verb_args.insert(verb_args.end(), args.begin() + 2, args.end());
+    try {
+      return command.run(verb_args);
+    } catch (const std::exception& e) {
+      std::cerr << "rigc: internal error: " << e.what() << '\n';
+      return kExitInternalError;
+    }
+  }
+  std::vector<std::string> names;
+  for (const auto& c : commands()) names.push_back(c.name);
+  std::string suggestion = closest_match(verb, names);
+  std::cerr << fmt::format("rigc: error: unknown command '{}'{}\n\n{}", verb,
+                           suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion),
+                           usage());
+  return kExitUserError;
+}
+
+}  // namespace rigc::cli

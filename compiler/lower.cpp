@@ -1,0 +1,381 @@
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <tuple>
+
+#include "compiler/check.h"
+#include "compiler/color.h"
+#include "compiler/frontend.h"
+#include "compiler/mesh_io.h"
+#include "compiler/primitives.h"
+
+namespace rigc {
+namespace {
+
+namespace fs = std::filesystem;
+using ir::Mat4;
+using ir::Vec3;
+
+Mat4 translation(const Vec3& t) {
+  Mat4 m = Mat4::Identity();
+  m.block<3, 1>(0, 3) = t;
+  return m;
+}
+
+Mat4 rotation(const Eigen::Matrix3d& r) {
+  Mat4 m = Mat4::Identity();
+  m.block<3, 3>(0, 0) = r;
+  return m;
+}
+
+// Converts a file's up axis to RigC's +Z up (right-handed rotations only).
+Eigen::Matrix3d up_axis_rotation(char axis, bool negative) {
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  if (axis == 'y') {
+    // +Y up: (x, y, z) -> (x, -z, y); -Y up: (x, y, z) -> (x, z, -y).
+    r << 1, 0, 0, 0, 0, negative ? 1 : -1, 0, negative ? -1 : 1, 0;
+  } else if (axis == 'z' && negative) {
+    r << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  }
+  return r;
+}
+
+// Camera looking from `eye` at `target`, OpenCV axes (+X right, +Y down, +Z forward).
+Mat4 look_at(const Vec3& eye, const Vec3& target, Vec3 up) {
+  Vec3 forward = (target - eye).normalized();
+  if (std::abs(forward.dot(up.normalized())) > 0.999) {
+    up = std::abs(forward.y()) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
+  }
+  Vec3 right = forward.cross(up).normalized();
+  Vec3 down = forward.cross(right);
+  Mat4 m = Mat4::Identity();
+  m.block<3, 1>(0, 0) = right;
+  m.block<3, 1>(0, 1) = down;
+  m.block<3, 1>(0, 2) = forward;
+  m.block<3, 1>(0, 3) = eye;
+  return m;
+}
+
+void transformed_bounds(const ir::Mesh& mesh, const Mat4& m, Vec3* lo, Vec3* hi) {
+  *lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  *hi = -*lo;
+  const Eigen::Matrix3d linear = m.block<3, 3>(0, 0);
+  const Vec3 offset = m.block<3, 1>(0, 3);
+  for (const auto& p : mesh.positions) {
+    Vec3 q = linear * p.cast<double>() + offset;
+    *lo = lo->cwiseMin(q);
+    *hi = hi->cwiseMax(q);
+  }
+}
+
+class Lowering {
+ public:
+  Lowering(const spec::SceneSpec& spec, DiagnosticEngine& diag) : spec_(spec), diag_(diag) {}
+
+  std::optional<ir::Scene> run() {
+    scene_.language_version = spec_.version;
+    scene_.name = spec_.name;
+    scene_.source_file = spec_.source_file;
+    scene_.studio = spec_.studio;
+    scene_.camera = spec_.camera;
+    if (!lower_object()) return std::nullopt;
+    lower_camera();
+    lower_lights();
+    lower_shots();
+    place_backdrop();
+    if (errors_) return std::nullopt;
+    return std::move(scene_);
+  }
+
+ private:
+  void error(const SourceLoc& loc, std::string message) {
+    diag_.error(loc, std::move(message));
+    ++errors_;
+  }
+
+  bool lower_object();
+  void lower_camera();
+  void lower_lights();
+  void lower_shots();
+  void place_backdrop();
+  Vec3 aim_point(const spec::Target& target) const {
+    if (!target.object) return target.point;
+    return (ir::world_from_object(scene_, 0) * object_center_.homogeneous()).head<3>();
+  }
+  void add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double angle, double velocity,
+                const Vec3& aim, const SourceLoc& loc);
+
+  const spec::SceneSpec& spec_;
+  DiagnosticEngine& diag_;
+  ir::Scene scene_;
+  Vec3 object_center_{0, 0, 0};  // bounding-box centre, object frame
+  int errors_ = 0;
+};
+
+bool Lowering::lower_object() {
+  const spec::ObjectSpec& object = spec_.object;
+  ir::Object& out = scene_.object;
+  out.loc = object.loc;
+  Eigen::Matrix3d up = Eigen::Matrix3d::Identity();
+  if (object.mesh_path) {
+    std::string why;
+    auto model = load_model(object.mesh_path_resolved, &why);
+    if (!model) {
+      error(object.mesh_path->loc, fmt::format("cannot load mesh: {}", why));
+      return false;
+    }
+    out.source = object.mesh_path_resolved;
+    out.mesh = std::move(model->mesh);
+    scene_.materials = std::move(model->materials);
+    scene_.textures = std::move(model->textures);
+    std::string ext = fs::path(object.mesh_path_resolved).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const bool gltf = ext == ".gltf" || ext == ".glb";
+    if (gltf && object.up_axis) {
+      diag_.warning(object.mesh_path->loc,
+                    "glTF files are always +Y up and converted automatically; 'up' is ignored");
+    } else if (!gltf) {
+      // Scans and DCC exports in OBJ/PLY are usually +Y up; STL (CAD) is usually +Z up.
+      char axis = object.up_axis ? object.up_axis : (ext == ".stl" ? 'z' : 'y');
+      up = up_axis_rotation(axis, object.up_negative);
+    }
+  } else {
+    auto kind = primitive_from_name(object.primitive->value);
+    out.source = "primitive:" + object.primitive->value;
+    out.mesh = make_primitive(*kind, object.primitive_detail, object.primitive_seed);
+    scene_.materials.push_back(ir::Material{});
+    scene_.materials.back().name = object.primitive->value;
+  }
+  for (auto& material : scene_.materials) {
+    material.loc = object.loc;
+    if (object.surface_color) material.base_color = *object.surface_color;
+    if (object.roughness) material.roughness = *object.roughness;
+    if (object.metallic) material.metallic = *object.metallic;
+    if (material.base_color_texture < 0) material.pattern = object.pattern;
+  }
+  if (scene_.materials.empty()) scene_.materials.push_back(ir::Material{});
+
+  // Rotation and scale first, then fit to the requested size, then rest on the turntable.
+  Eigen::Matrix3d user_rotation =
+      (Eigen::AngleAxisd(object.rotate_rad.z(), Vec3::UnitZ()) *
+       Eigen::AngleAxisd(object.rotate_rad.y(), Vec3::UnitY()) *
+       Eigen::AngleAxisd(object.rotate_rad.x(), Vec3::UnitX()))
+          .toRotationMatrix();
+  Mat4 user_scale = Mat4::Identity();
+  user_scale.diagonal().head<3>() = object.scale;
+  Mat4 shaped = rotation(user_rotation) * user_scale * rotation(up);
+  Vec3 lo, hi;
+  transformed_bounds(out.mesh, shaped, &lo, &hi);
+  const Vec3 extent = hi - lo;
+  if (!(extent.maxCoeff() > 0) || !extent.allFinite()) {
+    error(object.loc, "the object's mesh has no extent (all vertices at one point)");
+    return false;
+  }
+  double fit_scale = 1;
+  if (object.fit_height) {
+    if (extent.z() <= 0) {
+      error(object.fit_height->loc, "cannot fit the height of a flat object (no extent in z)");
+      return false;
+    }
+    fit_scale = object.fit_height->value / extent.z();
+  } else if (object.fit_width) {
+    fit_scale = object.fit_width->value / std::max(extent.x(), extent.y());
+  } else if (object.fit_size) {
+    fit_scale = object.fit_size->value / extent.maxCoeff();
+  }
+  Mat4 scaled = Mat4::Identity();
+  scaled.block<3, 3>(0, 0) *= fit_scale;
+  shaped = scaled * shaped;
+  transformed_bounds(out.mesh, shaped, &lo, &hi);
+  const Vec3 rest_on_table(-(lo.x() + hi.x()) / 2, -(lo.y() + hi.y()) / 2, -lo.z());
+  out.object_from_mesh = translation(rest_on_table + object.translate) * shaped;
+  transformed_bounds(out.mesh, out.object_from_mesh, &out.bounds_min_object,
+                     &out.bounds_max_object);
+  object_center_ = (out.bounds_min_object + out.bounds_max_object) / 2;
+  const double radius = (out.bounds_max_object - out.bounds_min_object).head<2>().norm() / 2;
+  if (radius > scene_.studio.turntable.diameter_m / 2 * 1.5) {
+    diag_.warning(object.loc,
+                  fmt::format("the object ({:.0f} cm across) overhangs the {:.0f} cm turntable",
+                              radius * 200, scene_.studio.turntable.diameter_m * 100));
+  }
+  bool textured = false;
+  for (const auto& m : scene_.materials) {
+    textured |= m.base_color_texture >= 0 || m.pattern.kind != ir::PatternKind::kNone;
+  }
+  if (!textured) {
+    diag_.warning(object.loc,
+                  "the object has no texture and no surface pattern: SfM will find few features; "
+                  "add surface: {pattern: speckle}");
+  }
+  return true;
+}
+
+void Lowering::lower_camera() {
+  ir::Camera& camera = scene_.camera;
+  camera.fx = camera.focal_length_m * camera.width_px / camera.sensor_width_m;
+  camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
+  camera.cx = camera.width_px / 2.0;
+  camera.cy = camera.height_px / 2.0;
+}
+
+void Lowering::lower_lights() {
+  for (const auto& light_spec : spec_.lights) {
+    ir::Light light = light_spec.light;
+    light.color = blackbody_linear_srgb(light.temperature_k);
+    if (light_spec.look_at) {
+      Vec3 direction = aim_point(*light_spec.look_at) - light.position;
+      if (direction.norm() < 1e-9) {
+        error(light.loc, "the light is at the point it looks at; move it or give a direction");
+        continue;
+      }
+      light.direction = direction.normalized();
+    }
+    scene_.studio.lights.push_back(light);
+  }
+}
+
+void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double angle,
+                        double velocity, const Vec3& aim, const SourceLoc& loc) {
+  ir::Shot shot;
+  shot.index = static_cast<int>(scene_.shots.size());
+  shot.name = fmt::format("shot_{:03d}", shot.index);
+  shot.kind = kind;
+  shot.world_from_camera = world_from_camera;
+  shot.turntable_angle_rad = angle;
+  shot.turntable_velocity_rad_s = velocity;
+  shot.loc = loc;
+  shot.object_from_camera = ir::world_from_object(scene_, angle).inverse() * world_from_camera;
+  const Vec3 eye = world_from_camera.block<3, 1>(0, 3);
+  const Vec3 forward = world_from_camera.block<3, 1>(0, 2);
+  const double camera_space_depth = (aim - eye).dot(forward);
+  shot.focus_distance_m = spec_.focus_auto ? camera_space_depth : spec_.focus_distance_m;
+  const double f = scene_.camera.focal_length_m;
+  if (shot.focus_distance_m <= f * 1.01) {
+    error(spec_.focus_auto ? loc : spec_.focus_loc,
+          fmt::format("{}: focus distance {:.3f} m is not beyond the focal length {:.0f} mm",
+                      shot.name, shot.focus_distance_m, f * 1000));
+  }
+  const Vec3 half = (scene_.object.bounds_max_object - scene_.object.bounds_min_object) / 2;
+  const Vec3 eye_in_object = shot.object_from_camera.block<3, 1>(0, 3) - object_center_;
+  if ((eye_in_object.cwiseAbs() - half).maxCoeff() < 0) {
+    error(loc, fmt::format("{}: the camera is inside the object's bounding box", shot.name));
+  }
+  scene_.shots.push_back(shot);
+}
+
+void Lowering::lower_shots() {
+  const double table_top = scene_.studio.turntable.height_m;
+  for (const auto& group : spec_.shots) {
+    switch (group.kind) {
+      case ir::ShotKind::kTurntable: {
+        const auto& tt = group.turntable;
+        const Vec3 eye(tt.camera.distance_m * std::cos(tt.camera.azimuth_rad),
+                       tt.camera.distance_m * std::sin(tt.camera.azimuth_rad),
+                       table_top + tt.camera.height_m);
+        // The default aim is on the turntable axis at the object's mid height, so that the
+        // object stays centred while it turns.
+        Vec3 aim = aim_point(tt.camera.aim);
+        if (tt.camera.aim.object) aim.head<2>().setZero();
+        const Mat4 world_from_camera = look_at(eye, aim, Vec3::UnitZ());
+        for (int i = 0; i < tt.steps; ++i) {
+          add_shot(ir::ShotKind::kTurntable, world_from_camera, tt.start_rad + i * tt.step_rad,
+                   tt.speed_rad_s, aim, group.loc);
+        }
+        break;
+      }
+      case ir::ShotKind::kOrbit: {
+        const Vec3 aim = aim_point(group.orbit.aim);
+        for (const auto& ring : group.orbit.rings) {
+          for (int i = 0; i < ring.count; ++i) {
+            const double azimuth = ring.start_rad + 2 * std::numbers::pi * i / ring.count;
+            const Vec3 offset(std::cos(ring.elevation_rad) * std::cos(azimuth),
+                              std::cos(ring.elevation_rad) * std::sin(azimuth),
+                              std::sin(ring.elevation_rad));
+            const Vec3 eye = aim + group.orbit.distance_m * offset;
+            add_shot(ir::ShotKind::kOrbit, look_at(eye, aim, Vec3::UnitZ()), 0, 0, aim, ring.loc);
+          }
+        }
+        break;
+      }
+      case ir::ShotKind::kPose: {
+        const auto& pose = group.pose;
+        const Vec3 aim = aim_point(pose.look_at);
+        if ((aim - pose.position).norm() < 1e-6) {
+          error(group.loc, "a pose's position and look_at are the same point");
+          break;
+        }
+        add_shot(ir::ShotKind::kPose, look_at(pose.position, aim, pose.up), pose.turntable_rad, 0,
+                 aim, group.loc);
+        break;
+      }
+    }
+  }
+}
+
+void Lowering::place_backdrop() {
+  // The backdrop hangs behind the object, facing the cameras' mean horizontal direction.
+  Vec3 mean_view = Vec3::Zero();
+  for (const auto& shot : scene_.shots) mean_view += shot.world_from_camera.block<3, 1>(0, 2);
+  mean_view.z() = 0;
+  ir::Backdrop& backdrop = scene_.studio.backdrop;
+  // A full orbit has no mean direction: the backdrop then stays on the +Y side.
+  backdrop.direction = mean_view.norm() > 0.3 * scene_.shots.size() ? mean_view.normalized()
+                                                                     : Vec3(0, 1, 0);
+  if (!spec_.backdrop_distance_set) {
+    // Behind every camera's horizontal distance, so no camera stands behind the screen.
+    double farthest_camera = 0;
+    for (const auto& shot : scene_.shots) {
+      farthest_camera = std::max(farthest_camera, shot.world_from_camera.block<2, 1>(0, 3).norm());
+    }
+    backdrop.distance_m = std::clamp(farthest_camera + 0.3, 0.3, 20.0);
+  }
+}
+
+}  // namespace
+
+std::optional<ir::Scene> lower_scene(const spec::SceneSpec& scene, DiagnosticEngine& diag) {
+  return Lowering(scene, diag).run();
+}
+
+std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::string& file,
+                                            const std::string& base_dir, DiagnosticEngine& diag) {
+  diag.add_source(file, text);
+  // Checking walks the tree section by section; its diagnostics are reported in file order.
+  DiagnosticEngine checking;
+  checking.set_handler([](const Diagnostic&, const std::string&) {});
+  std::optional<spec::SceneSpec> checked;
+  if (auto root = parse_yaml(text, file, checking)) {
+    checked = check_scene(*root, file, base_dir, checking);
+  }
+  std::vector<Diagnostic> found = checking.diagnostics();
+  std::stable_sort(found.begin(), found.end(), [](const Diagnostic& a, const Diagnostic& b) {
+    return std::tie(a.loc.line, a.loc.col) < std::tie(b.loc.line, b.loc.col);
+  });
+  for (auto& d : found) diag.report(std::move(d));
+  if (!checked || checking.has_errors()) return std::nullopt;
+  return lower_scene(*checked, diag);
+}
+
+std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  if (!in || fs::is_directory(path, ec)) {
+    diag.error({path, 0, 0}, "cannot read the scene file");
+    return std::nullopt;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string base_dir = fs::path(path).parent_path().string();
+  if (base_dir.empty()) base_dir = ".";
+  return compile_scene_text(text.str(), path, base_dir, diag);
+}
+
+Mat4 ir::world_from_object(const ir::Scene& scene, double turntable_angle_rad) {
+  return translation(Vec3(0, 0, scene.studio.turntable.height_m)) *
+         rotation(Eigen::AngleAxisd(turntable_angle_rad, Vec3::UnitZ()).toRotationMatrix());
+}
+
+}  // namespace rigc

@@ -1,0 +1,89 @@
+#include "dslr/develop.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "compiler/color.h"
+
+namespace rigc::dslr {
+
+ir::Vec3 blackbody_rgb(double kelvin) { return blackbody_linear_srgb(kelvin); }
+
+std::array<double, 3> white_balance_gains(const ir::Camera& camera,
+                                          const std::vector<float>& linear,
+                                          const std::vector<std::uint8_t>& mask) {
+  if (camera.white_balance == ir::WhiteBalanceMode::kKelvin) {
+    const ir::Vec3 white = blackbody_rgb(camera.white_balance_k);
+    return {1 / white.x(), 1 / white.y(), 1 / white.z()};
+  }
+  const std::size_t n = linear.size() / 3;
+  std::size_t masked = 0;
+  if (mask.size() == n) {
+    for (std::uint8_t m : mask) masked += m >= 128;
+  }
+  // A mask covering almost nothing says little about the light: use the whole frame.
+  const bool use_mask = masked > std::max<std::size_t>(16, n / 1000);
+  double sum[3] = {0, 0, 0};
+  for (std::size_t p = 0; p < n; ++p) {
+    if (use_mask && mask[p] < 128) continue;
+    const float* v = &linear[3 * p];
+    if (std::max({v[0], v[1], v[2]}) >= 0.98f) continue;  // clipped: its colour is wrong
+    for (int c = 0; c < 3; ++c) sum[c] += std::max(0.0f, v[c]);
+  }
+  const double y = 0.2126 * sum[0] + 0.7152 * sum[1] + 0.0722 * sum[2];
+  std::array<double, 3> gains{1, 1, 1};
+  if (!(y > 0)) return gains;
+  for (int c = 0; c < 3; ++c) {
+    gains[c] = sum[c] > 0 ? std::clamp(y / sum[c], 1.0 / 8, 8.0) : 1.0;
+  }
+  return gains;
+}
+
+double srgb_oetf(double linear) {
+  linear = std::clamp(linear, 0.0, 1.0);
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
+}
+
+namespace {
+
+// Tables indexed by the linear value: 2^16 entries are exact to 8 bits; 2^20 keep 16-bit output
+// within about one code even in the steep segment near black.
+const std::vector<std::uint16_t>& srgb_table(int bits) {
+  auto build = [](int index_bits, double out_max) {
+    const int size = 1 << index_bits;
+    std::vector<std::uint16_t> table(size);
+    for (int i = 0; i < size; ++i) {
+      table[i] = static_cast<std::uint16_t>(std::lround(srgb_oetf(double(i) / (size - 1)) * out_max));
+    }
+    return table;
+  };
+  static const std::vector<std::uint16_t> table8 = build(16, 255);
+  static const std::vector<std::uint16_t> table16 = build(20, 65535);
+  return bits == 8 ? table8 : table16;
+}
+
+}  // namespace
+
+std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
+                                       const std::array<double, 3>& gains, int bits) {
+  const std::vector<std::uint16_t>& table = srgb_table(bits);
+  const float last = static_cast<float>(table.size() - 1);
+  const float g[3] = {float(gains[0] * last), float(gains[1] * last), float(gains[2] * last)};
+  std::vector<std::uint16_t> out(linear.size());
+  const std::size_t n = linear.size() / 3;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t p = range.begin(); p < range.end(); ++p) {
+                        for (int c = 0; c < 3; ++c) {
+                          const float x = std::clamp(linear[3 * p + c] * g[c], 0.0f, last);
+                          out[3 * p + c] = table[static_cast<std::size_t>(x + 0.5f)];
+                        }
+                      }
+                    });
+  return out;
+}
+
+}  // namespace rigc::dslr

@@ -1,0 +1,34 @@
+// Development of the sensor signal into an image file's pixels: white balance, tone curve, sRGB.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "compiler/ir.h"
+
+namespace rigc::dslr {
+
+// Linear sRGB of a blackbody at `kelvin`, normalised to luminance 1 (the same function the
+// compiler uses for light colours, so a light of T kelvin is neutral under white balance T).
+ir::Vec3 blackbody_rgb(double kelvin);
+
+// Per-channel gains that make a neutral surface neutral, preserving luminance.
+//  - kKelvin: 1 / blackbody_rgb(white_balance_k).
+//  - kAuto: gray world: the mean colour of the masked pixels (the object; all pixels when the
+//    mask is empty or nearly so), ignoring clipped ones, is made grey. Gains are kept in 1/8..8.
+std::array<double, 3> white_balance_gains(const ir::Camera& camera,
+                                          const std::vector<float>& linear,
+                                          const std::vector<std::uint8_t>& mask);
+
+// The sRGB transfer function (IEC 61966-2-1) on [0, 1].
+double srgb_oetf(double linear);
+
+// Tone curve and encoding: the white-balanced signal is clipped to [0, 1] (highlights clip as
+// on the sensor; no filmic shoulder, so the response stays exactly invertible) and encoded with
+// the sRGB transfer function to `bits` (8 or 16). A meter-average exposure (v = 12.5·q/78 ≈ 0.104)
+// lands at code 92/255: about 2/3 stop darker than an in-camera JPEG's tone curve would put it.
+std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
+                                       const std::array<double, 3>& gains, int bits);
+
+}  // namespace rigc::dslr

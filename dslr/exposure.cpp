@@ -1,0 +1,36 @@
+#include "dslr/exposure.h"
+
+#include <cmath>
+
+#include "dslr/lens.h"
+
+namespace rigc::dslr {
+
+double ev100(double f_number, double shutter_s, double iso) {
+  return std::log2(f_number * f_number / shutter_s) - std::log2(iso / 100.0);
+}
+
+double exposure_scale(const ir::Camera& camera) {
+  const double n = camera.aperture_f_number;
+  return camera.shutter_s * camera.iso * kExposureQ / (78.0 * n * n);
+}
+
+void apply_exposure(const ir::Camera& camera, std::vector<float>& rgb) {
+  const float scale = static_cast<float>(exposure_scale(camera));
+  for (float& v : rgb) v *= scale;
+}
+
+double motion_blur_length_px(double angular_velocity_rad_s, double shutter_s,
+                             double radius_perpendicular_m, double depth_m, double f_px) {
+  if (!(depth_m > 0)) return 0;
+  return std::abs(angular_velocity_rad_s) * shutter_s * std::abs(radius_perpendicular_m) * f_px /
+         depth_m;
+}
+
+double motion_blur_length_px(const ir::Camera& camera, double scale, double angular_velocity_rad_s,
+                             double radius_perpendicular_m, double depth_m) {
+  return motion_blur_length_px(angular_velocity_rad_s, camera.shutter_s, radius_perpendicular_m,
+                               depth_m, sensor_intrinsics(camera, scale).fx);
+}
+
+}  // namespace rigc::dslr

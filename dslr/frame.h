@@ -1,0 +1,73 @@
+// Data passed through the DSLR pipeline: what a renderer hands in, what comes out.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace rigc::dslr {
+
+// Pinhole intrinsics of a pixel grid. Pixel centres at +0.5 (COLMAP): pixel (i, j) has its
+// centre at u = i + 0.5, and u = fx * x + cx for normalised camera coordinates x.
+struct Intrinsics {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+
+// What a renderer must render: an undistorted pinhole canvas that covers every sensor pixel once
+// the lens distortion is applied. `clipped` is set when the growth cap was hit (very strong
+// distortion): some sensor pixels then sample the canvas edge.
+struct RenderGeometry : Intrinsics {
+  bool clipped = false;
+};
+
+// A linear frame from any renderer, rendered with an UNDISTORTED pinhole camera.
+struct LinearFrame {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  // 3 floats per pixel, row-major, top row first: scene-linear radiance in cd/m² (luminance
+  // Y = 0.2126 R + 0.7152 G + 0.0722 B is in cd/m²).
+  std::vector<float> rgb;
+  // Camera-space z depth in metres per pixel; +inf for background at infinity.
+  std::vector<float> depth_m;
+  // Optional object mask (0 or 255); empty when the renderer has none.
+  std::vector<std::uint8_t> mask;
+
+  Intrinsics intrinsics() const { return {width, height, fx, fy, cx, cy}; }
+};
+
+// Per-shot inputs that are not part of the camera.
+struct ShotParams {
+  double focus_distance_m = 1;  // ir::Shot::focus_distance_m
+  int shot_index = 0;           // varies the temporal noise between shots
+  std::uint64_t seed = 1;       // camera seed: fixes the sensor's fixed-pattern noise
+};
+
+// Wall-clock milliseconds spent in each stage of develop_frame.
+struct StageTimings {
+  double exposure_ms = 0;
+  double depth_of_field_ms = 0;
+  double diffraction_ms = 0;
+  double distortion_ms = 0;  // warp to the sensor grid, with vignetting
+  double noise_ms = 0;
+  double develop_ms = 0;  // white balance, tone curve, encoding
+  double total_ms = 0;
+};
+
+struct DevelopResult {
+  int width = 0;
+  int height = 0;
+  // Normalised sensor signal (1.0 = clipping), 3 per pixel, after noise and before white
+  // balance and the tone curve: the linear response tests can check against the formulas.
+  std::vector<float> linear;
+  int bits = 8;                        // 8 for JPEG, 16 for PNG/TIFF
+  std::vector<std::uint16_t> encoded;  // sRGB code values, 3 per pixel (0..255 or 0..65535)
+  std::vector<std::uint8_t> mask;      // object mask on the sensor grid; empty if the frame had none
+  std::vector<float> depth_m;          // depth on the sensor grid (nearest sample)
+  std::array<double, 3> white_balance_gains{1, 1, 1};
+  StageTimings timings;
+};
+
+}  // namespace rigc::dslr

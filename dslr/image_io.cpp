@@ -1,0 +1,117 @@
+#include "dslr/image_io.h"
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <atomic>
+#include <cmath>
+#include <system_error>
+
+namespace rigc::dslr {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void set_error(std::string* error, const std::string& message) {
+  if (error != nullptr) *error = message;
+}
+
+// A name in the same folder (so the rename is atomic), hidden, unique per process and call.
+fs::path temporary_path_for(const fs::path& path) {
+  static std::atomic<unsigned> counter{0};
+  return path.parent_path() / ("." + path.filename().string() + ".tmp" +
+                               std::to_string(::getpid()) + "_" + std::to_string(counter++));
+}
+
+// Writes pixels to a temporary file with the final name's format, then renames it into place.
+bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pixels,
+                      std::string* error) {
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    set_error(error, "cannot write " + path.string() + ": " + OIIO::geterror());
+    return false;
+  }
+  const fs::path temporary = temporary_path_for(path);
+  std::error_code ec;
+  auto fail = [&](const std::string& why) {
+    out.reset();  // closes the file before it is removed
+    fs::remove(temporary, ec);
+    set_error(error, "cannot write " + path.string() + ": " + why);
+    return false;
+  };
+  if (!out->open(temporary.string(), spec)) return fail(out->geterror());
+  if (!out->write_image(spec.format, pixels)) return fail(out->geterror());
+  if (!out->close()) return fail(out->geterror());
+  out.reset();
+  fs::rename(temporary, path, ec);
+  if (ec) return fail(ec.message());
+  return true;
+}
+
+}  // namespace
+
+bool write_image(const fs::path& path, const DevelopResult& result, const ir::Camera& camera,
+                 std::string* error) {
+  const std::size_t values = static_cast<std::size_t>(result.width) * result.height * 3;
+  if (result.width <= 0 || result.height <= 0 || result.encoded.size() != values) {
+    set_error(error, "cannot write " + path.string() + ": the image is empty or malformed");
+    return false;
+  }
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool jpeg = extension == ".jpg" || extension == ".jpeg";
+  const bool eight_bits = jpeg || result.bits == 8;
+
+  OIIO::ImageSpec spec(result.width, result.height, 3,
+                       eight_bits ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  if (jpeg) {
+    spec.attribute("Compression", "jpeg:" + std::to_string(std::clamp(camera.jpeg_quality, 1, 100)));
+  }
+  spec.attribute("Make", camera.make);
+  spec.attribute("Model", camera.model);
+  spec.attribute("Software", "RigC " RIGC_VERSION);
+  const double focal_mm = camera.focal_length_m * 1000;
+  spec.attribute("Exif:FocalLength", static_cast<float>(focal_mm));
+  spec.attribute("FNumber", static_cast<float>(camera.aperture_f_number));
+  spec.attribute("ExposureTime", static_cast<float>(camera.shutter_s));
+  spec.attribute("Exif:PhotographicSensitivity", static_cast<int>(std::lround(camera.iso)));
+  const double diagonal_mm =
+      std::hypot(camera.sensor_width_m, camera.sensor_height_m) * 1000;  // 35 mm film: 43.27 mm
+  if (diagonal_mm > 0) {
+    spec.attribute("Exif:FocalLengthIn35mmFilm",
+                   static_cast<int>(std::lround(focal_mm * 43.2666 / diagonal_mm)));
+  }
+  if (camera.sensor_width_m > 0 && camera.sensor_height_m > 0) {
+    spec.attribute("Exif:FocalPlaneXResolution",
+                   static_cast<float>(result.width / (camera.sensor_width_m * 100)));
+    spec.attribute("Exif:FocalPlaneYResolution",
+                   static_cast<float>(result.height / (camera.sensor_height_m * 100)));
+    spec.attribute("Exif:FocalPlaneResolutionUnit", 3);  // centimetres
+  }
+
+  if (eight_bits) {
+    std::vector<std::uint8_t> pixels(values);
+    const int shift = result.bits == 8 ? 0 : 1;
+    for (std::size_t i = 0; i < values; ++i) {
+      pixels[i] = static_cast<std::uint8_t>(
+          shift ? (result.encoded[i] * 255u + 32767u) / 65535u : result.encoded[i]);
+    }
+    return write_atomically(path, spec, pixels.data(), error);
+  }
+  return write_atomically(path, spec, result.encoded.data(), error);
+}
+
+bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int width, int height,
+                std::string* error) {
+  if (width <= 0 || height <= 0 || mask.size() != static_cast<std::size_t>(width) * height) {
+    set_error(error, "cannot write " + path.string() + ": the mask is empty or malformed");
+    return false;
+  }
+  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT8);
+  return write_atomically(path, spec, mask.data(), error);
+}
+
+}  // namespace rigc::dslr

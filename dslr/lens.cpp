@@ -1,0 +1,220 @@
+#include "dslr/lens.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rigc::dslr {
+
+Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale) {
+  Intrinsics k;
+  k.width = std::max(1, static_cast<int>(std::lround(camera.width_px * scale)));
+  k.height = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
+  const double sx = static_cast<double>(k.width) / camera.width_px;
+  const double sy = static_cast<double>(k.height) / camera.height_px;
+  const double fx = camera.fx > 0 ? camera.fx
+                                  : camera.focal_length_m * camera.width_px / camera.sensor_width_m;
+  const double fy = camera.fy > 0
+                        ? camera.fy
+                        : camera.focal_length_m * camera.height_px / camera.sensor_height_m;
+  k.fx = fx * sx;
+  k.fy = fy * sy;
+  k.cx = (camera.cx > 0 ? camera.cx : camera.width_px / 2.0) * sx;
+  k.cy = (camera.cy > 0 ? camera.cy : camera.height_px / 2.0) * sy;
+  return k;
+}
+
+ir::Vec2 distort_normalized(const ir::Distortion& d, double x, double y) {
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  return {x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x),
+          y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y};
+}
+
+bool try_undistort_normalized(const ir::Distortion& d, double x, double y, ir::Vec2* undistorted,
+                              const ir::Vec2* guess) {
+  auto newton = [&](double ux, double uy) -> bool {
+    for (int iteration = 0; iteration < 30; ++iteration) {
+      const double r2 = ux * ux + uy * uy;
+      const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+      const double dradial = d.k1 + r2 * (2 * d.k2 + 3 * d.k3 * r2);  // d radial / d r²
+      const double fx = ux * radial + 2 * d.p1 * ux * uy + d.p2 * (r2 + 2 * ux * ux) - x;
+      const double fy = uy * radial + d.p1 * (r2 + 2 * uy * uy) + 2 * d.p2 * ux * uy - y;
+      const double jxx = radial + 2 * ux * ux * dradial + 2 * d.p1 * uy + 6 * d.p2 * ux;
+      const double jxy = 2 * ux * uy * dradial + 2 * d.p1 * ux + 2 * d.p2 * uy;
+      const double jyy = radial + 2 * uy * uy * dradial + 6 * d.p1 * uy + 2 * d.p2 * ux;
+      const double det = jxx * jyy - jxy * jxy;
+      // A non-positive Jacobian means we are past the fold: the lens maps no point here.
+      if (!(det > 1e-12)) return false;
+      const double sx = (jyy * fx - jxy * fy) / det;
+      const double sy = (jxx * fy - jxy * fx) / det;
+      ux -= sx;
+      uy -= sy;
+      if (!std::isfinite(ux) || !std::isfinite(uy) || ux * ux + uy * uy > 1e6) return false;
+      if (sx * sx + sy * sy < 1e-28) {
+        *undistorted = {ux, uy};
+        return true;
+      }
+    }
+    return false;
+  };
+  if (guess != nullptr && newton(guess->x(), guess->y())) return true;
+  return newton(x, y);
+}
+
+ir::Vec2 undistort_normalized(const ir::Distortion& d, double x, double y) {
+  ir::Vec2 u;
+  return try_undistort_normalized(d, x, y, &u) ? u : ir::Vec2(x, y);
+}
+
+RenderGeometry render_geometry_for(const ir::Camera& camera, double scale) {
+  const Intrinsics sensor = sensor_intrinsics(camera, scale);
+  RenderGeometry geometry;
+  static_cast<Intrinsics&>(geometry) = sensor;
+  if (!camera.effects.distortion || camera.distortion.is_zero()) return geometry;
+
+  const double w = sensor.width, h = sensor.height;
+  double u_min = std::numeric_limits<double>::infinity(), u_max = -u_min;
+  double v_min = u_min, v_max = -u_min;
+  bool unreachable = false;
+  ir::Vec2 guess(0, 0);
+  auto visit = [&](double u, double v) {
+    ir::Vec2 xu;
+    if (!try_undistort_normalized(camera.distortion, (u - sensor.cx) / sensor.fx,
+                                  (v - sensor.cy) / sensor.fy, &xu, &guess)) {
+      unreachable = true;
+      return;
+    }
+    guess = xu;
+    const double uu = sensor.fx * xu.x() + sensor.cx, vv = sensor.fy * xu.y() + sensor.cy;
+    u_min = std::min(u_min, uu), u_max = std::max(u_max, uu);
+    v_min = std::min(v_min, vv), v_max = std::max(v_max, vv);
+  };
+  // The border, every pixel edge, then a coarse interior grid for unusual coefficient mixes.
+  for (int i = 0; i <= sensor.width; ++i) visit(i, 0);
+  for (int j = 0; j <= sensor.height; ++j) visit(w, j);
+  for (int i = sensor.width; i >= 0; --i) visit(i, h);
+  for (int j = sensor.height; j >= 0; --j) visit(0, j);
+  for (int a = 1; a < 32; ++a) {
+    for (int b = 1; b < 32; ++b) visit(w * a / 32, h * b / 32);
+  }
+  if (!(u_min <= u_max)) {
+    geometry.clipped = true;
+    return geometry;
+  }
+  // Equal padding on both sides keeps the principal point where it was relative to the centre
+  // (centred stays centred: renderers need no lens shift).
+  constexpr double kMargin = 2;
+  const double need_x = std::max(kMargin - u_min, u_max + kMargin - w);
+  const double need_y = std::max(kMargin - v_min, v_max + kMargin - h);
+  const int cap_x = sensor.width / 2, cap_y = sensor.height / 2;
+  const int pad_x = std::min(cap_x, static_cast<int>(std::ceil(need_x)));
+  const int pad_y = std::min(cap_y, static_cast<int>(std::ceil(need_y)));
+  geometry.clipped = unreachable || need_x > cap_x || need_y > cap_y;
+  geometry.width = std::max(1, sensor.width + 2 * pad_x);
+  geometry.height = std::max(1, sensor.height + 2 * pad_y);
+  geometry.cx = sensor.cx + pad_x;
+  geometry.cy = sensor.cy + pad_y;
+  return geometry;
+}
+
+double vignetting_gain(double fraction_lost, double r2, double r2_corner) {
+  if (fraction_lost <= 0 || r2_corner <= 0) return 1;
+  auto cos4 = [](double q) { return 1 / ((1 + q) * (1 + q)); };
+  return 1 - fraction_lost * (1 - cos4(r2)) / (1 - cos4(r2_corner));
+}
+
+namespace {
+
+bool same_grid(const Intrinsics& a, const Intrinsics& b) {
+  auto close = [](double p, double q) { return std::abs(p - q) <= 1e-9 * std::max(1.0, std::abs(p)); };
+  return a.width == b.width && a.height == b.height && close(a.fx, b.fx) && close(a.fy, b.fy) &&
+         close(a.cx, b.cx) && close(a.cy, b.cy);
+}
+
+}  // namespace
+
+SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
+                           const Intrinsics& canvas, const std::vector<float>& rgb,
+                           const std::vector<float>& depth_m,
+                           const std::vector<std::uint8_t>& mask) {
+  SensorImage out;
+  out.intrinsics = sensor;
+  const std::size_t n = static_cast<std::size_t>(sensor.width) * sensor.height;
+  out.rgb.resize(3 * n);
+  const bool has_depth = !depth_m.empty(), has_mask = !mask.empty();
+  if (has_depth) out.depth_m.resize(n);
+  if (has_mask) out.mask.resize(n);
+
+  const bool distort = camera.effects.distortion && !camera.distortion.is_zero();
+  const double vignetting = camera.effects.vignetting ? std::clamp(camera.vignetting, 0.0, 1.0) : 0;
+  double r2_corner = 0;
+  for (double u : {0.0, double(sensor.width)}) {
+    for (double v : {0.0, double(sensor.height)}) {
+      const double x = (u - sensor.cx) / sensor.fx, y = (v - sensor.cy) / sensor.fy;
+      r2_corner = std::max(r2_corner, x * x + y * y);
+    }
+  }
+  const bool copy = !distort && same_grid(sensor, canvas);
+  const int cw = canvas.width, ch = canvas.height;
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, sensor.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int j = rows.begin(); j < rows.end(); ++j) {
+      const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
+      ir::Vec2 guess(0, yd);
+      for (int i = 0; i < sensor.width; ++i) {
+        const std::size_t o = static_cast<std::size_t>(j) * sensor.width + i;
+        const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
+        const float gain =
+            vignetting > 0 ? static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner))
+                           : 1.0f;
+        if (copy) {
+          for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] = rgb[3 * o + c] * gain;
+          if (has_depth) out.depth_m[o] = depth_m[o];
+          if (has_mask) out.mask[o] = mask[o];
+          continue;
+        }
+        ir::Vec2 xu(xd, yd);
+        if (distort && !try_undistort_normalized(camera.distortion, xd, yd, &xu, &guess)) {
+          // Beyond the fold of the lens: no light arrives here.
+          for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] = 0;
+          if (has_depth) out.depth_m[o] = std::numeric_limits<float>::infinity();
+          if (has_mask) out.mask[o] = 0;
+          continue;
+        }
+        guess = xu;
+        // Canvas position in index space (pixel centres at +0.5).
+        const double uc = canvas.fx * xu.x() + canvas.cx - 0.5;
+        const double vc = canvas.fy * xu.y() + canvas.cy - 0.5;
+        const double fu = std::floor(uc), fv = std::floor(vc);
+        const float au = static_cast<float>(uc - fu), av = static_cast<float>(vc - fv);
+        const int i0 = std::clamp(static_cast<int>(fu), 0, cw - 1);
+        const int i1 = std::clamp(static_cast<int>(fu) + 1, 0, cw - 1);
+        const int j0 = std::clamp(static_cast<int>(fv), 0, ch - 1);
+        const int j1 = std::clamp(static_cast<int>(fv) + 1, 0, ch - 1);
+        const float* p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
+        const float* p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
+        const float* p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
+        const float* p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
+        for (int c = 0; c < 3; ++c) {
+          const float top = p00[c] + au * (p10[c] - p00[c]);
+          const float bottom = p01[c] + au * (p11[c] - p01[c]);
+          out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
+        }
+        if (has_depth || has_mask) {
+          const int ni = std::clamp(static_cast<int>(std::floor(uc + 0.5)), 0, cw - 1);
+          const int nj = std::clamp(static_cast<int>(std::floor(vc + 0.5)), 0, ch - 1);
+          const std::size_t s = static_cast<std::size_t>(nj) * cw + ni;
+          if (has_depth) out.depth_m[o] = depth_m[s];
+          if (has_mask) out.mask[o] = mask[s];
+        }
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace rigc::dslr

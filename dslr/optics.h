@@ -1,0 +1,49 @@
+// Optical blur: thin-lens depth of field and diffraction, applied to the undistorted canvas.
+#pragma once
+
+#include <vector>
+
+#include "compiler/ir.h"
+#include "dslr/frame.h"
+
+namespace rigc::dslr {
+
+// Blur discs are capped at this radius (pixels of the canvas): beyond it the blur is
+// underestimated (documented approximation that bounds the cost).
+inline constexpr int kMaxCocRadiusPx = 64;
+
+// Thin lens: diameter on the sensor (m) of the circle of confusion of a point at depth_m when
+// focused at focus_m: c = (f/N)·f·|S2 - S1| / (S2·(S1 - f)). depth_m = +inf gives the limit
+// (f/N)·f/(S1 - f). Zero when the focus is inside the focal length (not a real focus).
+double coc_diameter_m(double focal_length_m, double f_number, double focus_m, double depth_m);
+
+// Hyperfocal distance H = f²/(N·c0) + f.
+double hyperfocal_m(double focal_length_m, double f_number, double coc_m);
+
+// Gaussian stand-in for the Airy disc: σ ≈ 0.42·λ·N (m on the sensor).
+double diffraction_sigma_m(double f_number, double wavelength_m = 550e-9);
+
+// Depth of field on an undistorted canvas (rgb: 3 per pixel, depth_m: 1 per pixel).
+//
+// A scatter-as-gather disc blur: pixel p collects every neighbour q whose blur disc covers it.
+// Neighbours are split by depth into three layers composited front to back:
+//  - in front of p: q's own disc decides (a blurred foreground spreads over a sharp background);
+//    its weight is q's energy per pixel, 1/(π r_q²), and the summed coverage is the layer's alpha;
+//  - at p's depth (±2 %): the same, normalised (a uniform region gets the plain disc average);
+//  - behind p: only within p's own disc, so a sharp foreground never picks up the background
+//    behind it and keeps its exact values (no halos).
+// Taps: every pixel within 6.5 px, then rings 25 % apart with as many taps as keep the spacing
+// isotropic, each weighted by the area it stands for; taps are rounded to whole pixels (large
+// discs of small bright highlights show ring structure). Each 16x16 tile only visits the taps
+// that the largest disc reaching it needs, so sharp regions cost a copy.
+void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
+                          const Intrinsics& canvas, const std::vector<float>& rgb,
+                          const std::vector<float>& depth_m, std::vector<float>& out);
+
+// Diffraction as a separable Gaussian of σ = 0.42·λ·N (λ = 550 nm) in canvas pixels, skipped
+// below 0.2 px. Applied after the disc blur it adds variances as CAMERA.md combines them
+// (σ² = σ_diffraction² + (c/4)²). Returns the σ used (0 when skipped).
+double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
+                         std::vector<float>& rgb, std::vector<float>& scratch);
+
+}  // namespace rigc::dslr

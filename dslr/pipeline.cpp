@@ -1,0 +1,111 @@
+#include "dslr/pipeline.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <string>
+
+#include "dslr/develop.h"
+#include "dslr/exposure.h"
+#include "dslr/lens.h"
+#include "dslr/optics.h"
+#include "dslr/sensor.h"
+
+namespace rigc::dslr {
+
+int output_bits(const ir::Camera& camera) {
+  return camera.format == ir::ImageFormat::kJpeg ? 8 : 16;
+}
+
+namespace {
+
+class StageClock {
+ public:
+  double lap_ms() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+std::string check_frame(const LinearFrame& frame) {
+  const std::size_t n = static_cast<std::size_t>(std::max(0, frame.width)) * std::max(0, frame.height);
+  if (frame.width <= 0 || frame.height <= 0) return "the frame has no pixels";
+  if (!(frame.fx > 0) || !(frame.fy > 0)) return "the frame has no focal length in pixels";
+  if (frame.rgb.size() != 3 * n) {
+    return "the frame's rgb has " + std::to_string(frame.rgb.size()) + " values, expected " +
+           std::to_string(3 * n);
+  }
+  if (!frame.depth_m.empty() && frame.depth_m.size() != n) {
+    return "the frame's depth has " + std::to_string(frame.depth_m.size()) + " values, expected " +
+           std::to_string(n);
+  }
+  if (!frame.mask.empty() && frame.mask.size() != n) {
+    return "the frame's mask has " + std::to_string(frame.mask.size()) + " values, expected " +
+           std::to_string(n);
+  }
+  return {};
+}
+
+}  // namespace
+
+DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
+                            const ShotParams& shot, double scale, std::string* error) {
+  DevelopResult result;
+  if (std::string problem = check_frame(frame); !problem.empty()) {
+    if (error != nullptr) *error = problem;
+    return result;
+  }
+  StageClock clock;
+  const Intrinsics canvas = frame.intrinsics();
+  const Intrinsics sensor = sensor_intrinsics(camera, scale);
+
+  std::vector<float> work(frame.rgb.size());
+  const float exposure = static_cast<float>(exposure_scale(camera));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1 << 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i < r.end(); ++i) work[i] = frame.rgb[i] * exposure;
+                    });
+  result.timings.exposure_ms = clock.lap_ms();
+
+  std::vector<float> scratch;
+  if (camera.effects.depth_of_field && !frame.depth_m.empty()) {
+    apply_depth_of_field(camera, shot.focus_distance_m, canvas, work, frame.depth_m, scratch);
+    work.swap(scratch);
+  }
+  result.timings.depth_of_field_ms = clock.lap_ms();
+
+  if (camera.effects.diffraction) apply_diffraction(camera, canvas, work, scratch);
+  scratch = {};
+  result.timings.diffraction_ms = clock.lap_ms();
+
+  SensorImage image = warp_to_sensor(camera, sensor, canvas, work, frame.depth_m, frame.mask);
+  work = {};
+  result.timings.distortion_ms = clock.lap_ms();
+
+  apply_sensor(camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index);
+  result.timings.noise_ms = clock.lap_ms();
+
+  result.width = sensor.width;
+  result.height = sensor.height;
+  result.bits = output_bits(camera);
+  const auto gains = white_balance_gains(camera, image.rgb, image.mask);
+  result.white_balance_gains = gains;
+  result.encoded = encode_srgb(image.rgb, gains, result.bits);
+  result.linear = std::move(image.rgb);
+  result.mask = std::move(image.mask);
+  result.depth_m = std::move(image.depth_m);
+  result.timings.develop_ms = clock.lap_ms();
+
+  const auto& t = result.timings;
+  result.timings.total_ms = t.exposure_ms + t.depth_of_field_ms + t.diffraction_ms +
+                            t.distortion_ms + t.noise_ms + t.develop_ms;
+  return result;
+}
+
+}  // namespace rigc::dslr

@@ -1,0 +1,40 @@
+// The sensor: photon shot noise, dark current, read noise, fixed-pattern noise, clipping and the
+// ADC, in the order ISETCam simulates them (CAMERA.md).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "compiler/ir.h"
+
+namespace rigc::dslr {
+
+// Electrons at clipping at an ISO: full_well_e · base_iso / iso.
+double electrons_at_clipping(const ir::SensorNoise& noise, double iso);
+
+// Read noise (electrons) at an ISO: a power law through read_noise_e at the base ISO and
+// read_noise_high_iso_e at ISO 6400 (straight in log-ISO/log-electrons), held flat outside.
+// An estimate: the end points are estimates for most presets (see SensorNoise::source_note).
+double read_noise_electrons(const ir::SensorNoise& noise, double iso);
+
+// Black level of the simulated ADC, in code values: negative noise excursions down to this are
+// kept (as in a raw file before black subtraction) so dark regions keep an unbiased mean.
+int black_level_dn(int adc_bits);
+
+// Counter-based random numbers: the value for (seed, stream, index) does not depend on the order
+// of evaluation, so results are identical with any number of threads.
+std::uint64_t hash64(std::uint64_t seed, std::uint64_t stream, std::uint64_t index);
+// Standard normal from 16 bits (a table of the inverse CDF at bin centres, |z| <= 4.3).
+float normal_from_bits(std::uint32_t bits16);
+
+// Applies the sensor to a normalised signal (3 per pixel, 1.0 = clipping at this ISO), in place:
+//   e = v·electrons_at_clipping; PRNU gain; + dark current·t; Poisson shot noise (exact below
+//   30 e⁻, Gaussian above); + Gaussian read noise; + DSNU offset; quantise to adc_bits with
+//   clipping at full scale; back to normalised.
+// Each colour channel is simulated as its own photosite (no Bayer mosaic). PRNU and DSNU depend
+// on `seed` only (the same camera gives the same pattern in every shot); the temporal noise also
+// on `shot_index`. With camera.effects.noise off the signal is only clipped to [0, 1].
+void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
+                  std::uint64_t seed, int shot_index);
+
+}  // namespace rigc::dslr
