@@ -7,6 +7,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
+#include "backends/common/shots.h"
+#include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "compiler/ir_json.h"
 #include "compiler/units.h"
@@ -135,6 +139,43 @@ int run_compile(std::vector<std::string> args) {
   return kExitOk;
 }
 
+int run_render(std::vector<std::string> args) {
+  CLI::App app{"Render every shot of a scene with a backend, in RigC's output layout."};
+  std::string scene_path, backend = "preview", output, shot_text;
+  double scale = 1.0;
+  std::uint64_t seed = 1;
+  app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  app.add_option("--backend", backend, "renderer")
+      ->check(CLI::IsMember({"preview"}))
+      ->capture_default_str();
+  app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
+  app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 (default: all)");
+  app.add_option("--scale", scale, "multiplies the sensor resolution, for quick looks")
+      ->check(CLI::Range(0.01, 4.0))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "sensor noise seed")->capture_default_str();
+  if (auto code = parse_options(app, args)) return *code;
+
+  DiagnosticEngine diag;
+  auto scene = compile_scene_file(scene_path, diag);
+  if (!scene) return kExitUserError;
+  std::string error;
+  auto shots = backends::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()),
+                                              &error);
+  if (!shots) {
+    std::cerr << "rigc: error: --shots: " << error << '\n';
+    return kExitUserError;
+  }
+  if (output.empty()) output = (fs::path("out") / scene->name / backend).string();
+  preview::RenderOptions options;
+  options.output_dir = output;
+  options.shots = *shots;
+  options.scale = scale;
+  options.seed = seed;
+  options.progress_bar = isatty(STDERR_FILENO);
+  return preview::run_preview(*scene, options, std::cerr);
+}
+
 int run_version(std::vector<std::string> args) {
   CLI::App app{"Print the version of rigc and of the scene language."};
   if (auto code = parse_options(app, args)) return *code;
@@ -148,6 +189,7 @@ const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"check", "check a scene and report errors and capture warnings", run_check},
       {"compile", "compile a scene to a target (ir)", run_compile},
+      {"render", "render every shot with a backend (preview)", run_render},
       {"version", "print the version", run_version},
   };
   return table;

@@ -1,29 +1,31 @@
 #include "compiler/mesh_io.h"
 
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
-#include <assimp/config.h>
-#include <assimp/material.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <bit>
 #include <cctype>
 #include <charconv>
-#include <cstdlib>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
-#include <optional>
 #include <new>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -241,14 +243,22 @@ struct AccessorView {
 
 const char* type_name(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT2: return "MAT2";
-    case TINYGLTF_TYPE_MAT3: return "MAT3";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "unknown";
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT2:
+      return "MAT2";
+    case TINYGLTF_TYPE_MAT3:
+      return "MAT3";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "unknown";
   }
 }
 
@@ -283,8 +293,7 @@ AccessorView view_accessor(const tinygltf::Model& model, int index, const char* 
     return view;  // zeros
   }
   if (static_cast<std::size_t>(acc.bufferView) >= model.bufferViews.size()) {
-    fail("accessor {} ({}) uses buffer view {}, which does not exist", index, what,
-         acc.bufferView);
+    fail("accessor {} ({}) uses buffer view {}, which does not exist", index, what, acc.bufferView);
   }
   const tinygltf::BufferView& bv = model.bufferViews[acc.bufferView];
   if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= model.buffers.size()) {
@@ -338,7 +347,8 @@ float read_component(const unsigned char* p, int component_type, bool normalized
       const auto v = static_cast<float>(s);
       return normalized ? v / 65535.0f : v;
     }
-    default: return 0.0f;
+    default:
+      return 0.0f;
   }
 }
 
@@ -353,15 +363,16 @@ Eigen::Matrix<float, N, 1> read_vec(const AccessorView& view, std::size_t i) {
   }
   const int size =
       tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(view.component_type));
-  for (int k = 0; k < N; ++k) v[k] = read_component(p + k * size, view.component_type, view.normalized);
+  for (int k = 0; k < N; ++k)
+    v[k] = read_component(p + k * size, view.component_type, view.normalized);
   return v;
 }
 
 std::vector<std::uint32_t> read_indices(const tinygltf::Model& model, int accessor) {
-  const AccessorView view = view_accessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
-                                          {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+  const AccessorView view =
+      view_accessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
+                    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
   if (view.count > kMaxTriangles * 3) fail("accessor {} has too many indices", accessor);
   std::vector<std::uint32_t> out(view.count, 0);
   if (!view.data) return out;
@@ -393,7 +404,8 @@ Mat4 node_local_matrix(const tinygltf::Node& node, int index) {
   if (node.matrix.size() == 16) {
     for (int k = 0; k < 16; ++k) m(k % 4, k / 4) = node.matrix[k];  // column-major
   } else {
-    if (!node.matrix.empty()) fail("node {} has a matrix with {} values", index, node.matrix.size());
+    if (!node.matrix.empty())
+      fail("node {} has a matrix with {} values", index, node.matrix.size());
     Eigen::Affine3d t = Eigen::Affine3d::Identity();
     if (!node.translation.empty()) {
       if (node.translation.size() != 3) fail("node {} has a malformed translation", index);
@@ -443,7 +455,7 @@ class GltfLoader {
     }
     if (out_->mesh.triangles.empty()) {
       if (skipped_primitives_ > 0) {
-        fail("contains no triangles ({} primitives of points or lines were skipped)",
+        fail("contains no triangles (skipped {} primitive(s) of points or lines)",
              skipped_primitives_);
       }
       fail("contains no triangles");
@@ -562,9 +574,8 @@ class GltfLoader {
     }
     std::string source = external ? (fs::path(path_).parent_path() / img.uri).string()
                                   : fmt::format("{}#image{}", path_, image);
-    out_->textures.push_back(
-        make_texture(std::move(source), img.width, img.height, img.component, img.bits, img.image,
-                     what));
+    out_->textures.push_back(make_texture(std::move(source), img.width, img.height, img.component,
+                                          img.bits, img.image, what));
     const int index = static_cast<int>(out_->textures.size() - 1);
     image_to_texture_[image] = index;
     return index;
@@ -604,13 +615,11 @@ class GltfLoader {
       if (pos_it == prim.attributes.end()) {
         fail("mesh {} primitive {} has no POSITION attribute", mesh_index, pi);
       }
-      const AccessorView positions = view_accessor(model_, pos_it->second, "POSITION",
-                                                   TINYGLTF_TYPE_VEC3,
-                                                   {TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                                    TINYGLTF_COMPONENT_TYPE_BYTE,
-                                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                                    TINYGLTF_COMPONENT_TYPE_SHORT,
-                                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+      const AccessorView positions =
+          view_accessor(model_, pos_it->second, "POSITION", TINYGLTF_TYPE_VEC3,
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
       const std::size_t vertex_count = positions.count;
       if (vertex_count > kMaxVertices) fail("mesh {} has too many vertices", mesh_index);
 
@@ -739,7 +748,230 @@ class GltfLoader {
   int skipped_primitives_ = 0;
 };
 
+// tinygltf accepts many wrongly typed members by ignoring them (a "scene": "hello" silently
+// becomes scene 0, a texture index of the wrong type drops the texture). This checks the types of
+// the members RigC reads, and the required extensions, before tinygltf runs.
+class GltfSchemaCheck {
+ public:
+  using json = nlohmann::json;
+
+  void run(const json& root) {
+    object(root, "the top level");
+    if (!root.contains("asset")) fail("has no 'asset' (not a glTF 2.0 file)");
+    const json& asset = object(root["asset"], "asset");
+    const json* version = member(asset, "version", "asset");
+    if (!version || !version->is_string()) {
+      fail("is not a glTF 2.0 file (asset.version is {})", version ? version->dump() : "missing");
+    }
+    if (version->get<std::string>().rfind("2.", 0) != 0) {
+      fail("is glTF version {}; only glTF 2.x is supported", version->get<std::string>());
+    }
+    if (const json* required = member(root, "extensionsRequired", "")) {
+      for (const json& ext : array(*required, "extensionsRequired")) {
+        if (!ext.is_string()) fail("extensionsRequired must hold strings");
+        const std::string name = ext.get<std::string>();
+        if (name != "KHR_materials_pbrSpecularGlossiness" && name != "KHR_mesh_quantization" &&
+            name != "KHR_materials_unlit") {
+          fail("requires the glTF extension {}, which is not supported", name);
+        }
+      }
+    }
+    index(root, "scene", "");
+    each(root, "scenes", [&](const json& o, const std::string& at) {
+      string(o, "name", at);
+      indices(o, "nodes", at);
+    });
+    each(root, "nodes", [&](const json& o, const std::string& at) {
+      string(o, "name", at);
+      index(o, "mesh", at);
+      indices(o, "children", at);
+      numbers(o, "matrix", 16, at);
+      numbers(o, "translation", 3, at);
+      numbers(o, "rotation", 4, at);
+      numbers(o, "scale", 3, at);
+    });
+    each(root, "meshes", [&](const json& o, const std::string& at) {
+      string(o, "name", at);
+      const json* prims = member(o, "primitives", at);
+      if (!prims) fail("{}.primitives is missing", at);
+      const json& list = array(*prims, at + ".primitives");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string pat = fmt::format("{}.primitives[{}]", at, i);
+        const json& prim = object(list[i], pat);
+        const json* attrs = member(prim, "attributes", pat);
+        if (!attrs) fail("{}.attributes is missing", pat);
+        for (const auto& [key, value] : object(*attrs, pat + ".attributes").items()) {
+          if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+            fail("{}.attributes.{} must be an index (it is {})", pat, key, value.type_name());
+          }
+        }
+        index(prim, "indices", pat);
+        index(prim, "material", pat);
+        index(prim, "mode", pat);
+      }
+    });
+    each(root, "accessors", [&](const json& o, const std::string& at) {
+      index(o, "bufferView", at);
+      index(o, "byteOffset", at);
+      index(o, "componentType", at);
+      index(o, "count", at);
+      string(o, "type", at);
+    });
+    each(root, "bufferViews", [&](const json& o, const std::string& at) {
+      index(o, "buffer", at);
+      index(o, "byteOffset", at);
+      index(o, "byteLength", at);
+      index(o, "byteStride", at);
+    });
+    each(root, "buffers", [&](const json& o, const std::string& at) {
+      index(o, "byteLength", at);
+      string(o, "uri", at);
+    });
+    each(root, "materials", [&](const json& o, const std::string& at) {
+      string(o, "name", at);
+      if (const json* pbr = member(o, "pbrMetallicRoughness", at)) {
+        const std::string pat = at + ".pbrMetallicRoughness";
+        object(*pbr, pat);
+        numbers(*pbr, "baseColorFactor", 4, pat);
+        number(*pbr, "metallicFactor", pat);
+        number(*pbr, "roughnessFactor", pat);
+        texture_info(*pbr, "baseColorTexture", pat);
+        texture_info(*pbr, "metallicRoughnessTexture", pat);
+      }
+      texture_info(o, "normalTexture", at);
+      texture_info(o, "occlusionTexture", at);
+      texture_info(o, "emissiveTexture", at);
+      if (const json* t = member(o, "normalTexture", at))
+        number(*t, "scale", at + ".normalTexture");
+      if (const json* t = member(o, "occlusionTexture", at)) {
+        number(*t, "strength", at + ".occlusionTexture");
+      }
+    });
+    each(root, "textures", [&](const json& o, const std::string& at) {
+      index(o, "source", at);
+      index(o, "sampler", at);
+    });
+    each(root, "images", [&](const json& o, const std::string& at) {
+      string(o, "name", at);
+      string(o, "uri", at);
+      string(o, "mimeType", at);
+      index(o, "bufferView", at);
+    });
+  }
+
+ private:
+  static std::string join(const std::string& at, const char* key) {
+    return at.empty() ? std::string(key) : at + "." + key;
+  }
+  static const json& object(const json& j, const std::string& at) {
+    if (!j.is_object()) fail("{} must be an object (it is {})", at, j.type_name());
+    check_extensions(j, at);
+    return j;
+  }
+  static const json& array(const json& j, const std::string& at) {
+    if (!j.is_array()) fail("{} must be an array (it is {})", at, j.type_name());
+    return j;
+  }
+  // Every "extensions" member is an object of objects.
+  static void check_extensions(const json& o, const std::string& at) {
+    const auto it = o.find("extensions");
+    if (it == o.end()) return;
+    if (!it->is_object()) fail("{}.extensions must be an object", at);
+    for (const auto& [key, value] : it->items()) {
+      if (!value.is_object()) fail("{}.extensions.{} must be an object", at, key);
+    }
+  }
+  static const json* member(const json& o, const char* key, const std::string&) {
+    const auto it = o.find(key);
+    return it == o.end() ? nullptr : &*it;
+  }
+  static void index(const json& o, const char* key, const std::string& at) {
+    if (const json* v = member(o, key, at)) {
+      if (!v->is_number_integer() || (v->is_number_integer() && v->get<std::int64_t>() < 0)) {
+        fail("{} must be a non-negative integer (it is {} {})", join(at, key), v->type_name(),
+             v->dump());
+      }
+    }
+  }
+  static void indices(const json& o, const char* key, const std::string& at) {
+    if (const json* v = member(o, key, at)) {
+      for (const json& e : array(*v, join(at, key))) {
+        if (!e.is_number_integer() || e.get<std::int64_t>() < 0) {
+          fail("{} must hold non-negative integers", join(at, key));
+        }
+      }
+    }
+  }
+  static void number(const json& o, const char* key, const std::string& at) {
+    if (const json* v = member(o, key, at); v && !v->is_number()) {
+      fail("{} must be a number (it is {})", join(at, key), v->type_name());
+    }
+  }
+  static void numbers(const json& o, const char* key, std::size_t n, const std::string& at) {
+    if (const json* v = member(o, key, at)) {
+      const json& a = array(*v, join(at, key));
+      if (a.size() != n) fail("{} must have {} numbers (it has {})", join(at, key), n, a.size());
+      for (const json& e : a) {
+        if (!e.is_number()) fail("{} must hold numbers", join(at, key));
+      }
+    }
+  }
+  static void string(const json& o, const char* key, const std::string& at) {
+    if (const json* v = member(o, key, at); v && !v->is_string()) {
+      fail("{} must be a string (it is {})", join(at, key), v->type_name());
+    }
+  }
+  static void texture_info(const json& o, const char* key, const std::string& at) {
+    if (const json* v = member(o, key, at)) {
+      const std::string pat = join(at, key);
+      object(*v, pat);
+      if (!v->contains("index")) fail("{}.index is missing", pat);
+      index(*v, "index", pat);
+      index(*v, "texCoord", pat);
+    }
+  }
+  template <typename F>
+  void each(const json& root, const char* key, F&& f) {
+    if (const json* v = member(root, key, "")) {
+      const json& a = array(*v, key);
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string at = fmt::format("{}[{}]", key, i);
+        f(object(a[i], at), at);
+      }
+    }
+  }
+};
+
+// The JSON text of a .gltf file, or of a .glb's JSON chunk; empty if it cannot be found (tinygltf
+// then reports the problem).
+std::string gltf_json_text(const std::string& path, bool binary) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  if (!binary) return std::string(std::istreambuf_iterator<char>(in), {});
+  unsigned char header[20];
+  if (!in.read(reinterpret_cast<char*>(header), 20)) return {};
+  auto u32 = [&](int at) {
+    return static_cast<std::uint32_t>(header[at]) |
+           static_cast<std::uint32_t>(header[at + 1]) << 8 |
+           static_cast<std::uint32_t>(header[at + 2]) << 16 |
+           static_cast<std::uint32_t>(header[at + 3]) << 24;
+  };
+  if (std::memcmp(header, "glTF", 4) != 0 || u32(16) != 0x4E4F534AU) return {};
+  const std::uint32_t length = u32(12);
+  std::error_code ec;
+  const auto file_size = fs::file_size(path, ec);
+  if (ec || length > file_size) return {};
+  std::string text(length, '\0');
+  if (!in.read(text.data(), length)) return {};
+  return text;
+}
+
 LoadedModel load_gltf(const std::string& path, bool binary) {
+  {
+    const nlohmann::json root =
+        nlohmann::json::parse(gltf_json_text(path, binary), nullptr, /*allow_exceptions=*/false);
+    if (!root.is_discarded()) GltfSchemaCheck().run(root);
+  }
   tinygltf::TinyGLTF loader;
   loader.SetPreserveImageChannels(true);
   tinygltf::Model model;
@@ -748,7 +980,7 @@ LoadedModel load_gltf(const std::string& path, bool binary) {
                          : loader.LoadASCIIFromFile(&model, &err, &warn, path);
   if (!ok) {
     const std::string message = one_line(err.empty() ? warn : err);
-    fail("is not a valid glTF file: {}", message.empty() ? "unknown error" : message);
+    fail("could not be read: {}", message.empty() ? "unknown error" : message);
   }
   LoadedModel out;
   GltfLoader(path, model, &out).run();
@@ -776,13 +1008,17 @@ std::optional<PlyType> ply_type(const std::string& name) {
 std::size_t ply_size(PlyType t) {
   switch (t) {
     case PlyType::kInt8:
-    case PlyType::kUint8: return 1;
+    case PlyType::kUint8:
+      return 1;
     case PlyType::kInt16:
-    case PlyType::kUint16: return 2;
+    case PlyType::kUint16:
+      return 2;
     case PlyType::kInt32:
     case PlyType::kUint32:
-    case PlyType::kFloat32: return 4;
-    case PlyType::kFloat64: return 8;
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
   }
   return 1;
 }
@@ -819,14 +1055,22 @@ class PlyCursor {
       std::reverse(b, b + size);
     }
     switch (type) {
-      case PlyType::kInt8: return static_cast<std::int8_t>(b[0]);
-      case PlyType::kUint8: return b[0];
-      case PlyType::kInt16: return load<std::int16_t>(b);
-      case PlyType::kUint16: return load<std::uint16_t>(b);
-      case PlyType::kInt32: return load<std::int32_t>(b);
-      case PlyType::kUint32: return load<std::uint32_t>(b);
-      case PlyType::kFloat32: return load<float>(b);
-      case PlyType::kFloat64: return load<double>(b);
+      case PlyType::kInt8:
+        return static_cast<std::int8_t>(b[0]);
+      case PlyType::kUint8:
+        return b[0];
+      case PlyType::kInt16:
+        return load<std::int16_t>(b);
+      case PlyType::kUint16:
+        return load<std::uint16_t>(b);
+      case PlyType::kInt32:
+        return load<std::int32_t>(b);
+      case PlyType::kUint32:
+        return load<std::uint32_t>(b);
+      case PlyType::kFloat32:
+        return load<float>(b);
+      case PlyType::kFloat64:
+        return load<double>(b);
     }
     return 0;
   }
@@ -963,11 +1207,13 @@ LoadedModel load_ply(const std::string& path) {
   for (const PlyElement& e : elements) {
     std::size_t per = 0;
     for (const PlyProperty& prop : e.properties) {
-      per += *format == PlyFormat::kAscii ? 2 : (prop.is_list ? ply_size(prop.count_type)
-                                                               : ply_size(prop.type));
+      per += *format == PlyFormat::kAscii
+                 ? 2
+                 : (prop.is_list ? ply_size(prop.count_type) : ply_size(prop.type));
     }
     if (per > 0 && e.count > (static_cast<std::size_t>(end - p) + 1) / per) {
-      fail("element '{}' claims {} entries, more than the file holds", e.name, e.count);
+      fail("is truncated: element '{}' claims {} entries, more than the file holds", e.name,
+           e.count);
     }
   }
 
@@ -989,14 +1235,21 @@ LoadedModel load_ply(const std::string& path) {
       // Property slots: x y z nx ny nz u v.
       std::vector<int> slot(e.properties.size(), -1);
       static const std::vector<std::vector<std::string>> kNames = {
-          {"x"}, {"y"}, {"z"}, {"nx"}, {"ny"}, {"nz"},
-          {"s", "u", "texture_u", "texture_s"}, {"t", "v", "texture_v", "texture_t"}};
+          {"x"},
+          {"y"},
+          {"z"},
+          {"nx"},
+          {"ny"},
+          {"nz"},
+          {"s", "u", "texture_u", "texture_s"},
+          {"t", "v", "texture_v", "texture_t"}};
       std::array<bool, 8> found{};
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         if (e.properties[k].is_list) continue;
         for (int s = 0; s < 8; ++s) {
           const auto& names = kNames[s];
-          if (!found[s] && std::find(names.begin(), names.end(), e.properties[k].name) != names.end()) {
+          if (!found[s] &&
+              std::find(names.begin(), names.end(), e.properties[k].name) != names.end()) {
             slot[k] = s;
             found[s] = true;
           }
@@ -1146,11 +1399,12 @@ class AssimpLoader {
       auto [node, parent] = std::move(stack.back());
       stack.pop_back();
       const Mat4 world = parent * to_mat4(node->mTransformation);
-      if (!world.allFinite()) fail("node '{}' has a transform that is not finite", node->mName.C_Str());
+      if (!world.allFinite())
+        fail("node '{}' has a transform that is not finite", node->mName.C_Str());
       for (unsigned i = 0; i < node->mNumMeshes; ++i) {
         const unsigned mesh = node->mMeshes[i];
-        if (mesh >= scene_.mNumMeshes) fail("node '{}' uses mesh {}, which does not exist",
-                                            node->mName.C_Str(), mesh);
+        if (mesh >= scene_.mNumMeshes)
+          fail("node '{}' uses mesh {}, which does not exist", node->mName.C_Str(), mesh);
         add_mesh(*scene_.mMeshes[mesh], world);
       }
       for (unsigned i = node->mNumChildren; i-- > 0;) stack.emplace_back(node->mChildren[i], world);
@@ -1195,8 +1449,8 @@ class AssimpLoader {
       const std::string source = fmt::format("{}#{}", path_, reference);
       if (embedded->mHeight == 0) {
         const auto* bytes = reinterpret_cast<const unsigned char*>(embedded->pcData);
-        tex = decode_image(source, std::vector<unsigned char>(bytes, bytes + embedded->mWidth),
-                           what);
+        tex =
+            decode_image(source, std::vector<unsigned char>(bytes, bytes + embedded->mWidth), what);
       } else {
         std::vector<unsigned char> rgba(static_cast<std::size_t>(embedded->mWidth) *
                                         embedded->mHeight * 4);
@@ -1246,9 +1500,8 @@ class AssimpLoader {
     const Eigen::Matrix3f to_normal =
         normal_matrix(world.topLeftCorner<3, 3>(), &normals_ok).cast<float>();
     const bool flip = world.topLeftCorner<3, 3>().determinant() < 0;
-    const int material = mesh.mMaterialIndex < out_->materials.size()
-                             ? static_cast<int>(mesh.mMaterialIndex)
-                             : 0;
+    const int material =
+        mesh.mMaterialIndex < out_->materials.size() ? static_cast<int>(mesh.mMaterialIndex) : 0;
 
     const std::uint32_t n = mesh.mNumVertices;
     const std::uint32_t base = builder_.add_vertices(n);
@@ -1347,8 +1600,8 @@ std::optional<LoadedModel> load_model(const std::string& path, std::string* erro
     if (ext == ".gltf" || ext == ".glb") return load_gltf(path, ext == ".glb");
     if (ext == ".ply") return load_ply(path);
     if (ext == ".obj" || ext == ".stl") return load_with_assimp(path, ext);
-    set_error(fmt::format("unsupported model format '{}' (use .gltf, .glb, .obj, .ply or .stl)",
-                          ext));
+    set_error(
+        fmt::format("unsupported model format '{}' (use .gltf, .glb, .obj, .ply or .stl)", ext));
   } catch (const LoadError& e) {
     set_error(e.what());
   } catch (const std::bad_alloc&) {

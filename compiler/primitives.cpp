@@ -26,7 +26,9 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 //   triangles: 320  980  2880  9680  32000  100820  317520  1012500  3200000  10138880
 constexpr std::array<int, 10> kFrequency = {4, 7, 12, 22, 40, 71, 126, 225, 400, 712};
 
-int clamp_detail(int detail) { return std::clamp(detail, 1, 10); }
+int clamp_detail(int detail) {
+  return std::clamp(detail, 1, 10);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Deterministic noise: integer hashing only, so the same seed gives the same shape everywhere.
@@ -51,16 +53,20 @@ std::uint32_t hash_lattice(std::int32_t x, std::int32_t y, std::int32_t z, std::
 // gradients are Perlin's 12 cube-edge directions, four of them twice to make 16 (a table lookup
 // rather than a branch: the branch mispredicts on every call).
 double grad_dot(std::uint32_t h, double x, double y, double z) {
-  static constexpr double kGrad[16][3] = {
-      {1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
-      {1, 0, -1}, {-1, 0, -1}, {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1},
-      {1, 1, 0}, {-1, 1, 0}, {0, -1, 1}, {0, -1, -1}};
+  static constexpr double kGrad[16][3] = {{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0},
+                                          {1, 0, 1}, {-1, 0, 1}, {1, 0, -1}, {-1, 0, -1},
+                                          {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1},
+                                          {1, 1, 0}, {-1, 1, 0}, {0, -1, 1}, {0, -1, -1}};
   const double* g = kGrad[h >> 28];
   return g[0] * x + g[1] * y + g[2] * z;
 }
 
-double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
-double lerp(double a, double b, double t) { return a + t * (b - a); }
+double fade(double t) {
+  return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+double lerp(double a, double b, double t) {
+  return a + t * (b - a);
+}
 
 // 3D gradient noise, roughly in [-1, 1], zero at lattice points.
 double gradient_noise(double x, double y, double z, std::uint32_t seed) {
@@ -90,7 +96,8 @@ struct Octave {
 
   Octave(double f, double a, std::uint32_t s) : frequency(f), amplitude(a), seed(hash_u32(s)) {
     offset = Vector3d(hash_u32(seed ^ 1U) % 1024U, hash_u32(seed ^ 2U) % 1024U,
-                      hash_u32(seed ^ 3U) % 1024U) / 7.0;
+                      hash_u32(seed ^ 3U) % 1024U) /
+             7.0;
   }
   double operator()(const Vector3d& p) const {
     const Vector3d q = p * frequency + offset;
@@ -117,7 +124,7 @@ Icosphere make_icosphere(int n) {
                                        std::sqrt(10.0 + 2.0 * s5) / 4.0};
   auto cos_sin = [&](int step) -> std::pair<double, double> {  // angle = 36 degrees * step
     step %= 10;
-    const int q = step <= 5 ? step : 10 - step;                 // fold to 0..180
+    const int q = step <= 5 ? step : 10 - step;  // fold to 0..180
     const double c = q <= 2 ? cos36[q] : -cos36[5 - q];
     const double s = q <= 2 ? sin36[q] : sin36[5 - q];
     return {c, step <= 5 ? s : -s};
@@ -314,8 +321,8 @@ ir::Mesh make_sphere(int detail) {
 // twice its width in z and scaled to 1 m tall.
 struct StatueShape {
   explicit StatueShape(std::uint32_t seed)
-      : figure(0.9, 0.20, seed * 8 + 1),
-        lumps(2.1, 0.10, seed * 8 + 2),
+      : figure(1.2, 0.24, seed * 8 + 1),
+        lumps(2.4, 0.10, seed * 8 + 2),
         ridges(4.3, 0.07, seed * 8 + 3),
         details{Octave(9.1, 0.030, seed * 8 + 4), Octave(19.3, 0.015, seed * 8 + 5),
                 Octave(41.0, 0.008, seed * 8 + 6), Octave(87.0, 0.004, seed * 8 + 7)} {}
@@ -324,17 +331,17 @@ struct StatueShape {
     // Noise is sampled where the point will be after the vertical stretch, so bumps stay round.
     const Vector3d q(d.x(), d.y(), 2.0 * d.z());
     double r = 1.0 + figure.amplitude * figure(q) + lumps.amplitude * lumps(q);
-    r += ridges.amplitude * (0.5 - std::abs(ridges(q)));  // sharp creases, rock-like
+    r += ridges.amplitude * (0.5 - std::abs(ridges(q)));      // sharp creases, rock-like
     for (const Octave& o : details) r += o.amplitude * o(q);  // bumps at several scales
     // A narrower "neck" below a head-like top (a polynomial bump: no libm, same everywhere).
-    const double neck = (d.z() - 0.62) / 0.25;
+    const double neck = (d.z() - 0.6) / 0.35;
     if (std::abs(neck) < 1.0) {
       const double b = 1.0 - neck * neck;
-      r *= 1.0 - 0.18 * b * b * b;
+      r *= 1.0 - 0.2 * b * b * b;
     }
     r = std::max(r, 0.3);
     // A flat base to stand on.
-    constexpr double kBase = 0.82;
+    constexpr double kBase = 0.9;
     if (d.z() < 0 && r * -d.z() > kBase) r = kBase / -d.z();
     return r;
   }
@@ -353,8 +360,9 @@ ir::Mesh make_statue(int detail, std::uint32_t seed) {
   for (std::size_t i = 0; i < n; ++i) {
     const Vector3d& d = ico.directions[i];
     const double r = shape.radius(d);
-    mesh.positions[i] = Vector3f(static_cast<float>(0.5 * r * d.x()),
-                                 static_cast<float>(0.5 * r * d.y()), static_cast<float>(r * d.z()));
+    mesh.positions[i] =
+        Vector3f(static_cast<float>(0.5 * r * d.x()), static_cast<float>(0.5 * r * d.y()),
+                 static_cast<float>(r * d.z()));
   }
   // Centre the bounds on the origin and scale to exactly 1 m tall.
   Vector3f lo = mesh.positions[0], hi = mesh.positions[0];
@@ -474,16 +482,26 @@ std::optional<PrimitiveKind> primitive_from_name(const std::string& name) {
   return std::nullopt;
 }
 
-std::vector<std::string> primitive_names() { return {"sphere", "box", "cylinder", "statue"}; }
+std::vector<std::string> primitive_names() {
+  return {"sphere", "box", "cylinder", "statue"};
+}
 
 ir::Mesh make_primitive(PrimitiveKind kind, int detail, std::uint32_t seed) {
   detail = clamp_detail(detail);
   ir::Mesh mesh;
   switch (kind) {
-    case PrimitiveKind::kSphere: mesh = make_sphere(detail); break;
-    case PrimitiveKind::kBox: mesh = make_box(); break;
-    case PrimitiveKind::kCylinder: mesh = make_cylinder(detail); break;
-    case PrimitiveKind::kStatue: mesh = make_statue(detail, seed); break;
+    case PrimitiveKind::kSphere:
+      mesh = make_sphere(detail);
+      break;
+    case PrimitiveKind::kBox:
+      mesh = make_box();
+      break;
+    case PrimitiveKind::kCylinder:
+      mesh = make_cylinder(detail);
+      break;
+    case PrimitiveKind::kStatue:
+      mesh = make_statue(detail, seed);
+      break;
   }
   mesh.triangle_material.assign(mesh.triangles.size(), 0);
   return mesh;

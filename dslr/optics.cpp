@@ -1,13 +1,18 @@
 #include "dslr/optics.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
+
+// The 32-byte vectors of the gather are only passed between functions inlined into the AVX2 and
+// the default clone of one function, so GCC's note on their ABI without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace rigc::dslr {
 
@@ -29,33 +34,39 @@ double diffraction_sigma_m(double f_number, double wavelength_m) {
 
 namespace {
 
-struct Tap {
-  int dx, dy;
-  float distance;
-  float area;      // pixels this tap stands for
-  float inv_soft;  // 1 / width of the coverage ramp at the disc edge
-};
+constexpr int kTile = 16;            // pixels per side of a tile that shares one tap count
+constexpr int kLanes = 8;            // pixels gathered together (one AVX register)
+constexpr float kSameDepth = 0.02f;  // relative depth band counted as "the same surface"
+constexpr double kDenseRadius = 4.5, kRingRatio = 1.3;
 
 struct TapSet {
-  std::vector<Tap> taps;  // sorted by distance
-  // For a gather radius ceil(R): how many leading taps can be covered.
+  // Sorted by distance; structure of arrays for the gather loop.
+  std::vector<int> dx, dy;
+  std::vector<float> distance;
+  std::vector<float> area;      // pixels this tap stands for
+  std::vector<float> inv_soft;  // 1 / width of the coverage ramp at the disc edge
+  // For a gather radius ceil(R): how many leading taps a disc of radius R can cover.
   std::vector<int> count_for_radius;
 };
 
 const TapSet& tap_set() {
   static const TapSet set = [] {
-    TapSet s;
-    constexpr double kDense = 6.5, kRatio = 1.25;
-    const int d = static_cast<int>(kDense);
+    struct Tap {
+      int dx, dy;
+      float distance, area, inv_soft;
+    };
+    std::vector<Tap> taps;
+    const int d = static_cast<int>(kDenseRadius);
     for (int dy = -d; dy <= d; ++dy) {
       for (int dx = -d; dx <= d; ++dx) {
         const double r = std::hypot(dx, dy);
-        if (r <= kDense) s.taps.push_back({dx, dy, float(r), 1.0f, 1.0f});
+        if (r <= kDenseRadius) taps.push_back({dx, dy, float(r), 1.0f, 1.0f});
       }
     }
     int ring = 0;
-    for (double inner = kDense; inner < kMaxCocRadiusPx + 1; inner *= kRatio, ++ring) {
-      const double outer = inner * kRatio, width = outer - inner, rho = 0.5 * (inner + outer);
+    for (double inner = kDenseRadius; inner < kMaxCocRadiusPx + 1; inner *= kRingRatio, ++ring) {
+      const double outer = inner * kRingRatio, width = outer - inner, rho = 0.5 * (inner + outer);
+      // As many taps as keep their spacing along the ring equal to the ring width.
       const int n = static_cast<int>(std::lround(2 * std::numbers::pi * rho / width));
       const double area = std::numbers::pi * (outer * outer - inner * inner) / n;
       const double phase = ring * 2.399963;  // golden angle: rings do not line up
@@ -63,95 +74,107 @@ const TapSet& tap_set() {
         const double a = phase + 2 * std::numbers::pi * k / n;
         const int dx = static_cast<int>(std::lround(rho * std::cos(a)));
         const int dy = static_cast<int>(std::lround(rho * std::sin(a)));
-        s.taps.push_back({dx, dy, float(std::hypot(dx, dy)), float(area), float(1 / width)});
+        taps.push_back({dx, dy, float(std::hypot(dx, dy)), float(area), float(1 / width)});
       }
     }
-    std::stable_sort(s.taps.begin(), s.taps.end(),
+    std::stable_sort(taps.begin(), taps.end(),
                      [](const Tap& a, const Tap& b) { return a.distance < b.distance; });
+    TapSet s;
+    for (const Tap& t : taps) {
+      s.dx.push_back(t.dx);
+      s.dy.push_back(t.dy);
+      s.distance.push_back(t.distance);
+      s.area.push_back(t.area);
+      s.inv_soft.push_back(t.inv_soft);
+    }
     s.count_for_radius.assign(kMaxCocRadiusPx + 2, 0);
     for (int radius = 0; radius < static_cast<int>(s.count_for_radius.size()); ++radius) {
-      int count = 0;
-      for (int t = 0; t < static_cast<int>(s.taps.size()); ++t) {
-        const Tap& tap = s.taps[t];
-        if (tap.distance - 0.5f / tap.inv_soft < radius) count = t + 1;
+      for (int t = 0; t < static_cast<int>(taps.size()); ++t) {
+        if (taps[t].distance - 0.5f / taps[t].inv_soft < radius) s.count_for_radius[radius] = t + 1;
       }
-      s.count_for_radius[radius] = count;
     }
     return s;
   }();
   return set;
 }
 
-struct DepthRadius {
-  float z;       // metres, +inf for unknown or background
-  float radius;  // blur disc radius in pixels, at least 0.5 (one pixel's own footprint)
+// A horizontal strip of the canvas as padded planes, so taps never need bounds checks. Padding
+// pixels have no energy (inv_area 0) and sit in front of everything (z = -inf): they never
+// contribute. Strips keep the working set small (no 500 MB of planes for a full frame).
+struct Planes {
+  int pad = 0, stride = 0, y0 = 0;  // y0: the first image row of the strip
+  std::vector<float> r, g, b;
+  std::vector<float> z;         // metres, +inf for unknown or background
+  std::vector<float> radius;    // blur disc radius in pixels, at least 0.5 (a pixel's footprint)
+  std::vector<float> inv_area;  // 1 / (π radius²): a pixel's energy per covered pixel
+  std::size_t index(int x, int y) const {
+    return static_cast<std::size_t>(y - y0 + pad) * stride + (x + pad);
+  }
 };
 
-constexpr int kTile = 16;
-constexpr float kSameDepth = 0.02f;  // relative depth band counted as "the same surface"
+using Floats = float __attribute__((vector_size(4 * kLanes)));
 
-template <bool kCheckBounds>
-void gather_tile(const TapSet& set, int tap_count, int x0, int x1, int y0, int y1, int w, int h,
-                 const float* rgb, const DepthRadius* zr, float* out) {
-  const Tap* taps = set.taps.data();
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * w + x;
-      const float zp = zr[p].z, rp = zr[p].radius;
-      const float z_front = zp * (1 - kSameDepth), z_back = zp * (1 + kSameDepth);
-      float wf = 0, ws = 0, wb = 0;
-      float cf[3] = {0, 0, 0}, cs[3] = {0, 0, 0}, cb[3] = {0, 0, 0};
-      for (int t = 0; t < tap_count; ++t) {
-        const Tap& tap = taps[t];
-        const int qx = x + tap.dx, qy = y + tap.dy;
-        if constexpr (kCheckBounds) {
-          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-        }
-        const std::size_t q = static_cast<std::size_t>(qy) * w + qx;
-        const DepthRadius s = zr[q];
-        float* c;
-        float weight;
-        if (s.z <= z_back) {
-          // In front or the same surface: q's disc must reach p; weight is q's energy per pixel.
-          const float coverage = std::clamp((s.radius - tap.distance) * tap.inv_soft + 0.5f, 0.f, 1.f);
-          if (coverage <= 0) continue;
-          weight = tap.area * coverage / (std::numbers::pi_v<float> * s.radius * s.radius);
-          if (s.z < z_front) {
-            wf += weight;
-            c = cf;
-          } else {
-            ws += weight;
-            c = cs;
-          }
-        } else {
-          // Behind p: seen only through p's own blur, never over a sharper p.
-          const float coverage = std::clamp((rp - tap.distance) * tap.inv_soft + 0.5f, 0.f, 1.f);
-          if (coverage <= 0) continue;
-          weight = tap.area * coverage;
-          wb += weight;
-          c = cb;
-        }
-        const float* src = rgb + 3 * q;
-        c[0] += weight * src[0];
-        c[1] += weight * src[1];
-        c[2] += weight * src[2];
-      }
-      float result[3];
-      const float alpha_same = wb > 0 ? std::min(1.f, ws) : 1.f;
-      for (int k = 0; k < 3; ++k) {
-        result[k] = alpha_same * cs[k] / ws;  // ws > 0: p covers itself
-        if (wb > 0) result[k] += (1 - alpha_same) * cb[k] / wb;
-      }
-      if (wf > 0) {
-        const float alpha_front = std::min(1.f, wf);
-        for (int k = 0; k < 3; ++k) {
-          result[k] = alpha_front * cf[k] / wf + (1 - alpha_front) * result[k];
-        }
-      }
-      out[3 * p] = result[0];
-      out[3 * p + 1] = result[1];
-      out[3 * p + 2] = result[2];
+inline Floats load(const float* p) {
+  Floats v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+inline Floats clamp01(Floats v) {
+  const Floats zero = {}, one = zero + 1;
+  v = v < zero ? zero : v;
+  return v > one ? one : v;
+}
+
+struct GroupSums {
+  Floats wf, ws, wb;  // front, same surface, behind
+  Floats front[3], same[3], behind[3];
+};
+
+// One row of kLanes neighbouring pixels against taps [0, tap_count): the loads for a tap are
+// contiguous, so this vectorises. AVX2 where the CPU has it, SSE otherwise.
+__attribute__((target_clones("avx2", "default"))) void gather_group(const Planes& pl,
+                                                                     const TapSet& set,
+                                                                     int tap_count, std::size_t i,
+                                                                     GroupSums& s) {
+  const Floats zp = load(&pl.z[i]), rp = load(&pl.radius[i]);
+  const Floats z_front = zp * (1 - kSameDepth), z_back = zp * (1 + kSameDepth);
+  const Floats zero = {};
+  s = GroupSums{};
+  for (int t = 0; t < tap_count; ++t) {
+    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
+    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
+    const Floats zq = load(&pl.z[q]), rq = load(&pl.radius[q]);
+    // In front or on the same surface: q's own disc must reach p, with q's energy per pixel.
+    const Floats w_disc = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
+    // Behind: seen only through p's own disc, so a sharp p never picks it up.
+    const Floats w_behind = area * clamp01((rp - d) * inv_soft + 0.5f);
+    const auto front = zq < z_front, behind = zq > z_back;
+    const Floats wf = front ? w_disc : zero;
+    const Floats wb = behind ? w_behind : zero;
+    const Floats ws = (front | behind) ? zero : w_disc;
+    const Floats c[3] = {load(&pl.r[q]), load(&pl.g[q]), load(&pl.b[q])};
+    s.wf += wf;
+    s.ws += ws;
+    s.wb += wb;
+    for (int k = 0; k < 3; ++k) {
+      s.front[k] += wf * c[k];
+      s.same[k] += ws * c[k];
+      s.behind[k] += wb * c[k];
     }
+  }
+}
+
+// Front-to-back compositing of the three layers for one pixel (lane).
+void composite(const GroupSums& s, int lane, float* out) {
+  const float wf = s.wf[lane], ws = s.ws[lane], wb = s.wb[lane];
+  const float alpha_same = wb > 0 ? std::min(1.f, ws) : 1.f;  // ws > 0: p covers itself
+  const float alpha_front = std::min(1.f, wf);
+  for (int k = 0; k < 3; ++k) {
+    float v = alpha_same * s.same[k][lane] / ws;
+    if (wb > 0) v += (1 - alpha_same) * s.behind[k][lane] / wb;
+    if (wf > 0) v = alpha_front * s.front[k][lane] / wf + (1 - alpha_front) * v;
+    out[k] = v;
   }
 }
 
@@ -164,38 +187,37 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
   const std::size_t n = static_cast<std::size_t>(w) * h;
   out.resize(rgb.size());
   const double f = camera.focal_length_m, f_number = camera.aperture_f_number;
-  const bool possible = depth_m.size() == n && focus_distance_m > f && f > 0;
-  if (!possible) {
+  if (depth_m.size() != n || !(focus_distance_m > f) || !(f > 0)) {
     std::copy(rgb.begin(), rgb.end(), out.begin());
     return;
   }
-  // Sensor metres to canvas pixels: fx / f.
-  const double px_per_m = canvas.fx / f;
-  std::vector<DepthRadius> zr(n);
+  const double px_per_m = canvas.fx / f;  // sensor metres to canvas pixels
+  auto radius_at = [&](float z) {
+    return static_cast<float>(std::clamp(
+        0.5 * coc_diameter_m(f, f_number, focus_distance_m, z) * px_per_m, 0.5,
+        static_cast<double>(kMaxCocRadiusPx)));
+  };
+
+  // Largest disc per tile, then the largest disc reaching each tile.
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
   std::vector<float> tile_max(static_cast<std::size_t>(tiles_x) * tiles_y, 0.5f);
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     for (int ty = r.begin(); ty < r.end(); ++ty) {
       for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
         for (int x = 0; x < w; ++x) {
-          const std::size_t p = static_cast<std::size_t>(y) * w + x;
-          float z = depth_m[p];
-          if (!(z > 0)) z = std::numeric_limits<float>::infinity();
-          const double c = coc_diameter_m(f, f_number, focus_distance_m, z);
-          const float radius = static_cast<float>(
-              std::clamp(0.5 * c * px_per_m, 0.5, static_cast<double>(kMaxCocRadiusPx)));
-          zr[p] = {z, radius};
+          const float z = depth_m[static_cast<std::size_t>(y) * w + x];
           float& m = tile_max[static_cast<std::size_t>(ty) * tiles_x + x / kTile];
-          m = std::max(m, radius);
+          m = std::max(m, radius_at(z > 0 ? z : std::numeric_limits<float>::infinity()));
         }
       }
     }
   });
-  // The largest disc that reaches each tile: spread every tile's maximum over the tiles it covers.
   std::vector<float> reach(tile_max.size(), 0.5f);
+  float reach_max = 0.5f;
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       const float m = tile_max[static_cast<std::size_t>(ty) * tiles_x + tx];
+      reach_max = std::max(reach_max, m);
       const int span = static_cast<int>(std::ceil(m / kTile));
       for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
         for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
@@ -205,35 +227,92 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
       }
     }
   }
+  if (reach_max <= 0.5f) {  // everything is sharp
+    std::copy(rgb.begin(), rgb.end(), out.begin());
+    return;
+  }
+
   const TapSet& set = tap_set();
-  tbb::parallel_for(
-      tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 4), [&](const tbb::blocked_range2d<int>& r) {
-        for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty) {
-          for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
-            const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
-            const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
-            const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
-            if (radius <= 0.5f) {  // everything here and around it is sharp
-              for (int y = y0; y < y1; ++y) {
-                const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
-                std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
-              }
-              continue;
+  const int max_taps = set.count_for_radius[std::min<int>(
+      static_cast<int>(std::ceil(reach_max)), static_cast<int>(set.count_for_radius.size()) - 1)];
+  int tap_extent = 0;
+  for (int t = 0; t < max_taps; ++t) {
+    tap_extent = std::max({tap_extent, std::abs(set.dx[t]), std::abs(set.dy[t])});
+  }
+  const int pad = tap_extent + 1;
+  const int strip_rows = std::max(2 * kTile, (4 * pad + kTile - 1) / kTile * kTile);
+  const int strips = (h + strip_rows - 1) / strip_rows;
+  const float inf = std::numeric_limits<float>::infinity();
+  tbb::enumerable_thread_specific<Planes> scratch;
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& r) {
+    Planes& pl = scratch.local();
+    GroupSums sums;
+    for (int strip = r.begin(); strip < r.end(); ++strip) {
+      const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
+      const int ty0 = sy0 / kTile, ty1 = (sy1 + kTile - 1) / kTile;
+      float strip_reach = 0.5f;
+      for (int ty = ty0; ty < ty1; ++ty) {
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          strip_reach = std::max(strip_reach, reach[static_cast<std::size_t>(ty) * tiles_x + tx]);
+        }
+      }
+      if (strip_reach <= 0.5f) {
+        const std::size_t a = 3 * static_cast<std::size_t>(sy0) * w;
+        const std::size_t b = 3 * static_cast<std::size_t>(sy1) * w;
+        std::copy(rgb.begin() + a, rgb.begin() + b, out.begin() + a);
+        continue;
+      }
+      pl.pad = pad;
+      pl.stride = w + 2 * pad + kTile;  // a tile's last group may run past the right edge
+      pl.y0 = sy0;
+      const std::size_t size = static_cast<std::size_t>(pl.stride) * (sy1 - sy0 + 2 * pad);
+      pl.r.assign(size, 0);
+      pl.g.assign(size, 0);
+      pl.b.assign(size, 0);
+      pl.z.assign(size, -inf);
+      pl.radius.assign(size, 0.5f);
+      pl.inv_area.assign(size, 0);
+      for (int y = std::max(0, sy0 - pad); y < std::min(h, sy1 + pad); ++y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t p = static_cast<std::size_t>(y) * w + x, i = pl.index(x, y);
+          const float z = depth_m[p] > 0 ? depth_m[p] : inf;
+          const float radius = radius_at(z);
+          pl.r[i] = rgb[3 * p];
+          pl.g[i] = rgb[3 * p + 1];
+          pl.b[i] = rgb[3 * p + 2];
+          pl.z[i] = z;
+          pl.radius[i] = radius;
+          pl.inv_area[i] = 1 / (std::numbers::pi_v<float> * radius * radius);
+        }
+      }
+      for (int ty = ty0; ty < ty1; ++ty) {
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
+          const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
+          const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
+          if (radius <= 0.5f) {  // everything here and around it is sharp
+            for (int y = y0; y < y1; ++y) {
+              const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
+              std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
             }
-            const int reach_px = static_cast<int>(std::ceil(radius));
-            const int tap_count = set.count_for_radius[std::min<int>(
-                reach_px, static_cast<int>(set.count_for_radius.size()) - 1)];
-            const int margin = reach_px + 1;
-            if (x0 - margin >= 0 && y0 - margin >= 0 && x1 + margin <= w && y1 + margin <= h) {
-              gather_tile<false>(set, tap_count, x0, x1, y0, y1, w, h, rgb.data(), zr.data(),
-                                 out.data());
-            } else {
-              gather_tile<true>(set, tap_count, x0, x1, y0, y1, w, h, rgb.data(), zr.data(),
-                                out.data());
+            continue;
+          }
+          const int tap_count = set.count_for_radius[std::min<int>(
+              static_cast<int>(std::ceil(radius)),
+              static_cast<int>(set.count_for_radius.size()) - 1)];
+          for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; x += kLanes) {
+              gather_group(pl, set, tap_count, pl.index(x, y), sums);
+              for (int lane = 0; lane < kLanes && x + lane < x1; ++lane) {
+                composite(sums, lane, &out[3 * (static_cast<std::size_t>(y) * w + x + lane)]);
+              }
             }
           }
         }
-      });
+      }
+    }
+  });
 }
 
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,

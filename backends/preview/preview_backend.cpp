@@ -1,0 +1,220 @@
+#include "backends/preview/preview_backend.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <ostream>
+
+#include "backends/common/colmap_text.h"
+#include "backends/common/manifest.h"
+#include "backends/common/transforms_json.h"
+#include "dslr/exposure.h"
+#include "dslr/image_io.h"
+#include "dslr/lens.h"
+#include "dslr/pipeline.h"
+
+namespace rigc::preview {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string progress_line(int done, int total, const std::string& name, double seconds) {
+  constexpr int kWidth = 30;
+  const int filled = total > 0 ? done * kWidth / total : kWidth;
+  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s", std::string(filled, '#'),
+                     std::string(kWidth - filled, ' '), done, total, name, seconds);
+}
+
+}  // namespace
+
+int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
+                          double scale) {
+  const ir::Camera& camera = scene.camera;
+  if (!camera.effects.motion_blur || shot.turntable_velocity_rad_s == 0) return 1;
+  // The fastest object point: the far rim of its bounding sphere, at its nearest depth.
+  const double radius = studio.object_center.head<2>().norm() + studio.object_radius;
+  const ir::Vec3 center_world =
+      (ir::world_from_object(scene, shot.turntable_angle_rad) * studio.object_center.homogeneous())
+          .head<3>();
+  const ir::Vec3 eye = shot.world_from_camera.block<3, 1>(0, 3);
+  const double depth = std::max(0.05, (center_world - eye).norm() - studio.object_radius);
+  const double blur_px = dslr::motion_blur_length_px(camera, scale, shot.turntable_velocity_rad_s,
+                                                     radius, depth);
+  // About one sub-frame per pixel of travel keeps the streak continuous.
+  return std::clamp(static_cast<int>(std::ceil(blur_px)) + 1, 1, 48);
+}
+
+dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
+                                const ir::Shot& shot, double scale, std::uint64_t seed,
+                                ShotTiming* timing, dslr::LinearFrame* linear_out) {
+  const auto start = Clock::now();
+  const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
+  FrameRequest request;
+  request.world_from_camera = shot.world_from_camera;
+  request.canvas = geometry;
+  request.shadow_map_size = std::clamp(geometry.width, 512, 2048);
+  const int subframes = motion_blur_subframes(scene, studio, shot, scale);
+  RasterTimings raster;
+  dslr::LinearFrame frame;
+  if (subframes == 1) {
+    request.turntable_angle_rad = shot.turntable_angle_rad;
+    frame = render_frame(scene, studio, request, &raster);
+  } else {
+    // Sub-frames spread evenly over the open shutter, centred on the shot's angle. Depth and
+    // mask come from the middle one.
+    const double sweep = shot.turntable_velocity_rad_s * scene.camera.shutter_s;
+    std::vector<double> sum;
+    for (int k = 0; k < subframes; ++k) {
+      request.turntable_angle_rad = shot.turntable_angle_rad + sweep * ((k + 0.5) / subframes - 0.5);
+      dslr::LinearFrame sub = render_frame(scene, studio, request, &raster);
+      if (sum.empty()) sum.assign(sub.rgb.size(), 0.0);
+      for (size_t i = 0; i < sub.rgb.size(); ++i) sum[i] += sub.rgb[i];
+      if (k == subframes / 2) frame = std::move(sub);
+    }
+    for (size_t i = 0; i < sum.size(); ++i) frame.rgb[i] = static_cast<float>(sum[i] / subframes);
+  }
+  if (linear_out) *linear_out = frame;
+  dslr::ShotParams params;
+  params.focus_distance_m = shot.focus_distance_m;
+  params.shot_index = shot.index;
+  params.seed = seed;
+  dslr::DevelopResult result = dslr::develop_frame(scene.camera, frame, params, scale);
+  if (timing) {
+    timing->raster = raster;
+    timing->develop = result.timings;
+    timing->subframes = subframes;
+    timing->total_ms = ms_since(start);
+  }
+  return result;
+}
+
+int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostream& log,
+                std::vector<ShotTiming>* timings) {
+  const fs::path run_dir = options.output_dir;
+  std::error_code ec;
+  for (const char* sub : {"images", "masks", "sparse"}) {
+    fs::create_directories(run_dir / sub, ec);
+    if (ec || !fs::is_directory(run_dir / sub)) {
+      log << fmt::format("rigc: error: cannot create the output folder '{}': {}\n",
+                         (run_dir / sub).string(), ec ? ec.message() : "not a folder");
+      return 1;
+    }
+  }
+  if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
+    log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
+    return 1;
+  }
+  std::vector<int> shots = options.shots;
+  if (shots.empty()) {
+    for (const auto& shot : scene.shots) shots.push_back(shot.index);
+  }
+
+  const fs::path manifest_path = run_dir / "manifest.json";
+  backends::Manifest manifest = backends::Manifest::load(manifest_path);
+  const std::string content_hash = backends::scene_content_hash(scene);
+  manifest.set_backend("preview");
+  manifest.set_inputs({{"scene", scene.name},
+                       {"source_file", scene.source_file},
+                       {"content_sha256", content_hash},
+                       {"scale", options.scale},
+                       {"seed", options.seed}});
+  const StudioScene studio = prepare_studio_scene(scene);
+  int failures = 0, done = 0;
+  for (int index : shots) {
+    const ir::Shot& shot = scene.shots[index];
+    const std::string key =
+        backends::shot_key(scene, content_hash, shot, "preview", options.scale, options.seed);
+    ShotTiming timing;
+    if (manifest.is_done(shot.name, key, run_dir)) {
+      timing.skipped = true;
+      ++done;
+      if (timings) timings->push_back(timing);
+      if (!options.progress_bar) log << fmt::format("{}: up to date, skipped\n", shot.name);
+      continue;
+    }
+    dslr::DevelopResult result =
+        render_shot(scene, studio, shot, options.scale, options.seed, &timing);
+    const auto write_start = Clock::now();
+    const std::string image = backends::image_relative_path(scene.camera, shot);
+    const std::string mask = backends::mask_relative_path(shot);
+    std::string error;
+    bool ok = !result.encoded.empty();
+    if (!ok) error = "the DSLR model produced no image";
+    ok = ok && dslr::write_image(run_dir / image, result, scene.camera, &error);
+    ok = ok && dslr::write_mask(run_dir / mask, result.mask, result.width, result.height, &error);
+    timing.write_ms = ms_since(write_start);
+    timing.total_ms += timing.write_ms;
+    if (!ok) {
+      log << fmt::format("{}rigc: error: {}: {}\n", options.progress_bar ? "\n" : "", shot.name,
+                         error);
+      ++failures;
+      continue;
+    }
+    backends::ShotRecord record;
+    record.name = shot.name;
+    record.key = key;
+    record.render_ms = timing.total_ms;
+    record.stage_ms = {{"shadows", timing.raster.shadow_ms},
+                       {"setup", timing.raster.setup_ms},
+                       {"raster_and_shading", timing.raster.raster_ms},
+                       {"exposure", timing.develop.exposure_ms},
+                       {"depth_of_field", timing.develop.depth_of_field_ms},
+                       {"diffraction", timing.develop.diffraction_ms},
+                       {"distortion_vignetting", timing.develop.distortion_ms},
+                       {"noise", timing.develop.noise_ms},
+                       {"develop", timing.develop.develop_ms},
+                       {"write", timing.write_ms}};
+    record.files = {image, mask};
+    manifest.record(record);
+    // Saved after every shot, so an interrupted run resumes where it stopped.
+    if (!manifest.save(manifest_path, &error)) {
+      log << fmt::format("rigc: error: {}\n", error);
+      return 2;
+    }
+    ++done;
+    if (timings) timings->push_back(timing);
+    if (options.progress_bar) {
+      log << progress_line(done, static_cast<int>(shots.size()), shot.name,
+                           timing.total_ms / 1000) << std::flush;
+    } else {
+      log << fmt::format("{}: rendered in {:.2f} s ({} sub-frame{})\n", shot.name,
+                         timing.total_ms / 1000, timing.subframes,
+                         timing.subframes == 1 ? "" : "s");
+    }
+  }
+  if (options.progress_bar) log << '\n';
+
+  // Ground truth for every shot that has its image in this run folder.
+  std::vector<int> present;
+  for (const auto& shot : scene.shots) {
+    if (manifest.find(shot.name) &&
+        fs::exists(run_dir / backends::image_relative_path(scene.camera, shot))) {
+      present.push_back(shot.index);
+    }
+  }
+  std::string error;
+  if (!backends::write_colmap_sparse(run_dir / "sparse", scene, present, options.scale, &error) ||
+      !backends::write_transforms_json(run_dir / "transforms.json", scene, present, options.scale,
+                                       &error)) {
+    log << fmt::format("rigc: error: {}\n", error);
+    return 2;
+  }
+  if (failures) {
+    log << fmt::format("rigc: {} of {} shots failed; rerun to retry them\n", failures,
+                       shots.size());
+    return 2;
+  }
+  log << fmt::format("rigc: {} shots in {}\n", shots.size(), run_dir.string());
+  return 0;
+}
+
+}  // namespace rigc::preview

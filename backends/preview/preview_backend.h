@@ -1,0 +1,48 @@
+// `rigc render --backend preview`: every shot through the rasterizer and the DSLR model, written
+// in the common output layout (images, masks, sparse/, transforms.json, manifest.json).
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "backends/preview/rasterizer.h"
+#include "compiler/ir.h"
+#include "dslr/frame.h"
+
+namespace rigc::preview {
+
+struct RenderOptions {
+  std::string output_dir;  // the run folder
+  std::vector<int> shots;  // indices to render (all when empty)
+  double scale = 1.0;      // multiplies the sensor resolution
+  std::uint64_t seed = 1;  // sensor noise
+  bool progress_bar = false;
+};
+
+struct ShotTiming {
+  RasterTimings raster;
+  dslr::StageTimings develop;
+  double write_ms = 0;
+  double total_ms = 0;
+  int subframes = 1;
+  bool skipped = false;  // already in the manifest with the same inputs
+};
+
+// Renders one shot to developed pixels (no files). For tests and benchmarks.
+dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
+                                const ir::Shot& shot, double scale, std::uint64_t seed,
+                                ShotTiming* timing = nullptr,
+                                dslr::LinearFrame* linear_out = nullptr);
+
+// The number of sub-frames motion blur needs for a shot (1 when there is no motion).
+int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
+                          double scale);
+
+// Runs the whole backend; returns the process exit code (0, 1 user error, 2 failure) and
+// writes progress and errors to `log`.
+int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostream& log,
+                std::vector<ShotTiming>* timings = nullptr);
+
+}  // namespace rigc::preview

@@ -1,0 +1,578 @@
+#include "backends/preview/rasterizer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace rigc::preview {
+namespace {
+
+using Eigen::Matrix3f;
+using Eigen::Vector2f;
+using Eigen::Vector3f;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kTileSize = 32;
+constexpr int kSamples = 4;
+// Rotated-grid sample offsets inside a pixel: good edge anti-aliasing for four samples.
+constexpr float kSampleX[kSamples] = {0.375f, 0.875f, 0.125f, 0.625f};
+constexpr float kSampleY[kSamples] = {0.125f, 0.375f, 0.625f, 0.875f};
+constexpr float kNear = 0.01f;
+// Blender's photometric convention: 1 W of light is 683 lm at 555 nm.
+constexpr float kLumensPerWatt = 683.0f;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A triangle after clipping and projection. Attributes are looked up in the source triangle
+// through the barycentric coordinates each clipped vertex has there.
+struct ScreenTriangle {
+  std::array<Vector2f, 3> screen;     // pixel coordinates
+  std::array<float, 3> inv_z;         // 1 / camera z
+  std::array<Vector3f, 3> source_bary;
+  float inv_area = 0;                 // 1 / (twice the signed screen area)
+  std::int32_t source = 0;            // triangle index; object triangles first, then studio
+};
+
+struct FrameGeometry {
+  const Geometry* object;
+  const Geometry* studio;
+  Matrix3f world_from_object_rot;
+  Vector3f world_from_object_t;
+  int object_triangles;
+};
+
+// Clips a camera-space triangle against z = kNear; emits 0, 1 or 2 triangles.
+template <typename Emit>
+void clip_near(const std::array<Vector3f, 3>& cam, Emit emit) {
+  std::array<Vector3f, 4> out_p;
+  std::array<Vector3f, 4> out_b;
+  int count = 0;
+  const Vector3f bary[3] = {Vector3f(1, 0, 0), Vector3f(0, 1, 0), Vector3f(0, 0, 1)};
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const bool in_i = cam[i].z() >= kNear, in_j = cam[j].z() >= kNear;
+    if (in_i) {
+      out_p[count] = cam[i];
+      out_b[count++] = bary[i];
+    }
+    if (in_i != in_j) {
+      const float t = (kNear - cam[i].z()) / (cam[j].z() - cam[i].z());
+      out_p[count] = cam[i] + t * (cam[j] - cam[i]);
+      out_b[count++] = bary[i] + t * (bary[j] - bary[i]);
+    }
+  }
+  if (count < 3) return;
+  emit(std::array<Vector3f, 3>{out_p[0], out_p[1], out_p[2]},
+       std::array<Vector3f, 3>{out_b[0], out_b[1], out_b[2]});
+  if (count == 4) {
+    emit(std::array<Vector3f, 3>{out_p[0], out_p[2], out_p[3]},
+         std::array<Vector3f, 3>{out_b[0], out_b[2], out_b[3]});
+  }
+}
+
+inline float edge(const Vector2f& a, const Vector2f& b, float px, float py) {
+  return (b.x() - a.x()) * (py - a.y()) - (b.y() - a.y()) * (px - a.x());
+}
+
+// Perspective-correct barycentrics of the screen triangle at (px, py), unclamped.
+inline Vector3f screen_bary(const ScreenTriangle& t, float px, float py) {
+  const float w0 = edge(t.screen[1], t.screen[2], px, py) * t.inv_area;
+  const float w1 = edge(t.screen[2], t.screen[0], px, py) * t.inv_area;
+  const float w2 = 1 - w0 - w1;
+  Vector3f p(w0 * t.inv_z[0], w1 * t.inv_z[1], w2 * t.inv_z[2]);
+  const float sum = p.sum();
+  return sum != 0 ? Vector3f(p / sum) : Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3);
+}
+
+inline Vector3f source_bary(const ScreenTriangle& t, const Vector3f& b) {
+  return b.x() * t.source_bary[0] + b.y() * t.source_bary[1] + b.z() * t.source_bary[2];
+}
+
+// A depth map from a light, over the shadow casters (object and turntable).
+struct ShadowMap {
+  bool orthographic = false;
+  Matrix3f light_from_world = Matrix3f::Identity();  // rows: right, down, forward
+  Vector3f origin = Vector3f::Zero();                // light position (or ortho centre)
+  float focal = 1;       // perspective: pixels per unit of x/z; ortho: pixels per meter
+  float texel_m_per_z = 0;  // world size of a texel at unit distance (perspective)
+  float texel_m = 0;        // world size of a texel (orthographic)
+  int size = 0;
+  float softness_texels_per_m = 0;  // area lights: penumbra growth
+  float light_size_m = 0;
+  std::vector<float> depth;  // light-space z, +inf where empty
+
+  // Fraction of light reaching a world point with geometric normal facing cos_theta.
+  float visibility(const Vector3f& world, float cos_theta) const;
+};
+
+Matrix3f light_frame(const Vector3f& forward_in) {
+  Vector3f forward = forward_in.normalized();
+  Vector3f up = std::abs(forward.z()) > 0.99f ? Vector3f::UnitY() : Vector3f::UnitZ();
+  Vector3f right = forward.cross(up).normalized();
+  Vector3f down = forward.cross(right);
+  Matrix3f m;
+  m.row(0) = right;
+  m.row(1) = down;
+  m.row(2) = forward;
+  return m;
+}
+
+float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
+  if (depth.empty()) return 1;
+  const Vector3f local = light_from_world * (world - origin);
+  float u, v, texel;
+  if (orthographic) {
+    u = local.x() * focal + size / 2.0f;
+    v = local.y() * focal + size / 2.0f;
+    texel = texel_m;
+  } else {
+    if (local.z() <= kNear) return 1;
+    u = local.x() / local.z() * focal + size / 2.0f;
+    v = local.y() / local.z() * focal + size / 2.0f;
+    texel = texel_m_per_z * local.z();
+  }
+  if (u < 0 || v < 0 || u >= size || v >= size) return 1;
+  const float tan_theta = std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)) /
+                          std::max(cos_theta, 0.15f);
+  const float bias = texel * (1.5f + 2.0f * tan_theta) + 0.002f;
+  const float receiver = local.z() - bias;
+  auto lookup = [&](float su, float sv) {
+    const int iu = std::clamp(static_cast<int>(su), 0, size - 1);
+    const int iv = std::clamp(static_cast<int>(sv), 0, size - 1);
+    return depth[static_cast<size_t>(iv) * size + iu];
+  };
+  // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels.
+  static constexpr float kDisc[16][2] = {
+      {-0.94f, -0.40f}, {0.95f, -0.77f}, {-0.09f, -0.93f}, {0.34f, 0.29f},
+      {-0.92f, 0.46f},  {-0.81f, -0.88f}, {-0.38f, 0.28f}, {0.97f, 0.76f},
+      {0.44f, -0.98f},  {0.54f, 0.89f},   {-0.26f, -0.60f}, {-0.10f, 0.89f},
+      {0.79f, 0.19f},   {-0.62f, 0.99f},  {0.20f, -0.35f}, {-0.50f, -0.12f}};
+  float radius = 1.5f;
+  if (light_size_m > 0 && !orthographic) {
+    // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
+    float blockers = 0, blocker_sum = 0;
+    const float search = std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f,
+                                    2.0f, 24.0f);
+    for (const auto& d : kDisc) {
+      const float z = lookup(u + d[0] * search, v + d[1] * search);
+      if (z < receiver) {
+        blockers += 1;
+        blocker_sum += z;
+      }
+    }
+    if (blockers == 0) return 1;
+    const float blocker = blocker_sum / blockers;
+    const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
+    radius = std::clamp(penumbra_m / texel, 1.5f, 24.0f);
+  }
+  float lit = 0;
+  for (const auto& d : kDisc) {
+    if (lookup(u + d[0] * radius, v + d[1] * radius) >= receiver) lit += 1;
+  }
+  return lit / 16;
+}
+
+void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>& tris) {
+  map.depth.assign(static_cast<size_t>(map.size) * map.size,
+                   std::numeric_limits<float>::infinity());
+  const int size = map.size;
+  const int bands = 16;
+  // Bands of rows in parallel: each band owns its rows, so no locks are needed.
+  tbb::parallel_for(0, bands, [&](int band) {
+    const int row0 = band * size / bands, row1 = (band + 1) * size / bands;
+    for (const auto& tri : tris) {
+      std::array<Vector2f, 3> s;
+      std::array<float, 3> z;
+      bool behind = false;
+      for (int i = 0; i < 3; ++i) {
+        const Vector3f l = map.light_from_world * (tri[i] - map.origin);
+        if (map.orthographic) {
+          s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
+        } else {
+          if (l.z() <= kNear) behind = true;
+          s[i] = {l.x() / l.z() * map.focal + size / 2.0f, l.y() / l.z() * map.focal + size / 2.0f};
+        }
+        z[i] = l.z();
+      }
+      if (behind) continue;
+      const float area = edge(s[0], s[1], s[2].x(), s[2].y());
+      if (std::abs(area) < 1e-12f) continue;
+      const int x0 = std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
+      const int x1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+      const int y0 = std::max(row0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
+      const int y1 = std::min(row1 - 1, static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+      const float inv_area = 1 / area;
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+          const float px = x + 0.5f, py = y + 0.5f;
+          const float w0 = edge(s[1], s[2], px, py) * inv_area;
+          const float w1 = edge(s[2], s[0], px, py) * inv_area;
+          const float w2 = 1 - w0 - w1;
+          if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+          // Linear depth is affine in screen space only for orthographic maps; for perspective
+          // maps interpolate 1/z.
+          float depth_here;
+          if (map.orthographic) {
+            depth_here = w0 * z[0] + w1 * z[1] + w2 * z[2];
+          } else {
+            depth_here = 1 / (w0 / z[0] + w1 / z[1] + w2 / z[2]);
+          }
+          float& stored = map.depth[static_cast<size_t>(y) * size + x];
+          stored = std::min(stored, depth_here);
+        }
+      }
+    }
+  });
+}
+
+ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
+                           const std::vector<std::array<Vector3f, 3>>& casters, int size) {
+  ShadowMap map;
+  map.size = size;
+  if (light.type == ir::LightType::kDirectional) {
+    map.orthographic = true;
+    map.light_from_world = light_frame(light.direction.cast<float>());
+    map.origin = center - light.direction.cast<float>().normalized() * (radius * 4);
+    map.focal = size / (2.2f * radius);
+    map.texel_m = 1 / map.focal;
+  } else {
+    const Vector3f position = light.position.cast<float>();
+    const float distance = (center - position).norm();
+    if (distance <= radius * 1.05f) return map;  // light among the casters: no map, all lit
+    map.light_from_world = light_frame(center - position);
+    map.origin = position;
+    const float half_angle = std::asin(std::min(0.999f, radius * 1.1f / distance));
+    map.focal = size / (2 * std::tan(half_angle));
+    map.texel_m_per_z = 1 / map.focal;
+    if (light.type == ir::LightType::kArea) {
+      map.light_size_m = static_cast<float>(std::max(light.size_m.x(), light.size_m.y()));
+    }
+  }
+  rasterize_depth(map, casters);
+  return map;
+}
+
+// Radiometry of one light at a point: the colour-weighted illuminance (lux) arriving along `to_light`.
+struct LightSample {
+  Vector3f to_light;
+  Vector3f illuminance;  // per channel, lux
+};
+
+bool sample_light(const ir::Light& light, const Vector3f& color, const Vector3f& p, LightSample* out) {
+  if (light.type == ir::LightType::kDirectional) {
+    out->to_light = -light.direction.cast<float>().normalized();
+    out->illuminance = color * static_cast<float>(light.illuminance_lx);
+    return true;
+  }
+  const Vector3f d = light.position.cast<float>() - p;
+  const float dist2 = std::max(d.squaredNorm(), 1e-6f);
+  out->to_light = d / std::sqrt(dist2);
+  const float watts = static_cast<float>(light.power_w);
+  float intensity_cd;  // candela towards p
+  if (light.type == ir::LightType::kArea) {
+    // A one-sided Lambertian emitter of power P has intensity P/π along its normal.
+    const float cos_emit = std::max(0.0f, -light.direction.cast<float>().dot(out->to_light));
+    intensity_cd = kLumensPerWatt * watts / kPi * cos_emit;
+  } else {
+    intensity_cd = kLumensPerWatt * watts / (4 * kPi);
+    if (light.type == ir::LightType::kSpot) {
+      const float cos_axis = light.direction.cast<float>().dot(-out->to_light);
+      const float half = static_cast<float>(light.spot_angle_rad / 2);
+      const float outer = std::cos(half);
+      const float inner = std::cos(half * (1 - static_cast<float>(light.spot_blend)));
+      const float t = std::clamp((cos_axis - outer) / std::max(inner - outer, 1e-4f), 0.0f, 1.0f);
+      intensity_cd *= t * t * (3 - 2 * t);
+    }
+  }
+  out->illuminance = color * (intensity_cd / dist2);
+  return intensity_cd > 0;
+}
+
+// GGX microfacet specular (Smith-Schlick visibility), times π so that it sits beside albedo/π·π.
+float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h, float roughness,
+                   float f0, float* fresnel_out) {
+  const float alpha = std::max(roughness * roughness, 0.002f);
+  const float a2 = alpha * alpha;
+  const float denom = n_dot_h * n_dot_h * (a2 - 1) + 1;
+  const float d = a2 / (kPi * denom * denom);
+  const float k = alpha / 2;
+  const float vis = 1 / ((n_dot_l * (1 - k) + k) * (n_dot_v * (1 - k) + k));
+  const float fresnel = f0 + (1 - f0) * std::pow(1 - v_dot_h, 5.0f);
+  *fresnel_out = fresnel;
+  return d * vis * fresnel / 4;
+}
+
+}  // namespace
+
+dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio,
+                               const FrameRequest& request, RasterTimings* timings) {
+  const dslr::Intrinsics& canvas = request.canvas;
+  dslr::LinearFrame frame;
+  frame.width = canvas.width;
+  frame.height = canvas.height;
+  frame.fx = canvas.fx;
+  frame.fy = canvas.fy;
+  frame.cx = canvas.cx;
+  frame.cy = canvas.cy;
+  const size_t pixel_count = static_cast<size_t>(canvas.width) * canvas.height;
+  frame.rgb.assign(pixel_count * 3, 0.0f);
+  frame.depth_m.assign(pixel_count, std::numeric_limits<float>::infinity());
+  frame.mask.assign(pixel_count, 0);
+
+  const ir::Mat4 world_from_object = ir::world_from_object(scene, request.turntable_angle_rad);
+  const Matrix3f object_rot = world_from_object.block<3, 3>(0, 0).cast<float>();
+  const Vector3f object_t = world_from_object.block<3, 1>(0, 3).cast<float>();
+  const ir::Mat4 camera_from_world = request.world_from_camera.inverse();
+  const Matrix3f cam_rot = camera_from_world.block<3, 3>(0, 0).cast<float>();
+  const Vector3f cam_t = camera_from_world.block<3, 1>(0, 3).cast<float>();
+  const Vector3f eye = request.world_from_camera.block<3, 1>(0, 3).cast<float>();
+  const Geometry& object = studio.object;
+  const Geometry& room = studio.studio;
+  const int object_tris = static_cast<int>(object.triangles.size());
+  const int total_tris = object_tris + static_cast<int>(room.triangles.size());
+
+  auto world_vertex = [&](int tri, int corner) -> Vector3f {
+    if (tri < object_tris) {
+      return object_rot * object.positions[object.triangles[tri][corner]] + object_t;
+    }
+    return room.positions[room.triangles[tri - object_tris][corner]];
+  };
+
+  // Shadow maps: one per light, over the object (at this turntable angle) and the turntable.
+  auto shadow_start = Clock::now();
+  std::vector<std::array<Vector3f, 3>> casters;
+  casters.reserve(total_tris);
+  for (int t = 0; t < total_tris; ++t) {
+    const int material = t < object_tris ? object.triangle_material[t]
+                                         : room.triangle_material[t - object_tris];
+    if (studio.materials[material].casts_shadow) {
+      casters.push_back({world_vertex(t, 0), world_vertex(t, 1), world_vertex(t, 2)});
+    }
+  }
+  const Vector3f caster_center =
+      object_rot * studio.object_center.cast<float>() + object_t;
+  const float table_radius = static_cast<float>(scene.studio.turntable.diameter_m / 2);
+  const float caster_radius = std::max(
+      static_cast<float>(studio.object_radius),
+      std::sqrt(table_radius * table_radius +
+                std::pow(caster_center.z() - object_t.z() +
+                             static_cast<float>(scene.studio.turntable.thickness_m),
+                         2.0f)));
+  std::vector<ShadowMap> shadow_maps;
+  for (const auto& light : scene.studio.lights) {
+    shadow_maps.push_back(
+        build_shadow_map(light, caster_center, caster_radius, casters, request.shadow_map_size));
+  }
+  if (timings) timings->shadow_ms += ms_since(shadow_start);
+
+  // Transform, clip and project every triangle; bin into tiles.
+  const auto setup_start = Clock::now();
+  const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
+  const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
+  std::vector<ScreenTriangle> screen_tris;
+  screen_tris.reserve(total_tris + 64);
+  for (int t = 0; t < total_tris; ++t) {
+    std::array<Vector3f, 3> cam;
+    for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
+    if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
+    clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
+      ScreenTriangle s;
+      for (int c = 0; c < 3; ++c) {
+        s.inv_z[c] = 1 / p[c].z();
+        // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
+        s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
+        s.source_bary[c] = b[c];
+      }
+      const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
+      if (std::abs(area) < 1e-10f) return;
+      s.inv_area = 1 / area;
+      s.source = t;
+      screen_tris.push_back(s);
+    });
+  }
+  const int tiles_x = (canvas.width + kTileSize - 1) / kTileSize;
+  const int tiles_y = (canvas.height + kTileSize - 1) / kTileSize;
+  std::vector<std::vector<std::int32_t>> bins(static_cast<size_t>(tiles_x) * tiles_y);
+  for (size_t i = 0; i < screen_tris.size(); ++i) {
+    const auto& s = screen_tris[i];
+    const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+    const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+    const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+    const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+    if (max_x < 0 || max_y < 0 || min_x >= canvas.width || min_y >= canvas.height) continue;
+    const int tx0 = std::max(0, static_cast<int>(min_x) / kTileSize);
+    const int tx1 = std::min(tiles_x - 1, static_cast<int>(max_x) / kTileSize);
+    const int ty0 = std::max(0, static_cast<int>(min_y) / kTileSize);
+    const int ty1 = std::min(tiles_y - 1, static_cast<int>(max_y) / kTileSize);
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        bins[static_cast<size_t>(ty) * tiles_x + tx].push_back(static_cast<std::int32_t>(i));
+      }
+    }
+  }
+  if (timings) timings->setup_ms += ms_since(setup_start);
+
+  // Light colours and the ambient term, once.
+  std::vector<Vector3f> light_colors;
+  for (const auto& light : scene.studio.lights) light_colors.push_back(light.color.cast<float>());
+  const float ambient_lx = static_cast<float>(scene.studio.ambient_lx);
+
+  auto shade = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+    const int t = s.source;
+    const bool is_object = t < object_tris;
+    const Geometry& g = is_object ? object : room;
+    const int local = is_object ? t : t - object_tris;
+    const auto& tri = g.triangles[local];
+    Vector3f b = source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
+    b /= b.sum();
+    const Vector3f p_local = b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] +
+                             b.z() * g.positions[tri[2]];
+    Vector3f n_local =
+        (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
+    const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
+    Vector3f n = (is_object ? Vector3f(object_rot * n_local) : n_local).normalized();
+    const Vector3f v = (eye - p).normalized();
+    // Geometric normal for shadow bias; shading normals are flipped towards the viewer, so
+    // back faces of open meshes still shade.
+    const Vector3f e1 = g.positions[tri[1]] - g.positions[tri[0]];
+    const Vector3f e2 = g.positions[tri[2]] - g.positions[tri[0]];
+    Vector3f geometric = e1.cross(e2).normalized();
+    if (is_object) geometric = object_rot * geometric;
+    if (geometric.dot(v) < 0) geometric = -geometric;
+    if (n.dot(v) < 0) n = -n;
+
+    const int material_index = is_object ? object.triangle_material[local]
+                                         : room.triangle_material[local];
+    const ShadedMaterial& material = studio.materials[material_index];
+    Vector3f albedo = material.base_color;
+    const float depth = (cam_rot * p + cam_t).z();
+    const float footprint_m = depth / fx / std::max(std::abs(n.dot(v)), 0.2f);
+    if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size())) {
+      const MipTexture& texture = studio.textures[material.texture];
+      auto uv_at = [&](float qx, float qy) {
+        Vector3f bq = source_bary(s, screen_bary(s, qx, qy));
+        return Vector2f(bq.x() * g.uvs[tri[0]] + bq.y() * g.uvs[tri[1]] + bq.z() * g.uvs[tri[2]]);
+      };
+      const Vector2f uv = b.x() * g.uvs[tri[0]] + b.y() * g.uvs[tri[1]] + b.z() * g.uvs[tri[2]];
+      const Vector2f du = uv_at(px + 1, py) - uv_at(px, py);
+      const Vector2f dv = uv_at(px, py + 1) - uv_at(px, py);
+      const float texels =
+          std::max(du.norm(), dv.norm()) *
+          static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
+      albedo = albedo.cwiseProduct(texture.sample(uv, texels));
+    }
+    if (is_object) albedo *= pattern_factor(material.pattern, p_local, footprint_m);
+
+    const float metallic = material.metallic;
+    const Vector3f diffuse_albedo = albedo * (1 - metallic);
+    // Ambient: a uniform white room of the given illuminance.
+    Vector3f radiance = diffuse_albedo * (ambient_lx / kPi);
+    const float n_dot_v = std::max(n.dot(v), 1e-3f);
+    for (size_t l = 0; l < scene.studio.lights.size(); ++l) {
+      LightSample sample;
+      if (!sample_light(scene.studio.lights[l], light_colors[l], p, &sample)) continue;
+      const float n_dot_l = n.dot(sample.to_light);
+      const float geo_dot_l = geometric.dot(sample.to_light);
+      if (n_dot_l <= 0 || geo_dot_l <= -0.05f) continue;
+      const float visibility = shadow_maps[l].visibility(p, std::max(geo_dot_l, 0.0f));
+      if (visibility <= 0) continue;
+      const Vector3f h = (sample.to_light + v).normalized();
+      float fresnel = 0;
+      const float f0 = 0.04f * (1 - metallic) + metallic;
+      const float specular = ggx_specular(n_dot_l, n_dot_v, std::max(n.dot(h), 0.0f),
+                                          std::max(v.dot(h), 0.0f), material.roughness, f0,
+                                          &fresnel);
+      const Vector3f spec_color =
+          metallic > 0 ? Vector3f(Vector3f::Constant(1 - metallic) + albedo * metallic)
+                       : Vector3f::Ones();
+      const Vector3f brdf = diffuse_albedo * ((1 - fresnel) / kPi) + spec_color * specular;
+      radiance += brdf.cwiseProduct(sample.illuminance) * (n_dot_l * visibility);
+    }
+    return radiance;
+  };
+
+  const auto raster_start = Clock::now();
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, tiles_x * tiles_y, 4), [&](const tbb::blocked_range<int>& range) {
+        std::vector<float> sample_inv_z(kTileSize * kTileSize * kSamples);
+        std::vector<std::int32_t> sample_tri(kTileSize * kTileSize * kSamples);
+        for (int tile = range.begin(); tile != range.end(); ++tile) {
+          const int tx = tile % tiles_x, ty = tile / tiles_x;
+          const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+          const int x1 = std::min(x0 + kTileSize, canvas.width);
+          const int y1 = std::min(y0 + kTileSize, canvas.height);
+          std::fill(sample_inv_z.begin(), sample_inv_z.end(), 0.0f);
+          std::fill(sample_tri.begin(), sample_tri.end(), -1);
+          for (const std::int32_t id : bins[tile]) {
+            const ScreenTriangle& s = screen_tris[id];
+            const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+            const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+            const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+            const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+            const int px0 = std::max(x0, static_cast<int>(std::floor(min_x)));
+            const int px1 = std::min(x1 - 1, static_cast<int>(std::floor(max_x)));
+            const int py0 = std::max(y0, static_cast<int>(std::floor(min_y)));
+            const int py1 = std::min(y1 - 1, static_cast<int>(std::floor(max_y)));
+            for (int py = py0; py <= py1; ++py) {
+              for (int px = px0; px <= px1; ++px) {
+                const int base = ((py - y0) * kTileSize + (px - x0)) * kSamples;
+                for (int k = 0; k < kSamples; ++k) {
+                  const float sx = px + kSampleX[k], sy = py + kSampleY[k];
+                  const float w0 = edge(s.screen[1], s.screen[2], sx, sy) * s.inv_area;
+                  const float w1 = edge(s.screen[2], s.screen[0], sx, sy) * s.inv_area;
+                  const float w2 = 1 - w0 - w1;
+                  if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+                  const float inv_z = w0 * s.inv_z[0] + w1 * s.inv_z[1] + w2 * s.inv_z[2];
+                  if (inv_z > sample_inv_z[base + k]) {
+                    sample_inv_z[base + k] = inv_z;
+                    sample_tri[base + k] = id;
+                  }
+                }
+              }
+            }
+          }
+          // Resolve: shade each distinct triangle of a pixel once, weighted by its samples.
+          for (int py = y0; py < y1; ++py) {
+            for (int px = x0; px < x1; ++px) {
+              const int base = ((py - y0) * kTileSize + (px - x0)) * kSamples;
+              Vector3f color = Vector3f::Zero();
+              int object_samples = 0;
+              float nearest = 0;
+              std::array<std::int32_t, kSamples> done{-1, -1, -1, -1};
+              for (int k = 0; k < kSamples; ++k) {
+                const std::int32_t id = sample_tri[base + k];
+                nearest = std::max(nearest, sample_inv_z[base + k]);
+                if (id < 0) continue;
+                if (screen_tris[id].source < object_tris) ++object_samples;
+                if (std::find(done.begin(), done.end(), id) != done.end()) continue;
+                done[k] = id;
+                int count = 0;
+                for (int j = k; j < kSamples; ++j) count += sample_tri[base + j] == id;
+                color += shade(screen_tris[id], px + 0.5f, py + 0.5f) * (float(count) / kSamples);
+              }
+              const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
+              frame.rgb[pixel * 3 + 0] = color.x();
+              frame.rgb[pixel * 3 + 1] = color.y();
+              frame.rgb[pixel * 3 + 2] = color.z();
+              if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
+              frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
+            }
+          }
+        }
+      });
+  if (timings) {
+    timings->raster_ms += ms_since(raster_start);
+  }
+  return frame;
+}
+
+}  // namespace rigc::preview

@@ -1,0 +1,288 @@
+#include "backends/preview/studio_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rigc::preview {
+namespace {
+
+using Eigen::Vector2f;
+using Eigen::Vector3f;
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+MipTexture build_mips(const ir::Texture& texture) {
+  MipTexture mips;
+  MipTexture::Level base;
+  base.width = texture.width;
+  base.height = texture.height;
+  base.texels.resize(static_cast<size_t>(texture.width) * texture.height);
+  // Decode once through a table: sRGB code values to linear.
+  std::array<float, 256> decode{};
+  for (int i = 0; i < 256; ++i) decode[i] = srgb_to_linear(i / 255.0f);
+  const int channels = texture.channels;
+  for (size_t i = 0; i < base.texels.size(); ++i) {
+    const std::uint8_t* px = &texture.pixels[i * channels];
+    if (channels >= 3) {
+      base.texels[i] = {decode[px[0]], decode[px[1]], decode[px[2]]};
+    } else {
+      base.texels[i] = Vector3f::Constant(decode[px[0]]);
+    }
+  }
+  mips.levels.push_back(std::move(base));
+  while (mips.levels.back().width > 1 || mips.levels.back().height > 1) {
+    const MipTexture::Level& fine = mips.levels.back();
+    MipTexture::Level coarse;
+    coarse.width = std::max(1, fine.width / 2);
+    coarse.height = std::max(1, fine.height / 2);
+    coarse.texels.resize(static_cast<size_t>(coarse.width) * coarse.height);
+    for (int y = 0; y < coarse.height; ++y) {
+      for (int x = 0; x < coarse.width; ++x) {
+        Vector3f sum = Vector3f::Zero();
+        for (int dy = 0; dy < 2; ++dy) {
+          for (int dx = 0; dx < 2; ++dx) {
+            int fx = std::min(fine.width - 1, 2 * x + dx);
+            int fy = std::min(fine.height - 1, 2 * y + dy);
+            sum += fine.texels[static_cast<size_t>(fy) * fine.width + fx];
+          }
+        }
+        coarse.texels[static_cast<size_t>(y) * coarse.width + x] = sum / 4;
+      }
+    }
+    mips.levels.push_back(std::move(coarse));
+  }
+  return mips;
+}
+
+Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
+  // Repeat wrapping, as glTF's default sampler.
+  float u = uv.x() - std::floor(uv.x());
+  float v = uv.y() - std::floor(uv.y());
+  float x = u * level.width - 0.5f, y = v * level.height - 0.5f;
+  int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  float tx = x - x0, ty = y - y0;
+  auto at = [&](int xi, int yi) -> const Vector3f& {
+    xi = ((xi % level.width) + level.width) % level.width;
+    yi = ((yi % level.height) + level.height) % level.height;
+    return level.texels[static_cast<size_t>(yi) * level.width + xi];
+  };
+  return (at(x0, y0) * (1 - tx) + at(x0 + 1, y0) * tx) * (1 - ty) +
+         (at(x0, y0 + 1) * (1 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
+}
+
+std::uint32_t hash3(std::int32_t x, std::int32_t y, std::int32_t z, std::uint32_t seed) {
+  std::uint32_t h = seed * 0x9E3779B9u;
+  h ^= static_cast<std::uint32_t>(x) * 0x85EBCA6Bu;
+  h = (h ^ (h >> 13)) * 0xC2B2AE35u;
+  h ^= static_cast<std::uint32_t>(y) * 0x27D4EB2Fu;
+  h = (h ^ (h >> 15)) * 0x165667B1u;
+  h ^= static_cast<std::uint32_t>(z) * 0x9E3779B1u;
+  h = (h ^ (h >> 16)) * 0x85EBCA77u;
+  return h ^ (h >> 13);
+}
+
+// Smooth value noise in [0, 1] on a unit lattice.
+float value_noise(const Vector3f& p, std::uint32_t seed) {
+  const float fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+  const auto ix = static_cast<std::int32_t>(fx), iy = static_cast<std::int32_t>(fy),
+             iz = static_cast<std::int32_t>(fz);
+  auto fade = [](float t) { return t * t * (3 - 2 * t); };
+  const float tx = fade(p.x() - fx), ty = fade(p.y() - fy), tz = fade(p.z() - fz);
+  auto value = [&](int dx, int dy, int dz) {
+    return (hash3(ix + dx, iy + dy, iz + dz, seed) & 0xFFFFFF) / float(0xFFFFFF);
+  };
+  auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
+  return lerp(lerp(lerp(value(0, 0, 0), value(1, 0, 0), tx), lerp(value(0, 1, 0), value(1, 1, 0), tx),
+                   ty),
+              lerp(lerp(value(0, 0, 1), value(1, 0, 1), tx), lerp(value(0, 1, 1), value(1, 1, 1), tx),
+                   ty),
+              tz);
+}
+
+void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const Vector3f& edge_v,
+              int material) {
+  const Vector3f normal = edge_u.cross(edge_v).normalized();
+  const auto base = static_cast<std::uint32_t>(g.positions.size());
+  const Vector3f corners[4] = {corner, corner + edge_u, corner + edge_u + edge_v, corner + edge_v};
+  const Vector2f uvs[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int i = 0; i < 4; ++i) {
+    g.positions.push_back(corners[i]);
+    g.normals.push_back(normal);
+    g.uvs.push_back(uvs[i]);
+  }
+  g.triangles.push_back({base, base + 1, base + 2});
+  g.triangles.push_back({base, base + 2, base + 3});
+  g.triangle_material.insert(g.triangle_material.end(), 2, material);
+}
+
+// A closed cylinder about the Z axis from z0 to z1, smooth sides and flat caps.
+void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
+  constexpr int kSegments = 96;
+  auto ring_point = [&](int i, float z) {
+    const float a = 2 * std::numbers::pi_v<float> * i / kSegments;
+    return Vector3f(radius * std::cos(a), radius * std::sin(a), z);
+  };
+  for (int i = 0; i < kSegments; ++i) {
+    const auto base = static_cast<std::uint32_t>(g.positions.size());
+    const Vector3f a0 = ring_point(i, z0), a1 = ring_point(i + 1, z0);
+    const Vector3f b0 = ring_point(i, z1), b1 = ring_point(i + 1, z1);
+    const Vector3f n0(a0.x() / radius, a0.y() / radius, 0), n1(a1.x() / radius, a1.y() / radius, 0);
+    // Side.
+    for (const auto& [p, n] : {std::pair{a0, n0}, {a1, n1}, {b1, n1}, {b0, n0}}) {
+      g.positions.push_back(p);
+      g.normals.push_back(n);
+      g.uvs.push_back({0, 0});
+    }
+    g.triangles.push_back({base, base + 1, base + 2});
+    g.triangles.push_back({base, base + 2, base + 3});
+    // Caps.
+    const auto cap = static_cast<std::uint32_t>(g.positions.size());
+    for (const auto& p : {Vector3f(0, 0, z1), b0, b1, Vector3f(0, 0, z0), a1, a0}) {
+      g.positions.push_back(p);
+      g.normals.push_back(p.z() == z1 ? Vector3f(0, 0, 1) : Vector3f(0, 0, -1));
+      g.uvs.push_back({0, 0});
+    }
+    g.triangles.push_back({cap, cap + 1, cap + 2});
+    g.triangles.push_back({cap + 3, cap + 4, cap + 5});
+    g.triangle_material.insert(g.triangle_material.end(), 4, material);
+  }
+}
+
+}  // namespace
+
+Vector3f MipTexture::sample(const Vector2f& uv, float footprint) const {
+  if (levels.empty()) return Vector3f::Ones();
+  const float lod = std::clamp(std::log2(std::max(footprint, 1e-8f)), 0.0f,
+                               static_cast<float>(levels.size() - 1));
+  const int fine = static_cast<int>(lod);
+  const int coarse = std::min(fine + 1, static_cast<int>(levels.size()) - 1);
+  const float t = lod - fine;
+  if (t <= 0 || fine == coarse) return bilinear(levels[fine], uv);
+  return bilinear(levels[fine], uv) * (1 - t) + bilinear(levels[coarse], uv) * t;
+}
+
+float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float footprint_m) {
+  if (pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) return 1.0f;
+  const float scale = static_cast<float>(pattern.scale_m);
+  const float contrast = static_cast<float>(pattern.contrast);
+  // Fade to the mean as the pattern gets finer than about two pixels.
+  const float resolve = std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f);
+  float darkness = 0, mean_darkness = 0;
+  const Vector3f q = p / scale;
+  switch (pattern.kind) {
+    case ir::PatternKind::kSpeckle: {
+      // Dark blotches covering about 40 % of the surface, at two scales.
+      const float n = 0.65f * value_noise(q, pattern.seed) +
+                      0.35f * value_noise(q * 2.7f + Vector3f(17.1f, 3.3f, 9.7f), pattern.seed + 1);
+      darkness = std::clamp((n - 0.47f) * 12.0f, 0.0f, 1.0f);
+      mean_darkness = 0.4f;
+      break;
+    }
+    case ir::PatternKind::kNoise: {
+      float n = 0, amplitude = 0.5f, frequency = 1;
+      for (int octave = 0; octave < 3; ++octave) {
+        n += amplitude * value_noise(q * frequency, pattern.seed + octave);
+        amplitude *= 0.5f;
+        frequency *= 2.1f;
+      }
+      darkness = std::clamp(n / 0.875f, 0.0f, 1.0f);
+      mean_darkness = 0.5f;
+      break;
+    }
+    case ir::PatternKind::kChecker: {
+      const int parity = (static_cast<int>(std::floor(q.x())) + static_cast<int>(std::floor(q.y())) +
+                          static_cast<int>(std::floor(q.z()))) &
+                         1;
+      darkness = static_cast<float>(parity);
+      mean_darkness = 0.5f;
+      break;
+    }
+    case ir::PatternKind::kNone: break;
+  }
+  darkness = resolve * darkness + (1 - resolve) * mean_darkness;
+  return 1.0f - contrast * darkness;
+}
+
+StudioScene prepare_studio_scene(const ir::Scene& scene) {
+  StudioScene out;
+  for (const auto& texture : scene.textures) out.textures.push_back(build_mips(texture));
+  for (const auto& material : scene.materials) {
+    ShadedMaterial shaded;
+    shaded.base_color = material.base_color.cast<float>();
+    shaded.texture = material.base_color_texture;
+    shaded.roughness = static_cast<float>(material.roughness);
+    shaded.metallic = static_cast<float>(material.metallic);
+    shaded.pattern = material.pattern;
+    shaded.casts_shadow = true;
+    out.materials.push_back(shaded);
+  }
+
+  // The object, moved into its own frame once.
+  const ir::Mesh& mesh = scene.object.mesh;
+  const Eigen::Matrix4f object_from_mesh = scene.object.object_from_mesh.cast<float>();
+  const Eigen::Matrix3f linear = object_from_mesh.block<3, 3>(0, 0);
+  const Eigen::Matrix3f normal_matrix = linear.inverse().transpose();
+  const Vector3f offset = object_from_mesh.block<3, 1>(0, 3);
+  Geometry& object = out.object;
+  object.positions.resize(mesh.positions.size());
+  object.normals.resize(mesh.positions.size());
+  object.uvs.assign(mesh.positions.size(), Vector2f::Zero());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    object.positions[i] = linear * mesh.positions[i] + offset;
+    object.normals[i] = (normal_matrix * mesh.normals[i]).normalized();
+    if (!mesh.uvs.empty()) object.uvs[i] = mesh.uvs[i];
+  }
+  object.triangles = mesh.triangles;
+  object.triangle_material = mesh.triangle_material;
+  if (object.triangle_material.size() != object.triangles.size()) {
+    object.triangle_material.assign(object.triangles.size(), 0);
+  }
+  out.object_center =
+      (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
+  for (const auto& p : object.positions) {
+    out.object_radius =
+        std::max(out.object_radius, (p.cast<double>() - out.object_center).norm());
+  }
+
+  // The studio, in the world frame.
+  const ir::Studio& studio = scene.studio;
+  auto add_material = [&](const ir::Vec3& color, float roughness) {
+    ShadedMaterial m;
+    m.base_color = color.cast<float>();
+    m.roughness = roughness;
+    out.materials.push_back(m);
+    return static_cast<int>(out.materials.size()) - 1;
+  };
+  const int table_material = add_material(studio.turntable.color, 0.6f);
+  out.materials[table_material].casts_shadow = true;
+  const int floor_material = add_material(studio.floor_color, 0.9f);
+  const float top = static_cast<float>(studio.turntable.height_m);
+  const float radius = static_cast<float>(studio.turntable.diameter_m / 2);
+  add_cylinder(out.studio, radius, top - static_cast<float>(studio.turntable.thickness_m), top,
+               table_material);
+  // The stand under the disc.
+  add_cylinder(out.studio, std::min(0.04f, radius / 2), 0.0f,
+               top - static_cast<float>(studio.turntable.thickness_m), table_material);
+  add_quad(out.studio, Vector3f(-6, -6, 0), Vector3f(12, 0, 0), Vector3f(0, 12, 0),
+           floor_material);
+  if (studio.backdrop.green_screen) {
+    const int backdrop_material = add_material(studio.backdrop.color, 0.95f);
+    const Vector3f toward = studio.backdrop.direction.cast<float>().normalized();
+    const Vector3f across = Vector3f::UnitZ().cross(toward).normalized();
+    const float half_width = static_cast<float>(studio.backdrop.width_m / 2);
+    const Vector3f center = toward * static_cast<float>(studio.backdrop.distance_m);
+    // Wound so that the normal faces the turntable.
+    add_quad(out.studio, center + across * half_width, -across * (2 * half_width),
+             Vector3f(0, 0, static_cast<float>(studio.backdrop.height_m)), backdrop_material);
+  }
+  const double table_radius = studio.turntable.diameter_m / 2;
+  out.turntable_caster_radius =
+      std::max(out.object_center.head<2>().norm() + out.object_radius, table_radius) +
+      out.object_center.z() + out.object_radius + studio.turntable.thickness_m;
+  return out;
+}
+
+}  // namespace rigc::preview

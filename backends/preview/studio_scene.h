@@ -1,0 +1,61 @@
+// Everything the rasterizer draws, prepared once per scene: the object in its own frame (it turns
+// with the table), the static studio (turntable, backdrop, floor) in the world frame, and the
+// materials with mip-mapped textures in linear colour.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "compiler/ir.h"
+
+namespace rigc::preview {
+
+// Linear RGB texture with its mip chain (level 0 is full size).
+struct MipTexture {
+  struct Level {
+    int width = 0;
+    int height = 0;
+    std::vector<Eigen::Vector3f> texels;
+  };
+  std::vector<Level> levels;
+
+  // Trilinear lookup; `footprint` is the texel-space size of one pixel at level 0.
+  Eigen::Vector3f sample(const Eigen::Vector2f& uv, float footprint) const;
+};
+
+struct ShadedMaterial {
+  Eigen::Vector3f base_color{0.8f, 0.8f, 0.8f};  // linear
+  int texture = -1;                              // index into StudioScene::textures
+  float roughness = 0.7f;
+  float metallic = 0.0f;
+  ir::SurfacePattern pattern;
+  bool casts_shadow = false;  // the object and the turntable; the room only receives
+};
+
+// A triangle soup with per-vertex attributes, in one frame.
+struct Geometry {
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<Eigen::Vector2f> uvs;  // one per vertex (zeros where the source had none)
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::int32_t> triangle_material;  // index into StudioScene::materials
+};
+
+struct StudioScene {
+  Geometry object;  // object frame (object_from_mesh applied)
+  Geometry studio;  // world frame
+  std::vector<ShadedMaterial> materials;
+  std::vector<MipTexture> textures;
+  Eigen::Vector3d object_center{0, 0, 0};  // object frame
+  double object_radius = 0;                // bounding sphere about object_center
+  double turntable_caster_radius = 0;      // bounding sphere of object + turntable, about the axis
+};
+
+StudioScene prepare_studio_scene(const ir::Scene& scene);
+
+// Albedo multiplier of a procedural pattern at an object-frame position; `footprint_m` is the
+// size of a pixel on the surface, so patterns finer than a pixel fade to their mean (no aliasing).
+float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p, float footprint_m);
+
+}  // namespace rigc::preview

@@ -1,0 +1,131 @@
+#include "dslr/image_io.h"
+
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include "dslr/pipeline.h"
+#include "dslr/test_helpers.h"
+#include "tests/test_support.h"
+
+namespace rigc::dslr {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::canon_6d;
+using testing::flat_frame;
+
+DevelopResult small_image(const ir::Camera& camera) {
+  LinearFrame frame = flat_frame(sensor_intrinsics(camera, 0.05), 800, 1.0f);
+  frame.mask.assign(static_cast<std::size_t>(frame.width) * frame.height, 0);
+  for (std::size_t p = 0; p < frame.mask.size(); p += 3) frame.mask[p] = 255;
+  return develop_frame(camera, frame, {1, 0, 1}, 0.05);
+}
+
+std::vector<std::string> folder_entries(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename());
+  return names;
+}
+
+TEST(DslrWrite, JpegCarriesTheExifACameraWouldWrite) {
+  rigc::testing::TempDir dir;
+  ir::Camera camera = canon_6d();
+  camera.iso = 400;
+  const DevelopResult image = small_image(camera);
+  const std::string path = dir.file("shot_000.jpg");
+  std::string error;
+  ASSERT_TRUE(write_image(path, image, camera, &error)) << error;
+  EXPECT_EQ(folder_entries(dir.path()), std::vector<std::string>{"shot_000.jpg"});
+
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const OIIO::ImageSpec& spec = in->spec();
+  EXPECT_EQ(spec.width, image.width);
+  EXPECT_EQ(spec.height, image.height);
+  EXPECT_EQ(spec.get_string_attribute("Make"), "Canon");
+  EXPECT_EQ(spec.get_string_attribute("Model"), "Canon EOS 6D");
+  EXPECT_NEAR(spec.get_float_attribute("Exif:FocalLength"), 50, 1e-3);
+  EXPECT_NEAR(spec.get_float_attribute("FNumber"), 8, 1e-3);
+  EXPECT_NEAR(spec.get_float_attribute("ExposureTime"), 1.0 / 125, 1e-6);
+  const int iso = std::max(spec.get_int_attribute("Exif:PhotographicSensitivity"),
+                           spec.get_int_attribute("Exif:ISOSpeedRatings"));
+  EXPECT_EQ(iso, 400);
+  // Pixels per cm on the focal plane: f_px = f_mm · resolution / 10.
+  EXPECT_EQ(spec.get_int_attribute("Exif:FocalPlaneResolutionUnit"), 3);
+  const double f_px = 50 * spec.get_float_attribute("Exif:FocalPlaneXResolution") / 10;
+  EXPECT_NEAR(f_px, 0.05 * image.width / 0.0358, 0.01);
+  EXPECT_EQ(spec.get_int_attribute("Exif:FocalLengthIn35mmFilm"), 50);
+  std::vector<std::uint8_t> pixels(image.encoded.size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+  EXPECT_NEAR(pixels[0], image.encoded[0], 3);  // JPEG at quality 95
+}
+
+TEST(DslrWrite, Png16KeepsEveryCodeValue) {
+  rigc::testing::TempDir dir;
+  ir::Camera camera = canon_6d();
+  camera.format = ir::ImageFormat::kPng16;
+  const DevelopResult image = small_image(camera);
+  const std::string path = dir.file("shot_000.png");
+  std::string error;
+  ASSERT_TRUE(write_image(path, image, camera, &error)) << error;
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in);
+  std::vector<std::uint16_t> pixels(image.encoded.size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT16, pixels.data()));
+  EXPECT_EQ(pixels, image.encoded);
+}
+
+TEST(DslrWrite, MaskIsAnEightBitPng) {
+  rigc::testing::TempDir dir;
+  const ir::Camera camera = canon_6d();
+  const DevelopResult image = small_image(camera);
+  const std::string path = dir.file("shot_000.png");
+  std::string error;
+  ASSERT_TRUE(write_mask(path, image.mask, image.width, image.height, &error)) << error;
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().nchannels, 1);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT8);
+  std::vector<std::uint8_t> pixels(image.mask.size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, pixels.data()));
+  EXPECT_EQ(pixels, image.mask);
+}
+
+TEST(DslrWrite, UnwritablePlacesGiveAnErrorAndLeaveNothing) {
+  rigc::testing::TempDir dir;
+  const ir::Camera camera = canon_6d();
+  const DevelopResult image = small_image(camera);
+  std::string error;
+  // A folder that does not exist.
+  EXPECT_FALSE(write_image(dir.path() / "missing" / "shot.jpg", image, camera, &error));
+  EXPECT_NE(error.find("missing"), std::string::npos) << error;
+  // A "folder" that is a file.
+  rigc::testing::write_text(dir.file("file"), "x");
+  error.clear();
+  EXPECT_FALSE(write_image(dir.path() / "file" / "shot.jpg", image, camera, &error));
+  EXPECT_FALSE(error.empty());
+  // The target is a folder: the rename fails after the data was written; the temporary goes.
+  fs::create_directories(dir.path() / "taken.jpg" / "inside");
+  error.clear();
+  EXPECT_FALSE(write_image(dir.path() / "taken.jpg", image, camera, &error));
+  EXPECT_FALSE(error.empty());
+  error.clear();
+  EXPECT_FALSE(write_mask(dir.path() / "taken.jpg", image.mask, image.width, image.height, &error));
+  auto entries = folder_entries(dir.path());
+  std::sort(entries.begin(), entries.end());
+  EXPECT_EQ(entries, (std::vector<std::string>{"file", "taken.jpg"}));
+}
+
+TEST(DslrWrite, ReplacesAnExistingFile) {
+  rigc::testing::TempDir dir;
+  const ir::Camera camera = canon_6d();
+  const std::string path = dir.file("shot.jpg");
+  rigc::testing::write_text(path, "old");
+  std::string error;
+  ASSERT_TRUE(write_image(path, small_image(camera), camera, &error)) << error;
+  EXPECT_GT(fs::file_size(path), 100u);
+}
+
+}  // namespace
+}  // namespace rigc::dslr

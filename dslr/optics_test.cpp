@@ -1,0 +1,232 @@
+#include "dslr/optics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "dslr/exposure.h"
+#include "dslr/pipeline.h"
+#include "dslr/test_helpers.h"
+
+namespace rigc::dslr {
+namespace {
+
+using testing::canon_6d;
+using testing::flat_frame;
+
+// Fraction of a disc of radius 1 to the left of x = a.
+double disc_edge_fraction(double a) {
+  return 0.5 + (a * std::sqrt(1 - a * a) + std::asin(a)) / M_PI;
+}
+
+// The 10-90 % width of the edge spread of a uniform disc, as a fraction of its diameter: the
+// disc's edge spread is the area of the disc left of a line, so it is 2·a90 with F(a90) = 0.9.
+double disc_10_90_width_over_diameter() {
+  double lo = 0, hi = 1;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (disc_edge_fraction(mid) < 0.9 ? lo : hi) = mid;
+  }
+  return lo;  // 2·a90 / 2 (diameter 2)
+}
+
+// Distance between the 10 % and 90 % crossings of a monotonic edge profile, linearly
+// interpolated between pixel centres.
+double width_10_90(const std::vector<double>& profile) {
+  const double low = profile.front(), high = profile.back();
+  auto crossing = [&](double level) {
+    const double target = low + level * (high - low);
+    for (std::size_t i = 1; i < profile.size(); ++i) {
+      const double a = profile[i - 1] - target, b = profile[i] - target;
+      if ((a <= 0) != (b <= 0)) return (i - 1) + a / (a - b);
+    }
+    return -1.0;
+  };
+  return std::abs(crossing(0.9) - crossing(0.1));
+}
+
+struct EdgeScene {
+  ir::Camera camera;
+  double scale;
+  LinearFrame frame;
+};
+
+// Dark on the left, bright from column width/2 on, every pixel at depth_m.
+EdgeScene step_edge(double f_number, double depth_m, double scale) {
+  EdgeScene s{canon_6d(), scale, {}};
+  s.camera.aperture_f_number = f_number;
+  s.camera.effects.depth_of_field = true;
+  s.frame = flat_frame(sensor_intrinsics(s.camera, scale), 100, static_cast<float>(depth_m));
+  for (int y = 0; y < s.frame.height; ++y) {
+    for (int x = s.frame.width / 2; x < s.frame.width; ++x) {
+      for (int c = 0; c < 3; ++c) s.frame.rgb[3 * (static_cast<std::size_t>(y) * s.frame.width + x) + c] = 1000;
+    }
+  }
+  return s;
+}
+
+// Mean over the middle rows of the green channel, columns [x0, x1).
+std::vector<double> row_profile(const DevelopResult& r, int x0, int x1) {
+  std::vector<double> profile;
+  for (int x = x0; x < x1; ++x) {
+    double sum = 0;
+    for (int y = r.height / 2 - 10; y < r.height / 2 + 10; ++y) {
+      sum += r.linear[3 * (static_cast<std::size_t>(y) * r.width + x) + 1];
+    }
+    profile.push_back(sum / 20);
+  }
+  return profile;
+}
+
+constexpr double kFocus = 0.8;
+
+TEST(DslrDepthOfField, CircleOfConfusionFollowsTheThinLens) {
+  // c = (f/N)·f·|S2 - S1| / (S2·(S1 - f))
+  EXPECT_NEAR(coc_diameter_m(0.05, 2.8, 0.8, 2.0), 0.05 / 2.8 * 0.05 * 1.2 / (2.0 * 0.75), 1e-12);
+  EXPECT_NEAR(coc_diameter_m(0.05, 8, 0.8, INFINITY), 0.05 / 8 * 0.05 / 0.75, 1e-12);
+  EXPECT_EQ(coc_diameter_m(0.05, 8, 0.8, 0.8), 0);
+  EXPECT_NEAR(hyperfocal_m(0.05, 8, 0.03e-3), 0.0025 / (8 * 0.03e-3) + 0.05, 1e-9);
+  // At the hyperfocal distance, infinity is blurred by exactly c0.
+  EXPECT_NEAR(coc_diameter_m(0.05, 8, hyperfocal_m(0.05, 8, 0.03e-3), INFINITY), 0.03e-3, 1e-9);
+}
+
+TEST(DslrDepthOfField, EdgeAtTheFocusDistanceStaysSharp) {
+  EdgeScene s = step_edge(2.8, kFocus, 0.125);
+  const DevelopResult r = develop_frame(s.camera, s.frame, {kFocus, 0, 1}, s.scale);
+  const int mid = r.width / 2;
+  EXPECT_LT(width_10_90(row_profile(r, mid - 20, mid + 20)), 1.0);
+}
+
+// The measured 10-90 % width of a blurred edge equals that of a disc of the thin-lens diameter.
+void expect_disc_blur(double depth_m, double scale, double min_diameter_px) {
+  EdgeScene s = step_edge(2.8, depth_m, scale);
+  const double pitch_m = s.camera.sensor_width_m / std::lround(s.camera.width_px * scale);
+  const double diameter_px =
+      0.05 / 2.8 * 0.05 * std::abs(depth_m - kFocus) / (depth_m * (kFocus - 0.05)) / pitch_m;
+  ASSERT_GT(diameter_px, min_diameter_px);  // the test means something
+  const DevelopResult r = develop_frame(s.camera, s.frame, {kFocus, 0, 1}, s.scale);
+  const int mid = r.width / 2, half = static_cast<int>(diameter_px) + 4;
+  const double measured = width_10_90(row_profile(r, mid - half, mid + half));
+  const double expected = 2 * disc_10_90_width_over_diameter() * diameter_px;
+  EXPECT_NEAR(measured, expected, 0.15 * expected) << "CoC diameter " << diameter_px << " px";
+}
+
+TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
+  EXPECT_NEAR(2 * disc_10_90_width_over_diameter(), 0.687, 0.001);
+  expect_disc_blur(1.3, 0.125, 8);     // ~8.8 px: the dense taps
+  expect_disc_blur(3.0, 0.25, 30);     // ~33 px: the ring taps
+  expect_disc_blur(0.6, 0.125, 8);     // in front of the focus
+}
+
+TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {
+  ir::Camera camera = canon_6d();
+  camera.aperture_f_number = 2.8;
+  camera.effects.depth_of_field = true;
+  const double scale = 0.125;
+  LinearFrame frame = flat_frame(sensor_intrinsics(camera, scale), 0, 3.0f);
+  const int w = frame.width, h = frame.height, edge = w / 2;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float* p = &frame.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
+      if (x < edge) {  // a red, textured foreground in focus
+        p[0] = 300 + 200 * ((x / 3 + y / 3) % 2);
+        frame.depth_m[static_cast<std::size_t>(y) * w + x] = kFocus;
+      } else {  // a blue, striped background far behind it
+        p[2] = 1000 * ((x / 4) % 2);
+      }
+    }
+  }
+  ir::Camera sharp = camera;
+  sharp.effects.depth_of_field = false;
+  const DevelopResult blurred = develop_frame(camera, frame, {kFocus, 0, 1}, scale);
+  const DevelopResult reference = develop_frame(sharp, frame, {kFocus, 0, 1}, scale);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x);
+      if (x < edge) {
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_FLOAT_EQ(blurred.linear[p + c], reference.linear[p + c]) << x << "," << y;
+        }
+      } else {
+        ASSERT_LT(blurred.linear[p], 1e-6) << "foreground red bled onto the background at " << x;
+      }
+    }
+  }
+  // The background really is blurred: its 4-pixel stripes average to half their peak.
+  const double peak = 1000 * exposure_scale(camera);
+  for (int x = edge + 30; x < edge + 40; ++x) {
+    const std::size_t p = 3 * (static_cast<std::size_t>(h / 2) * w + x);
+    EXPECT_NEAR(blurred.linear[p + 2], 0.5 * peak, 0.1 * peak) << x;
+  }
+}
+
+TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
+  ir::Camera camera = canon_6d();
+  camera.aperture_f_number = 2.8;
+  camera.effects.depth_of_field = true;
+  const double scale = 0.125;
+  LinearFrame frame = flat_frame(sensor_intrinsics(camera, scale), 0, kFocus);
+  const int w = frame.width, h = frame.height, edge = w / 2;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float* p = &frame.rgb[3 * (static_cast<std::size_t>(y) * w + x)];
+      if (x < edge) {  // red foreground, far in front of the focus
+        p[0] = 1000;
+        frame.depth_m[static_cast<std::size_t>(y) * w + x] = 0.4f;
+      } else {
+        p[2] = 1000;  // blue background in focus
+      }
+    }
+  }
+  const double pitch_m = camera.sensor_width_m / w;
+  const double radius_px = 0.5 * coc_diameter_m(0.05, 2.8, kFocus, 0.4) / pitch_m;
+  ASSERT_GT(radius_px, 8);
+  const DevelopResult r = develop_frame(camera, frame, {kFocus, 0, 1}, scale);
+  const double peak = 1000 * exposure_scale(camera);
+  auto red_at = [&](int x) { return r.linear[3 * (static_cast<std::size_t>(h / 2) * w + x)]; };
+  // Just past the edge the foreground covers about half of the background's view.
+  EXPECT_NEAR(red_at(edge) / peak, 0.4, 0.15);
+  EXPECT_GT(red_at(edge + static_cast<int>(radius_px / 2)) / peak, 0.02);
+  // Beyond its disc the background is untouched.
+  EXPECT_EQ(red_at(edge + static_cast<int>(radius_px) + 2), 0);
+  EXPECT_NEAR(red_at(edge - static_cast<int>(radius_px) - 2) / peak, 1, 1e-5);
+}
+
+// A small camera with the 6D's 6.54 µm pixels, so diffraction has its real size in pixels.
+ir::Camera small_sensor_camera(double f_number) {
+  ir::Camera camera = canon_6d();
+  camera.width_px = 240;
+  camera.height_px = 160;
+  camera.sensor_width_m = 240 * 0.0358 / 5472;
+  camera.sensor_height_m = 160 * 0.0358 / 5472;
+  camera.fx = camera.fy = camera.focal_length_m * 5472 / 0.0358;
+  camera.cx = 120;
+  camera.cy = 80;
+  camera.aperture_f_number = f_number;
+  camera.effects.diffraction = true;
+  return camera;
+}
+
+double diffraction_edge_width(const ir::Camera& camera) {
+  LinearFrame frame = flat_frame(sensor_intrinsics(camera, 1.0), 100, 1.0f);
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = frame.width / 2; x < frame.width; ++x) {
+      for (int c = 0; c < 3; ++c) frame.rgb[3 * (static_cast<std::size_t>(y) * frame.width + x) + c] = 300;
+    }
+  }
+  const DevelopResult r = develop_frame(camera, frame, {1, 0, 1}, 1.0);
+  return width_10_90(row_profile(r, r.width / 2 - 20, r.width / 2 + 20));
+}
+
+TEST(DslrDiffraction, GaussianWidthFollowsTheFNumber) {
+  // σ = 0.42·λ·N: 14.8 µm at f/64 = 2.26 px of 6.54 µm; a Gaussian edge is 2.563·σ wide (10-90 %).
+  const double sigma_px = 0.42 * 550e-9 * 64 / (0.0358 / 5472);
+  EXPECT_NEAR(diffraction_edge_width(small_sensor_camera(64)), 2.563 * sigma_px, 0.1 * 2.563 * sigma_px);
+  EXPECT_NEAR(diffraction_sigma_m(8), 1.848e-6, 1e-9);
+  // At f/2.8 σ is 0.1 px: skipped, the edge stays a step.
+  EXPECT_LT(diffraction_edge_width(small_sensor_camera(2.8)), 1.0);
+}
+
+}  // namespace
+}  // namespace rigc::dslr
