@@ -28,7 +28,7 @@ double disc_10_90_width_over_diameter() {
     const double mid = 0.5 * (lo + hi);
     (disc_edge_fraction(mid) < 0.9 ? lo : hi) = mid;
   }
-  return lo;  // 2·a90 / 2 (diameter 2)
+  return lo;  // 2·a90 over the diameter 2
 }
 
 // Distance between the 10 % and 90 % crossings of a monotonic edge profile, linearly
@@ -108,15 +108,15 @@ void expect_disc_blur(double depth_m, double scale, double min_diameter_px) {
   const DevelopResult r = develop_frame(s.camera, s.frame, {kFocus, 0, 1}, s.scale);
   const int mid = r.width / 2, half = static_cast<int>(diameter_px) + 4;
   const double measured = width_10_90(row_profile(r, mid - half, mid + half));
-  const double expected = 2 * disc_10_90_width_over_diameter() * diameter_px;
+  const double expected = disc_10_90_width_over_diameter() * diameter_px;
   EXPECT_NEAR(measured, expected, 0.15 * expected) << "CoC diameter " << diameter_px << " px";
 }
 
 TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
-  EXPECT_NEAR(2 * disc_10_90_width_over_diameter(), 0.687, 0.001);
+  EXPECT_NEAR(disc_10_90_width_over_diameter(), 0.687, 0.001);
   expect_disc_blur(1.3, 0.125, 8);     // ~8.8 px: the dense taps
   expect_disc_blur(3.0, 0.25, 30);     // ~33 px: the ring taps
-  expect_disc_blur(0.6, 0.125, 8);     // in front of the focus
+  expect_disc_blur(0.5, 0.125, 12);    // ~13.6 px, in front of the focus
 }
 
 TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {

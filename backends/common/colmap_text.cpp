@@ -18,6 +18,13 @@
 namespace rigc::backends {
 namespace fs = std::filesystem;
 
+namespace {
+// Adding +0 turns -0 into 0, so that files do not show "-0".
+double tidy(double v) {
+  return v + 0.0;
+}
+}  // namespace
+
 std::string image_extension(ir::ImageFormat format) {
   switch (format) {
     case ir::ImageFormat::kJpeg:
@@ -124,7 +131,7 @@ bool write_colmap_sparse(const fs::path& sparse_dir, const ir::Scene& scene,
       "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
       "# Number of cameras: 1\n";
   cameras += fmt::format("1 {} {} {}", camera->model, camera->width, camera->height);
-  for (double p : camera->params()) cameras += fmt::format(" {}", p);
+  for (double p : camera->params()) cameras += fmt::format(" {}", tidy(p));
   cameras += '\n';
 
   std::string images = fmt::format(
@@ -140,8 +147,9 @@ bool write_colmap_sparse(const fs::path& sparse_dir, const ir::Scene& scene,
     q.normalize();
     if (q.w() < 0) q.coeffs() *= -1;
     const ir::Vec3 t = pose.block<3, 1>(0, 3);
-    images += fmt::format("{} {} {} {} {} {} {} {} 1 {}\n\n", index + 1, q.w(), q.x(), q.y(), q.z(),
-                          t.x(), t.y(), t.z(), image_file_name(scene.camera, shot));
+    images += fmt::format("{} {} {} {} {} {} {} {} 1 {}\n\n", index + 1, tidy(q.w()), tidy(q.x()),
+                          tidy(q.y()), tidy(q.z()), tidy(t.x()), tidy(t.y()), tidy(t.z()),
+                          image_file_name(scene.camera, shot));
   }
 
   const std::string points =

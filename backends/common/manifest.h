@@ -31,7 +31,8 @@ class Manifest {
   // malformed shot entries are dropped. Never throws.
   static Manifest load(const std::filesystem::path& path);
 
-  // True when the entry for `name` has this key and every file it lists exists in run_dir.
+  // True when the entry for `name` has this (non-empty) key and every file it lists exists in
+  // run_dir.
   bool is_done(const std::string& name, const std::string& key,
                const std::filesystem::path& run_dir) const;
   // Adds or replaces the entry for record.name.

@@ -31,7 +31,8 @@ bool make_transforms_json(const ir::Scene& scene, const std::vector<int>& shots,
     const ir::Mat4 pose = opengl_object_from_camera(shot);
     nlohmann::json rows = nlohmann::json::array();
     for (int r = 0; r < 4; ++r) {
-      rows.push_back({pose(r, 0), pose(r, 1), pose(r, 2), pose(r, 3)});
+      // + 0.0 turns -0 into 0, so that the file does not show "-0.0".
+      rows.push_back({pose(r, 0) + 0.0, pose(r, 1) + 0.0, pose(r, 2) + 0.0, pose(r, 3) + 0.0});
     }
     frames.push_back({{"file_path", image_relative_path(scene.camera, shot)},
                       {"mask_path", mask_relative_path(shot)},

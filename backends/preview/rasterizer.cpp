@@ -182,50 +182,72 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
 }
 
 void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>& tris) {
-  map.depth.assign(static_cast<size_t>(map.size) * map.size,
-                   std::numeric_limits<float>::infinity());
   const int size = map.size;
-  const int bands = 16;
-  // Bands of rows in parallel: each band owns its rows, so no locks are needed.
-  tbb::parallel_for(0, bands, [&](int band) {
-    const int row0 = band * size / bands, row1 = (band + 1) * size / bands;
-    for (const auto& tri : tris) {
-      std::array<Vector2f, 3> s;
-      std::array<float, 3> z;
+  map.depth.assign(static_cast<size_t>(size) * size, std::numeric_limits<float>::infinity());
+  // Project once, then bin by bands of rows: each band owns its rows, so no locks are needed.
+  struct Projected {
+    std::array<Vector2f, 3> s;
+    std::array<float, 3> z;
+    float inv_area;
+  };
+  std::vector<Projected> projected(tris.size());
+  std::vector<char> keep(tris.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 4096),
+                    [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t t = range.begin(); t != range.end(); ++t) {
+      Projected& p = projected[t];
       bool behind = false;
       for (int i = 0; i < 3; ++i) {
-        const Vector3f l = map.light_from_world * (tri[i] - map.origin);
+        const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
         if (map.orthographic) {
-          s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
+          p.s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
         } else {
           if (l.z() <= kNear) behind = true;
-          s[i] = {l.x() / l.z() * map.focal + size / 2.0f, l.y() / l.z() * map.focal + size / 2.0f};
+          p.s[i] = {l.x() / l.z() * map.focal + size / 2.0f,
+                    l.y() / l.z() * map.focal + size / 2.0f};
         }
-        z[i] = l.z();
+        p.z[i] = l.z();
       }
-      if (behind) continue;
-      const float area = edge(s[0], s[1], s[2].x(), s[2].y());
-      if (std::abs(area) < 1e-12f) continue;
+      const float area = edge(p.s[0], p.s[1], p.s[2].x(), p.s[2].y());
+      if (behind || std::abs(area) < 1e-12f) continue;
+      p.inv_area = 1 / area;
+      keep[t] = 1;
+    }
+  });
+  constexpr int kBandRows = 32;
+  const int bands = (size + kBandRows - 1) / kBandRows;
+  std::vector<std::vector<std::uint32_t>> band_tris(bands);
+  for (size_t t = 0; t < tris.size(); ++t) {
+    if (!keep[t]) continue;
+    const auto& s = projected[t].s;
+    const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
+    const float max_y = std::max({s[0].y(), s[1].y(), s[2].y()});
+    if (max_y < 0 || min_y >= size) continue;
+    const int b0 = std::max(0, static_cast<int>(min_y) / kBandRows);
+    const int b1 = std::min(bands - 1, static_cast<int>(max_y) / kBandRows);
+    for (int b = b0; b <= b1; ++b) band_tris[b].push_back(static_cast<std::uint32_t>(t));
+  }
+  tbb::parallel_for(0, bands, [&](int band) {
+    const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
+    for (const std::uint32_t t : band_tris[band]) {
+      const Projected& p = projected[t];
+      const auto& s = p.s;
       const int x0 = std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
       const int x1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
       const int y0 = std::max(row0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
       const int y1 = std::min(row1 - 1, static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
-      const float inv_area = 1 / area;
       for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
           const float px = x + 0.5f, py = y + 0.5f;
-          const float w0 = edge(s[1], s[2], px, py) * inv_area;
-          const float w1 = edge(s[2], s[0], px, py) * inv_area;
+          const float w0 = edge(s[1], s[2], px, py) * p.inv_area;
+          const float w1 = edge(s[2], s[0], px, py) * p.inv_area;
           const float w2 = 1 - w0 - w1;
           if (w0 < 0 || w1 < 0 || w2 < 0) continue;
-          // Linear depth is affine in screen space only for orthographic maps; for perspective
-          // maps interpolate 1/z.
-          float depth_here;
-          if (map.orthographic) {
-            depth_here = w0 * z[0] + w1 * z[1] + w2 * z[2];
-          } else {
-            depth_here = 1 / (w0 / z[0] + w1 / z[1] + w2 / z[2]);
-          }
+          // Linear depth is affine in screen space only for orthographic maps; perspective maps
+          // interpolate 1/z.
+          const float depth_here =
+              map.orthographic ? w0 * p.z[0] + w1 * p.z[1] + w2 * p.z[2]
+                               : 1 / (w0 / p.z[0] + w1 / p.z[1] + w2 / p.z[2]);
           float& stored = map.depth[static_cast<size_t>(y) * size + x];
           stored = std::min(stored, depth_here);
         }
@@ -306,7 +328,7 @@ float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h, f
   const float d = a2 / (kPi * denom * denom);
   const float k = alpha / 2;
   const float vis = 1 / ((n_dot_l * (1 - k) + k) * (n_dot_v * (1 - k) + k));
-  const float fresnel = f0 + (1 - f0) * std::pow(1 - v_dot_h, 5.0f);
+  const float fresnel = f0 + (1 - f0) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h);
   *fresnel_out = fresnel;
   return d * vis * fresnel / 4;
 }
@@ -547,17 +569,41 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               Vector3f color = Vector3f::Zero();
               int object_samples = 0;
               float nearest = 0;
-              std::array<std::int32_t, kSamples> done{-1, -1, -1, -1};
+              // Samples on one surface (same object membership, depths within 1 %) are shaded
+              // once, with the triangle holding most of them; only silhouettes blend surfaces.
+              std::array<int, kSamples> surface{-1, -1, -1, -1};
               for (int k = 0; k < kSamples; ++k) {
                 const std::int32_t id = sample_tri[base + k];
                 nearest = std::max(nearest, sample_inv_z[base + k]);
-                if (id < 0) continue;
-                if (screen_tris[id].source < object_tris) ++object_samples;
-                if (std::find(done.begin(), done.end(), id) != done.end()) continue;
-                done[k] = id;
+                if (id < 0 || surface[k] >= 0) continue;
+                const bool on_object = screen_tris[id].source < object_tris;
                 int count = 0;
-                for (int j = k; j < kSamples; ++j) count += sample_tri[base + j] == id;
-                color += shade(screen_tris[id], px + 0.5f, py + 0.5f) * (float(count) / kSamples);
+                for (int j = k; j < kSamples; ++j) {
+                  const std::int32_t other = sample_tri[base + j];
+                  if (other < 0 || surface[j] >= 0) continue;
+                  if ((screen_tris[other].source < object_tris) != on_object) continue;
+                  if (std::abs(sample_inv_z[base + j] - sample_inv_z[base + k]) >
+                      0.01f * sample_inv_z[base + k]) {
+                    continue;
+                  }
+                  surface[j] = k;
+                  ++count;
+                }
+                int best = k, best_votes = 0;
+                for (int j = k; j < kSamples; ++j) {
+                  if (surface[j] != k) continue;
+                  int votes = 0;
+                  for (int m = k; m < kSamples; ++m) {
+                    votes += surface[m] == k && sample_tri[base + m] == sample_tri[base + j];
+                  }
+                  if (votes > best_votes) {
+                    best = j;
+                    best_votes = votes;
+                  }
+                }
+                if (on_object) object_samples += count;
+                color += shade(screen_tris[sample_tri[base + best]], px + 0.5f, py + 0.5f) *
+                         (float(count) / kSamples);
               }
               const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
               frame.rgb[pixel * 3 + 0] = color.x();

@@ -1,0 +1,243 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "backends/common/colmap_text.h"
+#include "backends/preview/preview_backend.h"
+#include "compiler/frontend.h"
+#include "dslr/exposure.h"
+#include "tests/test_support.h"
+
+namespace rigc::preview {
+namespace {
+
+namespace fs = std::filesystem;
+
+ir::Scene compile(const std::string& text) {
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  auto scene = compile_scene_text(text, "test.yaml", ".", diag);
+  EXPECT_TRUE(scene) << messages;
+  return scene ? *scene : ir::Scene{};
+}
+
+// A small bright ball on a black stand in a black room: its image is easy to measure.
+std::string ball_scene(const std::string& camera_extra, const std::string& shots,
+                       const std::string& object_extra = "") {
+  return R"(rigc: 1
+object:
+  primitive: {shape: sphere, detail: 5}
+  fit: {size: 1cm}
+  surface: {pattern: none, color: [0.9, 0.9, 0.9]}
+)" + object_extra + R"(
+studio:
+  turntable: {diameter: 2cm, height: 50cm, color: [0, 0, 0]}
+  backdrop: {green_screen: false}
+  floor: {color: [0, 0, 0]}
+  ambient: 2000lx
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm)" + camera_extra + R"(
+  exposure: {aperture: f/8, shutter: 1/125, iso: 200}
+  effects: {noise: false, depth_of_field: false, diffraction: false}
+shots:
+)" + shots;
+}
+
+struct Blob {
+  double x = 0, y = 0, mass = 0;
+  int min_x = 1 << 30, max_x = -1;
+};
+
+Blob mask_blob(const dslr::DevelopResult& result) {
+  Blob blob;
+  for (int y = 0; y < result.height; ++y) {
+    for (int x = 0; x < result.width; ++x) {
+      if (!result.mask[static_cast<size_t>(y) * result.width + x]) continue;
+      blob.x += x + 0.5;
+      blob.y += y + 0.5;
+      blob.mass += 1;
+    }
+  }
+  blob.x /= blob.mass;
+  blob.y /= blob.mass;
+  return blob;
+}
+
+// Horizontal extent of the pixels brighter than `fraction` of the brightest, on linear signal.
+Blob bright_extent(const dslr::DevelopResult& result, double fraction) {
+  float peak = 0;
+  for (size_t i = 0; i < result.linear.size(); i += 3) peak = std::max(peak, result.linear[i + 1]);
+  Blob blob;
+  for (int y = 0; y < result.height; ++y) {
+    for (int x = 0; x < result.width; ++x) {
+      if (result.linear[(static_cast<size_t>(y) * result.width + x) * 3 + 1] > fraction * peak) {
+        blob.min_x = std::min(blob.min_x, x);
+        blob.max_x = std::max(blob.max_x, x);
+      }
+    }
+  }
+  return blob;
+}
+
+// The ball's image centre must land where COLMAP's OPENCV model, with the exported intrinsics
+// and poses, puts the ball's centre; with strong distortion and off-centre positions.
+TEST(Preview, ObjectLandsWhereColmapProjectsIt) {
+  ir::Scene scene = compile(ball_scene(", distortion: {k1: -0.08, k2: 0.02, p1: 0.001}}",
+                                       R"(  - pose: {position: [0, -0.5m, 0.505m], look_at: [0.12m, 0, 0.55m]}
+  - pose: {position: [0.1m, -0.5m, 0.6m], look_at: [-0.1m, 0, 0.45m]}
+  - pose: {position: [0, -0.45m, 0.505m], look_at: [0, 0, 0.505m]}
+)"));
+  ASSERT_EQ(scene.shots.size(), 3u);
+  const double scale = 0.25;
+  StudioScene studio = prepare_studio_scene(scene);
+  std::string error;
+  auto camera = backends::output_camera(scene.camera, scale, &error);
+  ASSERT_TRUE(camera) << error;
+  // The ball's centre in the object frame: COLMAP's world.
+  const ir::Vec3 center =
+      (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
+  for (const auto& shot : scene.shots) {
+    dslr::DevelopResult result = render_shot(scene, studio, shot, scale, 1);
+    ASSERT_EQ(result.width, camera->width);
+    const Blob blob = mask_blob(result);
+    ASSERT_GT(blob.mass, 100) << shot.name;
+    const ir::Vec2 expected =
+        backends::project_opencv(camera->params(), backends::camera_from_object(shot), center);
+    EXPECT_NEAR(blob.x, expected.x(), 0.5) << shot.name;
+    EXPECT_NEAR(blob.y, expected.y(), 0.5) << shot.name;
+  }
+}
+
+double mean_green(const dslr::DevelopResult& result) {
+  double sum = 0;
+  int count = 0;
+  for (size_t i = 0; i < result.mask.size(); ++i) {
+    if (!result.mask[i]) continue;
+    sum += result.linear[i * 3 + 1];
+    ++count;
+  }
+  return sum / count;
+}
+
+TEST(Preview, ExposureFollowsShutterApertureAndIso) {
+  auto render_mean = [](const std::string& exposure) {
+    std::string text = ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
+    text.replace(text.find("{aperture: f/8, shutter: 1/125, iso: 200}"), 41, exposure);
+    ir::Scene scene = compile(text);
+    StudioScene studio = prepare_studio_scene(scene);
+    return mean_green(render_shot(scene, studio, scene.shots[0], 0.1, 1));
+  };
+  const double base = render_mean("{aperture: f/8, shutter: 1/250, iso: 200}");
+  ASSERT_GT(base, 0.02);
+  ASSERT_LT(base, 0.4);  // far from clipping, so ratios are clean
+  EXPECT_NEAR(render_mean("{aperture: f/8, shutter: 1/125, iso: 200}") / base, 2.0, 0.02);
+  EXPECT_NEAR(render_mean("{aperture: f/11.3137, shutter: 1/250, iso: 200}") / base, 0.5, 0.01);
+  EXPECT_NEAR(render_mean("{aperture: f/8, shutter: 1/250, iso: 400}") / base, 2.0, 0.02);
+}
+
+// A white Lambertian ball under a known illuminance has luminance L = ρE/π; its signal must be
+// the CAMERA.md exposure equation of that L.
+TEST(Preview, AbsoluteSignalMatchesTheExposureEquation) {
+  ir::Scene scene =
+      compile(ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n"));
+  StudioScene studio = prepare_studio_scene(scene);
+  dslr::DevelopResult result = render_shot(scene, studio, scene.shots[0], 0.1, 1);
+  const double luminance = 0.9 * 2000 / std::numbers::pi;  // ambient only, albedo 0.9
+  const double expected = luminance * dslr::exposure_scale(scene.camera);
+  // Vignetting darkens the image only slightly in the centre where the ball is.
+  EXPECT_NEAR(mean_green(result) / expected, 1.0, 0.05);
+}
+
+// The streak of a ball on a turning table is ω·t·R·f/Z pixels longer than the ball.
+TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
+  auto extent = [](const std::string& speed) {
+    ir::Scene scene = compile(ball_scene(
+        "}", "  - turntable: {steps: 1, step: 0deg, speed: " + speed +
+                 ", camera: {distance: 40cm, height: 0.5cm}}\n",
+        "  translate: [0, -6cm, 0]\n"));
+    StudioScene studio = prepare_studio_scene(scene);
+    const ir::Shot& shot = scene.shots[0];
+    Blob blob = bright_extent(render_shot(scene, studio, shot, 0.25, 1), 0.02);
+    return std::pair{blob.max_x - blob.min_x + 1.0, scene};
+  };
+  auto [still, scene] = extent("0deg/s");
+  auto [moving, unused] = extent("300deg/s");
+  // The ball's centre is 6 cm from the axis, moving across the view at 34 cm from the camera.
+  const double f_px = scene.camera.fx * 0.25;
+  const double expected = (300 * std::numbers::pi / 180) * (1.0 / 125) * 0.06 * f_px / 0.34;
+  ASSERT_GT(expected, 10);
+  EXPECT_NEAR((moving - still) / expected, 1.0, 0.15)
+      << "still " << still << " moving " << moving << " expected blur " << expected;
+}
+
+TEST(Preview, SameSeedGivesIdenticalImagesOtherSeedDiffers) {
+  std::string text = ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
+  text.replace(text.find("noise: false"), 12, "noise: true");
+  ir::Scene scene = compile(text);
+  StudioScene studio = prepare_studio_scene(scene);
+  auto a = render_shot(scene, studio, scene.shots[0], 0.1, 7);
+  auto b = render_shot(scene, studio, scene.shots[0], 0.1, 7);
+  auto c = render_shot(scene, studio, scene.shots[0], 0.1, 8);
+  EXPECT_EQ(a.encoded, b.encoded);
+  EXPECT_NE(a.encoded, c.encoded);
+}
+
+TEST(Preview, RunWritesTheLayoutAndResumes) {
+  testing::TempDir dir;
+  ir::Scene scene = compile(ball_scene(
+      "}", "  - turntable: {steps: 3, step: 120deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  RenderOptions options;
+  options.output_dir = dir.path().string();
+  options.scale = 0.05;
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
+  for (const char* file : {"images/shot_000.jpg", "images/shot_002.jpg", "masks/shot_001.png",
+                           "sparse/cameras.txt", "sparse/images.txt", "sparse/points3D.txt",
+                           "transforms.json", "manifest.json"}) {
+    EXPECT_TRUE(fs::exists(dir.path() / file)) << file;
+  }
+  // A rerun renders nothing; a deleted image is rendered again, alone.
+  std::vector<ShotTiming> timings;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0);
+  ASSERT_EQ(timings.size(), 3u);
+  for (const auto& t : timings) EXPECT_TRUE(t.skipped);
+  fs::remove(dir.path() / "images/shot_001.jpg");
+  timings.clear();
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0);
+  EXPECT_TRUE(timings[0].skipped);
+  EXPECT_FALSE(timings[1].skipped);
+  EXPECT_TRUE(timings[2].skipped);
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
+}
+
+TEST(Preview, UnwritableOutputIsAUserError) {
+  testing::TempDir dir;
+  fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
+  if (access(dir.path().c_str(), W_OK) == 0) {
+    // Running as root: permissions do not stop us, so use a path under a regular file instead.
+    testing::write_text(dir.file("file"), "x");
+  }
+  ir::Scene scene = compile(ball_scene(
+      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  RenderOptions options;
+  options.output_dir = (dir.path() / "file" / "run").string();
+  options.scale = 0.05;
+  std::ostringstream log;
+  EXPECT_EQ(run_preview(scene, options, log), 1);
+  EXPECT_NE(log.str().find("cannot create the output folder"), std::string::npos) << log.str();
+}
+
+TEST(Preview, RenderCommandRejectsBadShotSelection) {
+  auto result = testing::run_rigc({"render", testing::source_path("scenes/paper-turntable.yaml"),
+                                   "--shots", "3,40", "-o", "/tmp/rigc-never-written"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("--shots"), std::string::npos) << result.err;
+  EXPECT_FALSE(fs::exists("/tmp/rigc-never-written"));
+}
+
+}  // namespace
+}  // namespace rigc::preview

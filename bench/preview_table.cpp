@@ -1,0 +1,129 @@
+// Preview backend speed (issue #3 targets, measured, not asserted):
+//   paper scene, 18 shots, all effects on, full Canon 6D resolution, 100k-triangle mesh: <= 10 s;
+//   the same at 1280 x 853: <= 0.1 s per shot; growth with a 1M-triangle mesh; peak memory < 2 GB.
+// Usage: preview_table [SCENE] [--full] [--shots N]
+//   without --full only the 1280 px rows run (the full-resolution row takes minutes on 2 cores).
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+#include <fmt/format.h>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "backends/preview/preview_backend.h"
+#include "compiler/frontend.h"
+#include "compiler/primitives.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using rigc::preview::ShotTiming;
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+struct Row {
+  std::string name;
+  int shots = 0;
+  double seconds = 0;
+  std::map<std::string, double> stage_ms;
+};
+
+Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int shot_count) {
+  const fs::path dir = fs::temp_directory_path() / ("rigc_bench_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  rigc::preview::RenderOptions options;
+  options.output_dir = dir.string();
+  options.scale = scale;
+  for (int i = 0; i < shot_count && i < static_cast<int>(scene.shots.size()); ++i) {
+    options.shots.push_back(i);
+  }
+  std::vector<ShotTiming> timings;
+  std::ostringstream log;
+  const auto start = std::chrono::steady_clock::now();
+  const int code = rigc::preview::run_preview(scene, options, log, &timings);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fs::remove_all(dir);
+  if (code != 0) {
+    std::cerr << log.str();
+    std::exit(2);
+  }
+  Row row{name, static_cast<int>(options.shots.size()), seconds, {}};
+  for (const auto& t : timings) {
+    row.stage_ms["shadows"] += t.raster.shadow_ms;
+    row.stage_ms["setup+bin"] += t.raster.setup_ms;
+    row.stage_ms["raster+shade"] += t.raster.raster_ms;
+    row.stage_ms["exposure"] += t.develop.exposure_ms;
+    row.stage_ms["dof"] += t.develop.depth_of_field_ms;
+    row.stage_ms["diffraction"] += t.develop.diffraction_ms;
+    row.stage_ms["distortion"] += t.develop.distortion_ms;
+    row.stage_ms["noise"] += t.develop.noise_ms;
+    row.stage_ms["develop"] += t.develop.develop_ms;
+    row.stage_ms["encode+write"] += t.write_ms;
+  }
+  return row;
+}
+
+rigc::ir::Scene load(const std::string& path, int statue_detail) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  if (statue_detail > 0) {
+    const auto at = yaml.find("detail: ");
+    if (at != std::string::npos) yaml.replace(at + 8, 1, std::to_string(statue_detail));
+  }
+  rigc::DiagnosticEngine diag;
+  auto scene = rigc::compile_scene_text(yaml, path, fs::path(path).parent_path().string(), diag);
+  if (!scene) std::exit(1);
+  return *scene;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path = "scenes/paper-turntable.yaml";
+  bool full = false;
+  int shots = 18;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--full")) full = true;
+    else if (!std::strcmp(argv[i], "--shots") && i + 1 < argc) shots = std::atoi(argv[++i]);
+    else scene_path = argv[i];
+  }
+  std::vector<Row> rows;
+  const rigc::ir::Scene scene = load(scene_path, 0);
+  const double scale_1280 = 1280.0 / scene.camera.width_px;
+  rows.push_back(run(fmt::format("1280 px, {} tris", scene.object.mesh.triangles.size()), scene,
+                     scale_1280, shots));
+  // Detail 8 of the statue is the 1-million-triangle version of the same object.
+  const rigc::ir::Scene big = load(scene_path, 8);
+  rows.push_back(run(fmt::format("1280 px, {} tris", big.object.mesh.triangles.size()), big,
+                     scale_1280, shots));
+  if (full) {
+    rows.push_back(run(fmt::format("full res, {} tris", scene.object.mesh.triangles.size()),
+                       scene, 1.0, shots));
+  }
+  std::cout << fmt::format("{:<24} {:>5} {:>9} {:>9}", "run", "shots", "total s", "s/shot");
+  for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
+  std::cout << '\n';
+  for (const auto& row : rows) {
+    std::cout << fmt::format("{:<24} {:>5} {:>9.2f} {:>9.3f}", row.name, row.shots, row.seconds,
+                             row.seconds / row.shots);
+    double sum = 0;
+    for (const auto& [stage, ms] : row.stage_ms) sum += ms;
+    for (const auto& [stage, ms] : row.stage_ms) {
+      std::cout << fmt::format(" {:>11.1f}%", 100 * ms / std::max(sum, 1e-9));
+    }
+    std::cout << '\n';
+  }
+  std::cout << fmt::format("peak memory: {:.0f} MB\n", peak_rss_mb());
+}
