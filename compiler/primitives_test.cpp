@@ -262,6 +262,19 @@ TEST(PrimitiveStatue, DeterministicPerSeed) {
   EXPECT_GT(diff, 0.01);
 }
 
+// The shape for a seed is the same on every platform (integer hashing, no libm in the shape).
+// These values change only when the statue's design is changed on purpose.
+TEST(PrimitiveStatue, GoldenShape) {
+  const ir::Mesh mesh = make_primitive(PrimitiveKind::kStatue, 2, 1);
+  ASSERT_EQ(mesh.triangles.size(), 980u);
+  double sum = 0;
+  for (const Vector3f& p : mesh.positions) sum += p.cast<double>().norm();
+  EXPECT_NEAR(sum, 186.662464, 1e-3);
+  EXPECT_NEAR(mesh.positions[0].x(), -0.0057126f, 1e-6f);
+  EXPECT_NEAR(mesh.positions[0].y(), -0.0034274f, 1e-6f);
+  EXPECT_NEAR(mesh.positions[0].z(), 0.4710211f, 1e-6f);
+}
+
 TEST(PrimitiveStatue, TriangleCountsPerDetail) {
   // detail 6 is about 100k triangles, detail 8 over a million (for benchmarks).
   EXPECT_EQ(make_primitive(PrimitiveKind::kStatue, 6, 1).triangles.size(), 100820u);

@@ -194,7 +194,7 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
   const double px_per_m = canvas.fx / f;  // sensor metres to canvas pixels
   auto radius_at = [&](float z) {
     return static_cast<float>(std::clamp(
-        0.42 * coc_diameter_m(f, f_number, focus_distance_m, z) * px_per_m, 0.5,
+        0.5 * coc_diameter_m(f, f_number, focus_distance_m, z) * px_per_m, 0.5,
         static_cast<double>(kMaxCocRadiusPx)));
   };
 

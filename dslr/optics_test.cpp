@@ -185,9 +185,14 @@ TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
   const DevelopResult r = develop_frame(camera, frame, {kFocus, 0, 1}, scale);
   const double peak = 1000 * exposure_scale(camera);
   auto red_at = [&](int x) { return r.linear[3 * (static_cast<std::size_t>(h / 2) * w + x)]; };
-  // Just past the edge the foreground covers about half of the background's view.
-  EXPECT_NEAR(red_at(edge) / peak, 0.4, 0.15);
+  auto blue_at = [&](int x) { return r.linear[3 * (static_cast<std::size_t>(h / 2) * w + x) + 2]; };
+  // Across the edge the blur is symmetric (half and half at the edge) and conserves light.
+  EXPECT_NEAR(red_at(edge) / peak, 0.45, 0.1);
+  for (int x = edge - 20; x < edge + 20; ++x) EXPECT_NEAR((red_at(x) + blue_at(x)) / peak, 1, 0.02);
   EXPECT_GT(red_at(edge + static_cast<int>(radius_px / 2)) / peak, 0.02);
+  // Just inside the edge, the background shows through the blurred foreground's edge.
+  EXPECT_NEAR(red_at(edge - 1) / peak, 0.6, 0.15);
+  EXPECT_NEAR(blue_at(edge - 1) / peak, 0.4, 0.15);
   // Beyond its disc the background is untouched.
   EXPECT_EQ(red_at(edge + static_cast<int>(radius_px) + 2), 0);
   EXPECT_NEAR(red_at(edge - static_cast<int>(radius_px) - 2) / peak, 1, 1e-5);

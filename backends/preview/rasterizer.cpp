@@ -333,6 +333,155 @@ float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h, f
   return d * vis * fresnel / 4;
 }
 
+struct ScreenSetup {
+  std::vector<ScreenTriangle> tris;
+  std::vector<std::vector<std::int32_t>> bins;  // per tile, indices into tris
+  int tiles_x = 0;
+  int tiles_y = 0;
+};
+
+// Transforms (world_vertex(t, corner) -> world), clips, projects and bins every triangle.
+template <typename WorldVertex>
+ScreenSetup setup_screen(int total_tris, const WorldVertex& world_vertex, const Matrix3f& cam_rot,
+                         const Vector3f& cam_t, const dslr::Intrinsics& canvas) {
+  ScreenSetup setup;
+  std::vector<ScreenTriangle>& screen_tris = setup.tris;
+  const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
+  const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
+    screen_tris.reserve(total_tris + 64);
+  for (int t = 0; t < total_tris; ++t) {
+    std::array<Vector3f, 3> cam;
+    for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
+    if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
+    clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
+      ScreenTriangle s;
+      for (int c = 0; c < 3; ++c) {
+        s.inv_z[c] = 1 / p[c].z();
+        // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
+        s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
+        s.source_bary[c] = b[c];
+      }
+      const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
+      if (std::abs(area) < 1e-10f) return;
+      s.inv_area = 1 / area;
+      s.source = t;
+      screen_tris.push_back(s);
+    });
+  }
+  const int tiles_x = setup.tiles_x = (canvas.width + kTileSize - 1) / kTileSize;
+  const int tiles_y = setup.tiles_y = (canvas.height + kTileSize - 1) / kTileSize;
+  auto& bins = setup.bins;
+  bins.resize(static_cast<size_t>(tiles_x) * tiles_y);
+  for (size_t i = 0; i < screen_tris.size(); ++i) {
+    const auto& s = screen_tris[i];
+    const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+    const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+    const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+    const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+    if (max_x < 0 || max_y < 0 || min_x >= canvas.width || min_y >= canvas.height) continue;
+    const int tx0 = std::max(0, static_cast<int>(min_x) / kTileSize);
+    const int tx1 = std::min(tiles_x - 1, static_cast<int>(max_x) / kTileSize);
+    const int ty0 = std::max(0, static_cast<int>(min_y) / kTileSize);
+    const int ty1 = std::min(tiles_y - 1, static_cast<int>(max_y) / kTileSize);
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        bins[static_cast<size_t>(ty) * tiles_x + tx].push_back(static_cast<std::int32_t>(i));
+      }
+    }
+  }
+  return setup;
+}
+
+// Visibility in tiles with `Samples` samples per pixel (1: the pixel centre; 4: a rotated grid),
+// then resolve(px, py, inv_z[Samples], tri[Samples]) for every pixel (tri -1: nothing there).
+template <int Samples, typename Resolve>
+void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
+                     const Resolve& resolve) {
+  static_assert(Samples == 1 || Samples == kSamples);
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, setup.tiles_x * setup.tiles_y, 4),
+      [&](const tbb::blocked_range<int>& range) {
+        std::vector<float> sample_inv_z(kTileSize * kTileSize * Samples);
+        std::vector<std::int32_t> sample_tri(kTileSize * kTileSize * Samples);
+        for (int tile = range.begin(); tile != range.end(); ++tile) {
+          const int tx = tile % setup.tiles_x, ty = tile / setup.tiles_x;
+          const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+          const int x1 = std::min(x0 + kTileSize, canvas.width);
+          const int y1 = std::min(y0 + kTileSize, canvas.height);
+          std::fill(sample_inv_z.begin(), sample_inv_z.end(), 0.0f);
+          std::fill(sample_tri.begin(), sample_tri.end(), -1);
+          for (const std::int32_t id : setup.bins[tile]) {
+            const ScreenTriangle& s = setup.tris[id];
+            const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+            const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
+            const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+            const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
+            const int px0 = std::max(x0, static_cast<int>(std::floor(min_x)));
+            const int px1 = std::min(x1 - 1, static_cast<int>(std::floor(max_x)));
+            const int py0 = std::max(y0, static_cast<int>(std::floor(min_y)));
+            const int py1 = std::min(y1 - 1, static_cast<int>(std::floor(max_y)));
+            for (int py = py0; py <= py1; ++py) {
+              for (int px = px0; px <= px1; ++px) {
+                const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+                for (int k = 0; k < Samples; ++k) {
+                  const float sx = px + (Samples == 1 ? 0.5f : kSampleX[k]);
+                  const float sy = py + (Samples == 1 ? 0.5f : kSampleY[k]);
+                  const float w0 = edge(s.screen[1], s.screen[2], sx, sy) * s.inv_area;
+                  const float w1 = edge(s.screen[2], s.screen[0], sx, sy) * s.inv_area;
+                  const float w2 = 1 - w0 - w1;
+                  if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+                  const float inv_z = w0 * s.inv_z[0] + w1 * s.inv_z[1] + w2 * s.inv_z[2];
+                  if (inv_z > sample_inv_z[base + k]) {
+                    sample_inv_z[base + k] = inv_z;
+                    sample_tri[base + k] = id;
+                  }
+                }
+              }
+            }
+          }
+          for (int py = y0; py < y1; ++py) {
+            for (int px = x0; px < x1; ++px) {
+              const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+              resolve(px, py, &sample_inv_z[base], &sample_tri[base]);
+            }
+          }
+        }
+      });
+}
+
+// Where everything is for one frame: the object turned to its angle, the camera.
+struct FrameContext {
+  FrameContext(const ir::Scene& scene, const StudioScene& studio, const FrameRequest& request)
+      : object(studio.object), room(studio.studio) {
+    const ir::Mat4 world_from_object = ir::world_from_object(scene, request.turntable_angle_rad);
+    object_rot = world_from_object.block<3, 3>(0, 0).cast<float>();
+    object_t = world_from_object.block<3, 1>(0, 3).cast<float>();
+    const ir::Mat4 camera_from_world = request.world_from_camera.inverse();
+    cam_rot = camera_from_world.block<3, 3>(0, 0).cast<float>();
+    cam_t = camera_from_world.block<3, 1>(0, 3).cast<float>();
+    eye = request.world_from_camera.block<3, 1>(0, 3).cast<float>();
+    object_tris = static_cast<int>(object.triangles.size());
+    total_tris = object_tris + static_cast<int>(room.triangles.size());
+  }
+  // Object triangles come first, then the studio's.
+  Vector3f world_vertex(int tri, int corner) const {
+    if (tri < object_tris) {
+      return object_rot * object.positions[object.triangles[tri][corner]] + object_t;
+    }
+    return room.positions[room.triangles[tri - object_tris][corner]];
+  }
+  ScreenSetup setup(const dslr::Intrinsics& canvas) const {
+    return setup_screen(
+        total_tris, [&](int t, int c) { return world_vertex(t, c); }, cam_rot, cam_t, canvas);
+  }
+
+  const Geometry& object;
+  const Geometry& room;
+  Matrix3f object_rot, cam_rot;
+  Vector3f object_t, cam_t, eye;
+  int object_tris = 0, total_tris = 0;
+};
+
 }  // namespace
 
 dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio,
@@ -350,24 +499,17 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   frame.depth_m.assign(pixel_count, std::numeric_limits<float>::infinity());
   frame.mask.assign(pixel_count, 0);
 
-  const ir::Mat4 world_from_object = ir::world_from_object(scene, request.turntable_angle_rad);
-  const Matrix3f object_rot = world_from_object.block<3, 3>(0, 0).cast<float>();
-  const Vector3f object_t = world_from_object.block<3, 1>(0, 3).cast<float>();
-  const ir::Mat4 camera_from_world = request.world_from_camera.inverse();
-  const Matrix3f cam_rot = camera_from_world.block<3, 3>(0, 0).cast<float>();
-  const Vector3f cam_t = camera_from_world.block<3, 1>(0, 3).cast<float>();
-  const Vector3f eye = request.world_from_camera.block<3, 1>(0, 3).cast<float>();
+  const FrameContext context(scene, studio, request);
+  const Matrix3f& object_rot = context.object_rot;
+  const Vector3f& object_t = context.object_t;
+  const Matrix3f& cam_rot = context.cam_rot;
+  const Vector3f& cam_t = context.cam_t;
+  const Vector3f& eye = context.eye;
   const Geometry& object = studio.object;
   const Geometry& room = studio.studio;
-  const int object_tris = static_cast<int>(object.triangles.size());
-  const int total_tris = object_tris + static_cast<int>(room.triangles.size());
-
-  auto world_vertex = [&](int tri, int corner) -> Vector3f {
-    if (tri < object_tris) {
-      return object_rot * object.positions[object.triangles[tri][corner]] + object_t;
-    }
-    return room.positions[room.triangles[tri - object_tris][corner]];
-  };
+  const int object_tris = context.object_tris;
+  const int total_tris = context.total_tris;
+  auto world_vertex = [&](int tri, int corner) { return context.world_vertex(tri, corner); };
 
   // Shadow maps: one per light, over the object (at this turntable angle) and the turntable.
   auto shadow_start = Clock::now();
@@ -398,49 +540,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
 
   // Transform, clip and project every triangle; bin into tiles.
   const auto setup_start = Clock::now();
-  const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
-  const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
-  std::vector<ScreenTriangle> screen_tris;
-  screen_tris.reserve(total_tris + 64);
-  for (int t = 0; t < total_tris; ++t) {
-    std::array<Vector3f, 3> cam;
-    for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
-    if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
-    clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
-      ScreenTriangle s;
-      for (int c = 0; c < 3; ++c) {
-        s.inv_z[c] = 1 / p[c].z();
-        // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
-        s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
-        s.source_bary[c] = b[c];
-      }
-      const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
-      if (std::abs(area) < 1e-10f) return;
-      s.inv_area = 1 / area;
-      s.source = t;
-      screen_tris.push_back(s);
-    });
-  }
-  const int tiles_x = (canvas.width + kTileSize - 1) / kTileSize;
-  const int tiles_y = (canvas.height + kTileSize - 1) / kTileSize;
-  std::vector<std::vector<std::int32_t>> bins(static_cast<size_t>(tiles_x) * tiles_y);
-  for (size_t i = 0; i < screen_tris.size(); ++i) {
-    const auto& s = screen_tris[i];
-    const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-    const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-    const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-    const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-    if (max_x < 0 || max_y < 0 || min_x >= canvas.width || min_y >= canvas.height) continue;
-    const int tx0 = std::max(0, static_cast<int>(min_x) / kTileSize);
-    const int tx1 = std::min(tiles_x - 1, static_cast<int>(max_x) / kTileSize);
-    const int ty0 = std::max(0, static_cast<int>(min_y) / kTileSize);
-    const int ty1 = std::min(tiles_y - 1, static_cast<int>(max_y) / kTileSize);
-    for (int ty = ty0; ty <= ty1; ++ty) {
-      for (int tx = tx0; tx <= tx1; ++tx) {
-        bins[static_cast<size_t>(ty) * tiles_x + tx].push_back(static_cast<std::int32_t>(i));
-      }
-    }
-  }
+  const ScreenSetup setup = context.setup(canvas);
+  const auto& screen_tris = setup.tris;
+  const float fx = static_cast<float>(canvas.fx);
   if (timings) timings->setup_ms += ms_since(setup_start);
 
   // Light colours and the ambient term, once.
@@ -523,102 +625,119 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   };
 
   const auto raster_start = Clock::now();
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, tiles_x * tiles_y, 4), [&](const tbb::blocked_range<int>& range) {
-        std::vector<float> sample_inv_z(kTileSize * kTileSize * kSamples);
-        std::vector<std::int32_t> sample_tri(kTileSize * kTileSize * kSamples);
-        for (int tile = range.begin(); tile != range.end(); ++tile) {
-          const int tx = tile % tiles_x, ty = tile / tiles_x;
-          const int x0 = tx * kTileSize, y0 = ty * kTileSize;
-          const int x1 = std::min(x0 + kTileSize, canvas.width);
-          const int y1 = std::min(y0 + kTileSize, canvas.height);
-          std::fill(sample_inv_z.begin(), sample_inv_z.end(), 0.0f);
-          std::fill(sample_tri.begin(), sample_tri.end(), -1);
-          for (const std::int32_t id : bins[tile]) {
-            const ScreenTriangle& s = screen_tris[id];
-            const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-            const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-            const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-            const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-            const int px0 = std::max(x0, static_cast<int>(std::floor(min_x)));
-            const int px1 = std::min(x1 - 1, static_cast<int>(std::floor(max_x)));
-            const int py0 = std::max(y0, static_cast<int>(std::floor(min_y)));
-            const int py1 = std::min(y1 - 1, static_cast<int>(std::floor(max_y)));
-            for (int py = py0; py <= py1; ++py) {
-              for (int px = px0; px <= px1; ++px) {
-                const int base = ((py - y0) * kTileSize + (px - x0)) * kSamples;
-                for (int k = 0; k < kSamples; ++k) {
-                  const float sx = px + kSampleX[k], sy = py + kSampleY[k];
-                  const float w0 = edge(s.screen[1], s.screen[2], sx, sy) * s.inv_area;
-                  const float w1 = edge(s.screen[2], s.screen[0], sx, sy) * s.inv_area;
-                  const float w2 = 1 - w0 - w1;
-                  if (w0 < 0 || w1 < 0 || w2 < 0) continue;
-                  const float inv_z = w0 * s.inv_z[0] + w1 * s.inv_z[1] + w2 * s.inv_z[2];
-                  if (inv_z > sample_inv_z[base + k]) {
-                    sample_inv_z[base + k] = inv_z;
-                    sample_tri[base + k] = id;
-                  }
-                }
-              }
-            }
-          }
-          // Resolve: shade each distinct triangle of a pixel once, weighted by its samples.
-          for (int py = y0; py < y1; ++py) {
-            for (int px = x0; px < x1; ++px) {
-              const int base = ((py - y0) * kTileSize + (px - x0)) * kSamples;
-              Vector3f color = Vector3f::Zero();
-              int object_samples = 0;
-              float nearest = 0;
-              // Samples on one surface (same object membership, depths within 1 %) are shaded
-              // once, with the triangle holding most of them; only silhouettes blend surfaces.
-              std::array<int, kSamples> surface{-1, -1, -1, -1};
-              for (int k = 0; k < kSamples; ++k) {
-                const std::int32_t id = sample_tri[base + k];
-                nearest = std::max(nearest, sample_inv_z[base + k]);
-                if (id < 0 || surface[k] >= 0) continue;
-                const bool on_object = screen_tris[id].source < object_tris;
-                int count = 0;
-                for (int j = k; j < kSamples; ++j) {
-                  const std::int32_t other = sample_tri[base + j];
-                  if (other < 0 || surface[j] >= 0) continue;
-                  if ((screen_tris[other].source < object_tris) != on_object) continue;
-                  if (std::abs(sample_inv_z[base + j] - sample_inv_z[base + k]) >
-                      0.01f * sample_inv_z[base + k]) {
-                    continue;
-                  }
-                  surface[j] = k;
-                  ++count;
-                }
-                int best = k, best_votes = 0;
-                for (int j = k; j < kSamples; ++j) {
-                  if (surface[j] != k) continue;
-                  int votes = 0;
-                  for (int m = k; m < kSamples; ++m) {
-                    votes += surface[m] == k && sample_tri[base + m] == sample_tri[base + j];
-                  }
-                  if (votes > best_votes) {
-                    best = j;
-                    best_votes = votes;
-                  }
-                }
-                if (on_object) object_samples += count;
-                color += shade(screen_tris[sample_tri[base + best]], px + 0.5f, py + 0.5f) *
-                         (float(count) / kSamples);
-              }
-              const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
-              frame.rgb[pixel * 3 + 0] = color.x();
-              frame.rgb[pixel * 3 + 1] = color.y();
-              frame.rgb[pixel * 3 + 2] = color.z();
-              if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
-              frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
-            }
-          }
+  rasterize_tiles<kSamples>(setup, canvas, [&](int px, int py, const float* inv_z,
+                                                 const std::int32_t* tri) {
+    Vector3f color = Vector3f::Zero();
+    int object_samples = 0;
+    float nearest = 0;
+    // Samples on one surface (same object membership, depths within 1 %) are shaded
+    // once, with the triangle holding most of them; only silhouettes blend surfaces.
+    std::array<int, kSamples> surface{-1, -1, -1, -1};
+    for (int k = 0; k < kSamples; ++k) {
+      const std::int32_t id = tri[k];
+      nearest = std::max(nearest, inv_z[k]);
+      if (id < 0 || surface[k] >= 0) continue;
+      const bool on_object = screen_tris[id].source < object_tris;
+      int count = 0;
+      for (int j = k; j < kSamples; ++j) {
+        const std::int32_t other = tri[j];
+        if (other < 0 || surface[j] >= 0) continue;
+        if ((screen_tris[other].source < object_tris) != on_object) continue;
+        if (std::abs(inv_z[j] - inv_z[k]) >
+            0.01f * inv_z[k]) {
+          continue;
         }
-      });
+        surface[j] = k;
+        ++count;
+      }
+      int best = k, best_votes = 0;
+      for (int j = k; j < kSamples; ++j) {
+        if (surface[j] != k) continue;
+        int votes = 0;
+        for (int m = k; m < kSamples; ++m) {
+          votes += surface[m] == k && tri[m] == tri[j];
+        }
+        if (votes > best_votes) {
+          best = j;
+          best_votes = votes;
+        }
+      }
+      if (on_object) object_samples += count;
+      color += shade(screen_tris[tri[best]], px + 0.5f, py + 0.5f) *
+               (float(count) / kSamples);
+    }
+    const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
+    frame.rgb[pixel * 3 + 0] = color.x();
+    frame.rgb[pixel * 3 + 1] = color.y();
+    frame.rgb[pixel * 3 + 2] = color.z();
+    if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
+    frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
+  });
   if (timings) {
     timings->raster_ms += ms_since(raster_start);
   }
   return frame;
+}
+
+}  // namespace rigc::preview
+
+namespace rigc::preview {
+
+VisibilityBuffer render_visibility(const ir::Scene& scene, const StudioScene& studio,
+                                   const FrameRequest& request) {
+  const FrameContext context(scene, studio, request);
+  const ScreenSetup setup = context.setup(request.canvas);
+  VisibilityBuffer buffer;
+  buffer.width = request.canvas.width;
+  buffer.height = request.canvas.height;
+  const size_t pixel_count = static_cast<size_t>(buffer.width) * buffer.height;
+  buffer.object_triangle.assign(pixel_count, -1);
+  buffer.depth_m.assign(pixel_count, std::numeric_limits<float>::infinity());
+  rasterize_tiles<1>(setup, request.canvas,
+                     [&](int px, int py, const float* inv_z, const std::int32_t* tri) {
+                       if (tri[0] < 0) return;
+                       const size_t pixel = static_cast<size_t>(py) * buffer.width + px;
+                       buffer.depth_m[pixel] = 1 / inv_z[0];
+                       const int source = setup.tris[tri[0]].source;
+                       if (source < context.object_tris) buffer.object_triangle[pixel] = source;
+                     });
+  return buffer;
+}
+
+std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene& studio,
+                                      const FrameRequest& request,
+                                      const std::vector<Eigen::Vector3f>& face_colors) {
+  const FrameContext context(scene, studio, request);
+  const ScreenSetup setup = context.setup(request.canvas);
+  std::vector<float> rgb(static_cast<size_t>(request.canvas.width) * request.canvas.height * 3,
+                         0.08f);
+  // Face normals lit by a headlight, so the shape reads in the picture.
+  rasterize_tiles<kSamples>(
+      setup, request.canvas, [&](int px, int py, const float*, const std::int32_t* tri) {
+        Vector3f color = Vector3f::Zero();
+        for (int k = 0; k < kSamples; ++k) {
+          if (tri[k] < 0) {
+            color += Vector3f::Constant(0.08f);
+            continue;
+          }
+          const int t = setup.tris[tri[k]].source;
+          const Vector3f a = context.world_vertex(t, 0), b = context.world_vertex(t, 1),
+                         c = context.world_vertex(t, 2);
+          const Vector3f normal = (b - a).cross(c - a).normalized();
+          const Vector3f view = (context.eye - (a + b + c) / 3).normalized();
+          const float light = 0.35f + 0.65f * std::abs(normal.dot(view));
+          const Vector3f base = t < context.object_tris && t < static_cast<int>(face_colors.size())
+                                    ? face_colors[t]
+                                    : Vector3f(0.35f, 0.35f, 0.35f);
+          color += base * light;
+        }
+        color /= kSamples;
+        const size_t pixel = (static_cast<size_t>(py) * request.canvas.width + px) * 3;
+        rgb[pixel] = color.x();
+        rgb[pixel + 1] = color.y();
+        rgb[pixel + 2] = color.z();
+      });
+  return rgb;
 }
 
 }  // namespace rigc::preview

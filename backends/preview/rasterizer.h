@@ -28,4 +28,21 @@ struct RasterTimings {
 dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio,
                                const FrameRequest& request, RasterTimings* timings = nullptr);
 
+// Visibility only, one sample per pixel centre: the nearest object triangle (-1 where the studio
+// or nothing is seen) and the camera-space depth of whatever is nearest. For coverage analysis.
+struct VisibilityBuffer {
+  int width = 0;
+  int height = 0;
+  std::vector<std::int32_t> object_triangle;
+  std::vector<float> depth_m;
+};
+VisibilityBuffer render_visibility(const ir::Scene& scene, const StudioScene& studio,
+                                   const FrameRequest& request);
+
+// A picture of the object with one flat colour per triangle (linear RGB), lit by a headlight;
+// the studio in grey. 4 samples per pixel. Returns 3 floats per pixel.
+std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene& studio,
+                                      const FrameRequest& request,
+                                      const std::vector<Eigen::Vector3f>& face_colors);
+
 }  // namespace rigc::preview

@@ -1,0 +1,46 @@
+// `rigc compile --target povray` and `rigc render --backend povray`: the scene as POV-Ray 3.7
+// files (scene.inc with the meshes as mesh2, materials and lights; per shot a .pov with the
+// camera and the turntable angle, a .ini for the image and a _mask.ini for the object mask),
+// rendered by `povray` and developed by the shared DSLR model.
+//
+// Units: POV-Ray has none, so the files are written in Blender's radiometric units (the output
+// is cd/m² / 683, like Cycles'). POV's diffuse is albedo·cos·light colour with no 1/π, and its
+// inverse-square fade with fade_power 2 is 2/(1 + (d/D)²) ≈ 2D²/d² for D = 1 mm, so a light of
+// intensity I (W/sr) gets the colour I/(π·2D²). Area lights are POV area arrays of spotlights
+// with radius = falloff = 90° and tightness 1: a cos θ emission, one-sided, like a Lambertian
+// panel. Ambient illuminance E is ambient_light E/(683π) with finish ambient = diffuse albedo.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backends/reference/reference_backend.h"
+#include "compiler/ir.h"
+
+namespace rigc::povray {
+
+using reference::ReferenceOptions;
+using reference::ShotTiming;
+
+// POV-Ray's focal blur `aperture` per metre of pupil diameter f/N (measured with a render by
+// PovrayDepthOfField: see povray_test.cpp).
+extern const double kApertureMetersPerPupilDiameter;
+
+// Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
+// missing). `scale` multiplies the sensor resolution; `samples` sets antialiasing and focal blur
+// samples (0: defaults). Textures are written beside them as PNG. False with one-line `error`.
+bool emit(const ir::Scene& scene, const std::filesystem::path& dir, double scale,
+          std::string* error, int samples = 0);
+
+// Emits into <output_dir>/render, runs povray per shot (and per motion-blur sub-frame, which it
+// averages), develops and writes the common layout. Exit code 0, 1 user error, 2 POV-Ray failure.
+int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
+        std::vector<ShotTiming>* timings = nullptr);
+
+// The Renderer run() uses, for tests that need the linear frames.
+std::unique_ptr<reference::Renderer> make_renderer();
+
+}  // namespace rigc::povray
