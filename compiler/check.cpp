@@ -184,6 +184,7 @@ class Checker {
   void read_light(const YAML::Node& node, spec::SceneSpec& scene);
   void read_camera(const YAML::Node& node, spec::SceneSpec& scene);
   void read_shots(const YAML::Node& node, spec::SceneSpec& scene);
+  void read_coverage(const YAML::Node& node, spec::SceneSpec& scene);
   void read_turntable_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
   void read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
   void read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group);
@@ -205,7 +206,8 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
                                "and shots");
     return std::nullopt;
   }
-  check_keys(root, {"rigc", "name", "object", "studio", "camera", "shots"}, "the scene");
+  check_keys(root, {"rigc", "name", "object", "studio", "camera", "shots", "coverage"},
+             "the scene");
   if (root["rigc"]) {
     if (auto version = integer(root["rigc"], "language version 'rigc'", 1, 1)) {
       scene.version = *version;
@@ -232,8 +234,36 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
   } else {
     diag_.error({file_, 1, 1}, "missing 'shots': the list of photos to take");
   }
+  if (root["coverage"]) read_coverage(root["coverage"], scene);
   if (diag_.has_errors()) return std::nullopt;
   return scene;
+}
+
+void Checker::read_coverage(const YAML::Node& node, spec::SceneSpec& scene) {
+  ir::CoverageSettings& coverage = scene.coverage;
+  coverage.loc = loc(node);
+  if (!expect_map(node, "coverage")) return;
+  check_keys(node,
+             {"min_pixels_per_mm2", "max_view_angle", "max_blur", "min_triangulation_angle",
+              "min_signal", "max_signal", "min_overlap", "min_frame_fill"},
+             "coverage");
+  auto read = [&](const char* key, QuantityKind kind, Range range, double& out) {
+    if (!node[key]) return;
+    if (auto v = quantity(node[key], kind, key, range)) out = *v;
+  };
+  read("min_pixels_per_mm2", QuantityKind::kNumber, {0, 1e6}, coverage.min_pixels_per_mm2);
+  read("max_view_angle", QuantityKind::kAngle, {1 * kDeg, 90 * kDeg},
+       coverage.max_view_angle_rad);
+  read("max_blur", QuantityKind::kNumber, {0.1, 1000}, coverage.max_blur_px);
+  read("min_triangulation_angle", QuantityKind::kAngle, {0, 90 * kDeg},
+       coverage.min_triangulation_angle_rad);
+  read("min_signal", QuantityKind::kNumber, {0, 1}, coverage.min_signal);
+  read("max_signal", QuantityKind::kNumber, {0, 1}, coverage.max_signal);
+  read("min_overlap", QuantityKind::kNumber, {0, 1}, coverage.min_overlap);
+  read("min_frame_fill", QuantityKind::kNumber, {0, 1}, coverage.min_frame_fill);
+  if (coverage.min_signal >= coverage.max_signal) {
+    error(node, "coverage min_signal must be below max_signal");
+  }
 }
 
 void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
@@ -730,6 +760,9 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
         if (lacks(exposure, key)) error(exposure, fmt::format("exposure needs '{}'", key));
       }
       // The ranges of ISO 12232 stops that the seed paper's DSLR model offers.
+      if (exposure["aperture"]) camera.aperture_loc = loc(exposure["aperture"]);
+      if (exposure["shutter"]) camera.shutter_loc = loc(exposure["shutter"]);
+      if (exposure["iso"]) camera.iso_loc = loc(exposure["iso"]);
       if (exposure["aperture"]) {
         if (auto v = quantity(exposure["aperture"], QuantityKind::kFNumber, "aperture",
                               Range{1.2, 64})) {
@@ -752,7 +785,7 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     error(node, "the camera needs an 'exposure' {aperture, shutter, iso}");
   }
   if (const YAML::Node focus = node["focus"]) {
-    scene.focus_loc = loc(focus);
+    scene.focus_loc = camera.focus_loc = loc(focus);
     if (focus.IsScalar() && focus.Scalar() == "auto") {
       scene.focus_auto = true;
     } else if (auto d = quantity(focus, QuantityKind::kLength, "focus distance",

@@ -169,6 +169,21 @@ struct Camera {
   int jpeg_quality = 95;
   double circle_of_confusion_m = 0.03e-3;  // acceptable blur for DOF advice (diagonal / 1500)
   SourceLoc loc;
+  // Where the exposure settings were written, for capture advice at the responsible line.
+  SourceLoc aperture_loc, shutter_loc, iso_loc, focus_loc;
+};
+
+// Thresholds of the coverage analysis: when a view of a face is usable by SfM.
+struct CoverageSettings {
+  double min_pixels_per_mm2 = 1.0;        // image resolution on the surface
+  double max_view_angle_rad = 1.3089969389957472;    // 75 deg between normal and view ray
+  double max_blur_px = 2.0;               // circle of confusion, in pixels, still "in focus"
+  double min_triangulation_angle_rad = 0.08726646259971647;  // 5 deg between two usable views
+  double min_signal = 0.02;               // normalised signal below: too dark (noise)
+  double max_signal = 0.98;               // above: clipped
+  double min_overlap = 0.6;               // of consecutive shots' seen surface
+  double min_frame_fill = 0.05;           // object's share of the image area
+  SourceLoc loc;
 };
 
 enum class ShotKind { kTurntable, kOrbit, kPose };
@@ -196,6 +211,7 @@ struct Scene {
   Studio studio;
   Camera camera;
   std::vector<Shot> shots;
+  CoverageSettings coverage;
 };
 
 // world_from_object for a turntable angle.

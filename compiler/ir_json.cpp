@@ -218,6 +218,15 @@ json ir_to_json(const ir::Scene& scene, bool include_geometry) {
                      {"loc", loc_json(s.loc)}});
   }
   out["shots"] = shots;
+  const ir::CoverageSettings& cov = scene.coverage;
+  out["coverage"] = {{"min_pixels_per_mm2", cov.min_pixels_per_mm2},
+                     {"max_view_angle_rad", cov.max_view_angle_rad},
+                     {"max_blur_px", cov.max_blur_px},
+                     {"min_triangulation_angle_rad", cov.min_triangulation_angle_rad},
+                     {"min_signal", cov.min_signal},
+                     {"max_signal", cov.max_signal},
+                     {"min_overlap", cov.min_overlap},
+                     {"min_frame_fill", cov.min_frame_fill}};
   return out;
 }
 

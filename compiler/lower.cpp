@@ -81,6 +81,7 @@ class Lowering {
     scene_.source_file = spec_.source_file;
     scene_.studio = spec_.studio;
     scene_.camera = spec_.camera;
+    scene_.coverage = spec_.coverage;
     if (!lower_object()) return std::nullopt;
     lower_camera();
     lower_lights();

@@ -105,6 +105,7 @@ struct SceneSpec {
   double focus_distance_m = 1;
   SourceLoc focus_loc;
   std::vector<ShotGroupSpec> shots;
+  ir::CoverageSettings coverage;
 };
 
 }  // namespace rigc::spec

@@ -123,7 +123,7 @@ RenderGeometry render_geometry_for(const ir::Camera& camera, double scale) {
 
 double vignetting_gain(double fraction_lost, double r2, double r2_corner) {
   if (fraction_lost <= 0 || r2_corner <= 0) return 1;
-  auto cos4 = [](double q) { return 1 / ((1 + q) * (1 + q)); };
+  auto cos4 = [](double q) { return 1 / (1 + q); };
   return 1 - fraction_lost * (1 - cos4(r2)) / (1 - cos4(r2_corner));
 }
 

@@ -168,6 +168,13 @@ TEST(DslrVignetting, CornersLoseTheConfiguredFraction) {
   EXPECT_NEAR(at(0, 0) / centre, 0.6, 0.01);
   EXPECT_NEAR(at(s.width - 1, s.height - 1) / centre, 0.6, 0.01);
   EXPECT_GT(at(s.width / 4, s.height / 2) / centre, at(0, s.height / 2) / centre);
+  // In between, the shape is cos⁴ of the field angle: 1/(1 + r²)² for normalised radius r.
+  const double xc = (0 - s.cx) / s.fx, yc = (0 - s.cy) / s.fy;
+  const int i = s.width * 3 / 4, j = s.height / 2;
+  const double x = (i + 0.5 - s.cx) / s.fx, y = (j + 0.5 - s.cy) / s.fy;
+  auto cos4 = [](double r2) { return 1 / ((1 + r2) * (1 + r2)); };
+  const double expected = 1 - 0.4 * (1 - cos4(x * x + y * y)) / (1 - cos4(xc * xc + yc * yc));
+  EXPECT_NEAR(at(i, j) / centre, expected, 1e-4);
   EXPECT_DOUBLE_EQ(vignetting_gain(0.4, 0, 0.3), 1.0);
   EXPECT_DOUBLE_EQ(vignetting_gain(0.4, 0.3, 0.3), 0.6);
 }

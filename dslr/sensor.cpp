@@ -94,7 +94,7 @@ std::uint64_t stream_key(std::uint64_t seed, std::uint64_t stream) {
 enum Stream : std::uint64_t { kPrnuDsnu = 1, kReadNormal = 2, kShotNormal = 3, kShotUniform = 4 };
 
 // Below this mean the Gaussian approximation of the Poisson law is visibly skewed.
-constexpr double kExactPoissonBelow = 0;
+constexpr double kExactPoissonBelow = 30;
 
 }  // namespace
 

@@ -1,0 +1,334 @@
+#include "backends/cycles/cycles_backend.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <ostream>
+
+#include "backends/common/files.h"
+#include "backends/preview/studio_scene.h"
+#include "backends/reference/process.h"
+#include "backends/reference/script_text.h"
+#include "dslr/lens.h"
+
+namespace rigc::cycles {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using reference::RenderedShot;
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kDefaultSamples = 64;
+
+constexpr const char* kScriptTemplate =
+#include "backends/cycles/cycles_script.py.inc"
+    ;
+
+json matrix_rows(const ir::Mat4& m) {
+  json rows = json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+json vec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// Blender lights shine along their local -Z.
+ir::Mat4 light_matrix(const ir::Light& light) {
+  const Eigen::Vector3d dir = light.direction.normalized();
+  Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(dir);
+  if (across.norm() < 1e-6) across = Eigen::Vector3d::UnitX();
+  across.normalize();
+  const Eigen::Vector3d z = -dir;
+  const Eigen::Vector3d y = z.cross(across);
+  ir::Mat4 m = ir::Mat4::Identity();
+  m.block<3, 1>(0, 0) = across;
+  m.block<3, 1>(0, 1) = y;
+  m.block<3, 1>(0, 2) = z;
+  m.block<3, 1>(0, 3) = light.position;
+  return m;
+}
+
+json light_json(const ir::Light& light, int index) {
+  json spec = {{"name", fmt::format("RigcLight{}", index)},
+               {"color", vec3(light.color)},
+               {"matrix", matrix_rows(light_matrix(light))}};
+  switch (light.type) {
+    case ir::LightType::kPoint:
+      spec["type"] = "POINT";
+      spec["energy"] = light.power_w;
+      break;
+    case ir::LightType::kSpot:
+      spec["type"] = "SPOT";
+      spec["energy"] = light.power_w;
+      spec["spot_size"] = std::clamp(light.spot_angle_rad, 1e-3, kPi);
+      spec["spot_blend"] = std::clamp(light.spot_blend, 0.0, 1.0);
+      break;
+    case ir::LightType::kArea:
+      spec["type"] = "AREA";
+      spec["energy"] = light.power_w;
+      spec["size"] = {std::max(light.size_m.x(), 1e-4), std::max(light.size_m.y(), 1e-4)};
+      break;
+    case ir::LightType::kDirectional:
+      spec["type"] = "SUN";
+      spec["energy"] = light.illuminance_lx / reference::kCandelaPerBlenderUnit;
+      break;
+  }
+  return spec;
+}
+
+std::string texture_file_name(int texture) { return fmt::format("texture_{}.png", texture); }
+
+json material_json(const ir::Scene& scene, const preview::ShadedMaterial& material, int index,
+                   bool is_object) {
+  std::string name = index < static_cast<int>(scene.materials.size())
+                         ? scene.materials[index].name
+                         : fmt::format("rigc_studio_{}", index);
+  json spec = {{"name", name},
+               {"base_color", vec3(material.base_color.cast<double>())},
+               {"roughness", material.roughness},
+               {"metallic", material.metallic},
+               {"texture", material.texture >= 0 ? json(texture_file_name(material.texture))
+                                                 : json(nullptr)},
+               {"pattern", nullptr}};
+  const ir::SurfacePattern& pattern = material.pattern;
+  if (is_object && pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0) {
+    // Blender's noise is centred on 0.5 like the preview's value noise: speckle darkens where it
+    // is above a step a little over the middle (about 40 % of the surface).
+    json from = pattern.kind == ir::PatternKind::kSpeckle ? json{0.52, 0.57} : json{0.0, 1.0};
+    spec["pattern"] = {{"kind", pattern.kind == ir::PatternKind::kChecker ? "checker" : "noise"},
+                       {"scale", pattern.scale_m},
+                       {"contrast", pattern.contrast},
+                       {"from", from}};
+  }
+  return spec;
+}
+
+// Appends the mesh the way Blender's foreach_set wants it: per-vertex positions and normals,
+// per-loop vertex indices and UVs (v flipped: Blender's v = 0 is the image bottom).
+json append_geometry(std::string& bytes, const preview::Geometry& g, int material_offset,
+                     int material_count) {
+  auto append = [&](const void* data, size_t size) {
+    const size_t offset = bytes.size();
+    bytes.append(static_cast<const char*>(data), size);
+    return offset;
+  };
+  json spec;
+  spec["vertex_count"] = g.positions.size();
+  spec["triangle_count"] = g.triangles.size();
+  std::vector<float> floats;
+  for (const auto& p : g.positions) floats.insert(floats.end(), {p.x(), p.y(), p.z()});
+  spec["positions"] = append(floats.data(), floats.size() * sizeof(float));
+  floats.clear();
+  for (const auto& n : g.normals) floats.insert(floats.end(), {n.x(), n.y(), n.z()});
+  spec["normals"] = append(floats.data(), floats.size() * sizeof(float));
+  std::vector<std::int32_t> ints;
+  floats.clear();
+  for (const auto& tri : g.triangles) {
+    for (const std::uint32_t v : tri) {
+      ints.push_back(static_cast<std::int32_t>(v));
+      floats.push_back(g.uvs[v].x());
+      floats.push_back(1 - g.uvs[v].y());
+    }
+  }
+  spec["loop_vertices"] = append(ints.data(), ints.size() * sizeof(std::int32_t));
+  spec["loop_uvs"] = append(floats.data(), floats.size() * sizeof(float));
+  ints.clear();
+  for (const std::int32_t m : g.triangle_material) {
+    ints.push_back(std::clamp(m, material_offset, material_offset + material_count - 1));
+  }
+  spec["materials"] = append(ints.data(), ints.size() * sizeof(std::int32_t));
+  return spec;
+}
+
+std::string script_text(const json& data) {
+  const std::string literal = reference::python_string_literal(
+      data.dump(-1, ' ', true, json::error_handler_t::replace));
+  std::string script = kScriptTemplate;
+  const std::string placeholder = "@DATA@";
+  script.replace(script.find(placeholder), placeholder.size(), literal);
+  const std::string header = fmt::format(
+      "# RigC: Blender Cycles scene '{}' (object {}).\n"
+      "# Run: blender -b --factory-startup --python scene.py [-- --shot N[,N...] --samples N "
+      "--out DIR]\n",
+      reference::comment_text(data["scene"].get<std::string>()),
+      reference::comment_text(data["object_source"].get<std::string>()));
+  return header + script;
+}
+
+class CyclesRenderer : public reference::Renderer {
+ public:
+  std::string name() const override { return "cycles"; }
+  std::string executable() const override { return "blender"; }
+  std::string package() const override { return "blender"; }
+  bool emit(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
+            std::string* error) override {
+    return emit_files(scene, dir, scale, samples, error);
+  }
+  bool render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot, double scale,
+              int samples, const fs::path& log_path, RenderedShot* out,
+              std::string* error) override;
+
+  static bool emit_files(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
+                         std::string* error);
+};
+
+bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
+                                int samples, std::string* error) {
+  if (!(scale > 0) || !std::isfinite(scale)) {
+    *error = "the render scale must be a positive number";
+    return false;
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) {
+    *error = fmt::format("cannot create the folder '{}'", dir.string());
+    return false;
+  }
+  for (const auto& shot : scene.shots) {
+    if (!reference::is_plain_file_stem(shot.name)) {
+      *error = fmt::format("shot name '{}' cannot be a file name",
+                           reference::comment_text(shot.name));
+      return false;
+    }
+  }
+  const preview::StudioScene studio = preview::prepare_studio_scene(scene);
+  const int object_materials = static_cast<int>(scene.materials.size());
+  const int total_materials = static_cast<int>(studio.materials.size());
+  const ir::Camera& camera = scene.camera;
+  const dslr::RenderGeometry canvas = dslr::render_geometry_for(camera, scale);
+
+  json data;
+  data["scene"] = scene.name;
+  data["object_source"] = scene.object.source;
+  data["source_file"] = scene.source_file;
+  data["width"] = canvas.width;
+  data["height"] = canvas.height;
+  data["samples"] = samples > 0 ? samples : kDefaultSamples;
+  data["shutter_s"] = camera.shutter_s;
+  data["ambient_radiance"] = scene.studio.ambient_lx / reference::kCandelaPerBlenderUnit / kPi;
+  // The sensor width that gives the canvas's fx at the true focal length, so that Cycles' pupil
+  // (focal length / f-number) is the real one.
+  const double focal_mm = camera.focal_length_m * 1000;
+  const double max_side = std::max(canvas.width, canvas.height);
+  data["camera"] = {{"focal_mm", focal_mm},
+                    {"sensor_width_mm", canvas.width * focal_mm / canvas.fx},
+                    {"shift_x", (canvas.width / 2.0 - canvas.cx) / max_side},
+                    {"shift_y", (canvas.cy - canvas.height / 2.0) / max_side},
+                    {"f_number", camera.aperture_f_number},
+                    {"depth_of_field", camera.effects.depth_of_field}};
+
+  json materials = json::array();
+  for (int m = 0; m < total_materials; ++m) {
+    materials.push_back(material_json(scene, studio.materials[m], m, m < object_materials));
+  }
+  data["materials"] = materials;
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    if (!reference::write_texture_png(dir / texture_file_name(static_cast<int>(t)),
+                                      scene.textures[t], error)) {
+      return false;
+    }
+  }
+  std::string bytes;
+  data["geometry_file"] = "geometry.bin";
+  data["geometry"]["object"] = append_geometry(bytes, studio.object, 0, object_materials);
+  data["geometry"]["studio"] = append_geometry(bytes, studio.studio, object_materials,
+                                               total_materials - object_materials);
+  if (!backends::write_file_atomically(dir / "geometry.bin", bytes, error)) return false;
+
+  json lights = json::array();
+  for (size_t l = 0; l < scene.studio.lights.size(); ++l) {
+    lights.push_back(light_json(scene.studio.lights[l], static_cast<int>(l)));
+  }
+  data["lights"] = lights;
+
+  // OpenCV camera (+Y down, +Z forward) to Blender's (+Y up, looking down -Z).
+  const ir::Mat4 flip = Eigen::Vector4d(1, -1, -1, 1).asDiagonal();
+  json shots = json::array();
+  for (const auto& shot : scene.shots) {
+    // The turntable turns the object about the world Z axis through the table top.
+    const ir::Mat4 world_from_object = ir::world_from_object(scene, shot.turntable_angle_rad);
+    shots.push_back({{"name", shot.name},
+                     {"index", shot.index},
+                     {"camera_matrix", matrix_rows(shot.world_from_camera * flip)},
+                     {"focus_distance", shot.focus_distance_m},
+                     {"object_location", vec3(world_from_object.block<3, 1>(0, 3))},
+                     {"angle", std::atan2(world_from_object(1, 0), world_from_object(0, 0))},
+                     {"velocity", shot.turntable_velocity_rad_s},
+                     {"motion_blur", camera.effects.motion_blur}});
+  }
+  data["shots"] = shots;
+  return backends::write_file_atomically(dir / "scene.py", script_text(data), error);
+}
+
+bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
+                            double scale, int samples, const fs::path& log_path,
+                            RenderedShot* out, std::string* error) {
+  const std::string stem = shot.name;
+  std::error_code ec;
+  fs::remove(dir / (stem + ".exr"), ec);
+  fs::remove(dir / (stem + "_mask.exr"), ec);
+  std::vector<std::string> argv = {"blender",     "-b",         "--factory-startup", "-noaudio",
+                                   "--python-exit-code", "2", "--python",          "scene.py",
+                                   "--",          "--shot",     std::to_string(shot.index)};
+  if (samples > 0) {
+    argv.push_back("--samples");
+    argv.push_back(std::to_string(samples));
+  }
+  const reference::ProgramResult result = reference::run_program(argv, dir, log_path);
+  if (!result.started) {
+    *error = result.error;
+    return false;
+  }
+  if (result.exit_code != 0) {
+    *error = fmt::format("blender failed with exit code {}", result.exit_code);
+    return false;
+  }
+  const dslr::RenderGeometry canvas = dslr::render_geometry_for(scene.camera, scale);
+  reference::LinearImage image, mask;
+  if (!reference::read_linear_image(dir / (stem + ".exr"), &image, error) ||
+      !reference::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) {
+    return false;
+  }
+  if (image.width != canvas.width || image.height != canvas.height ||
+      mask.width != canvas.width || mask.height != canvas.height || mask.alpha.empty()) {
+    *error = fmt::format("Blender wrote {} x {} images, expected {} x {} with alpha", image.width,
+                         image.height, canvas.width, canvas.height);
+    return false;
+  }
+  dslr::LinearFrame& frame = out->frame;
+  frame.width = canvas.width;
+  frame.height = canvas.height;
+  frame.fx = canvas.fx;
+  frame.fy = canvas.fy;
+  frame.cx = canvas.cx;
+  frame.cy = canvas.cy;
+  frame.rgb = std::move(image.rgb);
+  for (float& v : frame.rgb) v *= static_cast<float>(reference::kCandelaPerBlenderUnit);
+  frame.mask.resize(mask.alpha.size());
+  for (size_t i = 0; i < mask.alpha.size(); ++i) frame.mask[i] = mask.alpha[i] >= 0.5f ? 255 : 0;
+  out->depth_of_field_rendered = scene.camera.effects.depth_of_field;
+  out->subframes = 1;
+  return true;
+}
+
+}  // namespace
+
+std::unique_ptr<reference::Renderer> make_renderer() { return std::make_unique<CyclesRenderer>(); }
+
+bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
+          int samples) {
+  return CyclesRenderer::emit_files(scene, dir, scale, samples, error);
+}
+
+int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
+        std::vector<ShotTiming>* timings) {
+  CyclesRenderer renderer;
+  return reference::run_reference(scene, options, renderer, log, timings);
+}
+
+}  // namespace rigc::cycles

@@ -1,0 +1,500 @@
+#include "backends/povray/povray_backend.h"
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <ostream>
+#include <regex>
+
+#include "backends/common/files.h"
+#include "backends/preview/preview_backend.h"
+#include "backends/preview/studio_scene.h"
+#include "backends/reference/process.h"
+#include "backends/reference/script_text.h"
+#include "dslr/lens.h"
+
+namespace rigc::povray {
+
+// POV-Ray 3.7 jitters the ray origin over a disc whose diameter is `aperture` scene units, so
+// the pupil diameter f/N maps one to one (PovrayDepthOfField checks the blur of a render
+// against the thin-lens circle of confusion).
+const double kApertureMetersPerPupilDiameter = 1.0;
+
+namespace {
+
+namespace fs = std::filesystem;
+using reference::number_text;
+using reference::RenderedShot;
+
+constexpr double kPi = std::numbers::pi;
+// fade_distance of every local light: POV's 2/(1 + (d/D)²) is 2D²/d² to 1e-6 beyond 1 m·1e-3.
+constexpr double kFadeDistance = 1e-3;
+constexpr int kMaxSubframes = 16;
+
+std::string vec(const Eigen::Vector3d& v) {
+  return fmt::format("<{}, {}, {}>", number_text(v.x()), number_text(v.y()), number_text(v.z()));
+}
+std::string vec(const Eigen::Vector3f& v) { return vec(Eigen::Vector3d(v.cast<double>())); }
+
+// POV's `matrix` keyword for a column-vector affine transform: its rows are our columns.
+std::string pov_matrix(const ir::Mat4& m) {
+  return fmt::format("matrix <{}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}>",
+                     number_text(m(0, 0)), number_text(m(1, 0)), number_text(m(2, 0)),
+                     number_text(m(0, 1)), number_text(m(1, 1)), number_text(m(2, 1)),
+                     number_text(m(0, 2)), number_text(m(1, 2)), number_text(m(2, 2)),
+                     number_text(m(0, 3)), number_text(m(1, 3)), number_text(m(2, 3)));
+}
+
+std::string material_identifier(int index) { return fmt::format("RigcMaterial{}", index); }
+std::string texture_file_name(int material) { return fmt::format("material_{}.png", material); }
+
+// The texture times the base colour, in linear light, as a 16-bit PNG read with gamma 1:
+// POV-Ray has no way to multiply an image_map by a colour.
+bool write_baked_texture(const fs::path& path, const ir::Texture& texture,
+                         const Eigen::Vector3f& base_color, std::string* error) {
+  const int channels = 3;
+  std::vector<std::uint16_t> pixels(static_cast<size_t>(texture.width) * texture.height * 3);
+  std::array<float, 256> decode{};
+  for (int i = 0; i < 256; ++i) {
+    const float c = i / 255.0f;
+    decode[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  }
+  for (size_t i = 0; i < static_cast<size_t>(texture.width) * texture.height; ++i) {
+    const std::uint8_t* px = &texture.pixels[i * texture.channels];
+    for (int c = 0; c < channels; ++c) {
+      const float value = decode[px[texture.channels >= 3 ? c : 0]] * base_color[c];
+      pixels[i * 3 + c] =
+          static_cast<std::uint16_t>(std::lround(std::clamp(value, 0.0f, 1.0f) * 65535));
+    }
+  }
+  auto output = OIIO::ImageOutput::create(path.string());
+  OIIO::ImageSpec spec(texture.width, texture.height, channels, OIIO::TypeDesc::UINT16);
+  spec.attribute("oiio:ColorSpace", "Linear");
+  if (!output || !output->open(path.string(), spec) ||
+      !output->write_image(OIIO::TypeDesc::UINT16, pixels.data()) || !output->close()) {
+    *error = fmt::format("cannot write the texture '{}'", path.string());
+    return false;
+  }
+  return true;
+}
+
+std::string pigment_text(const preview::ShadedMaterial& material, int index, bool is_object) {
+  const Eigen::Vector3f base = material.base_color;
+  if (material.texture >= 0) {
+    return fmt::format("uv_mapping image_map {{ png {} gamma 1.0 interpolate 2 }}",
+                       *reference::pov_string_literal(texture_file_name(index)));
+  }
+  const ir::SurfacePattern& pattern = material.pattern;
+  if (!is_object || pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
+    return "rgb " + vec(base);
+  }
+  const Eigen::Vector3f dark = base * static_cast<float>(1 - pattern.contrast);
+  const std::string scale = number_text(pattern.scale_m);
+  switch (pattern.kind) {
+    case ir::PatternKind::kSpeckle:
+      // Dark blotches on about 40 % of the surface, as the preview's speckle: POV's noise is
+      // centred on 0.5, so the step sits a little above it.
+      return fmt::format(
+          "bozo color_map {{ [0 rgb {0}] [0.52 rgb {0}] [0.57 rgb {1}] [1 rgb {1}] }} scale {2}",
+          vec(base), vec(dark), scale);
+    case ir::PatternKind::kNoise:
+      return fmt::format("bozo color_map {{ [0 rgb {}] [1 rgb {}] }} scale {}", vec(base),
+                         vec(dark), scale);
+    case ir::PatternKind::kChecker:
+      return fmt::format("checker rgb {}, rgb {} scale {}", vec(base), vec(dark), scale);
+    case ir::PatternKind::kNone: break;
+  }
+  return "rgb " + vec(base);
+}
+
+// The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) scaled by
+// 1 - F0 as the preview's (1 - Fresnel), and a normalised Blinn-Phong highlight of the same
+// peak as its GGX lobe.
+std::string finish_text(const preview::ShadedMaterial& material) {
+  const double metallic = material.metallic;
+  const double f0 = 0.04 * (1 - metallic) + metallic;
+  const double alpha = std::max(static_cast<double>(material.roughness) * material.roughness, 0.05);
+  const double exponent = std::max(2 / (alpha * alpha) - 2, 1.0);
+  const double specular = f0 * (exponent + 8) / 8;
+  return fmt::format(
+      "finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
+      number_text(1 - metallic), number_text((1 - f0) * (1 - metallic)), number_text(specular),
+      number_text(1 / exponent), metallic > 0.5 ? " metallic" : "");
+}
+
+void append_mesh2(fmt::memory_buffer& out, const std::string& name, const preview::Geometry& g,
+                  const std::vector<int>& triangles, int material_offset, int material_count) {
+  fmt::format_to(std::back_inserter(out), "#declare {} = mesh2 {{\n  vertex_vectors {{ {}", name,
+                 g.positions.size());
+  for (const auto& p : g.positions) {
+    fmt::format_to(std::back_inserter(out), ",\n    <{:.7g}, {:.7g}, {:.7g}>", p.x(), p.y(), p.z());
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  normal_vectors {{ {}", g.normals.size());
+  for (const auto& n : g.normals) {
+    fmt::format_to(std::back_inserter(out), ",\n    <{:.6g}, {:.6g}, {:.6g}>", n.x(), n.y(), n.z());
+  }
+  // RigC's v is 0 at the image top; POV's image_map has v = 0 at the bottom.
+  fmt::format_to(std::back_inserter(out), " }}\n  uv_vectors {{ {}", g.uvs.size());
+  for (const auto& uv : g.uvs) {
+    fmt::format_to(std::back_inserter(out), ",\n    <{:.7g}, {:.7g}>", uv.x(), 1 - uv.y());
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  texture_list {{ {}", material_count);
+  for (int m = 0; m < material_count; ++m) {
+    fmt::format_to(std::back_inserter(out), ",\n    texture {{ {} }}",
+                   material_identifier(material_offset + m));
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  face_indices {{ {}", triangles.size());
+  for (int t : triangles) {
+    const auto& tri = g.triangles[t];
+    const int material =
+        std::clamp(g.triangle_material[t] - material_offset, 0, std::max(0, material_count - 1));
+    fmt::format_to(std::back_inserter(out), ",\n    <{}, {}, {}>, {}", tri[0], tri[1], tri[2],
+                   material);
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n}}\n");
+}
+
+std::string light_text(const ir::Light& light) {
+  const Eigen::Vector3d color = light.color;
+  const double to_colour = 1 / (kPi * 2 * kFadeDistance * kFadeDistance);
+  const std::string fade = fmt::format("fade_distance {} fade_power 2", number_text(kFadeDistance));
+  switch (light.type) {
+    case ir::LightType::kDirectional: {
+      const Eigen::Vector3d dir = light.direction.normalized();
+      const Eigen::Vector3d center(0, 0, 1);
+      return fmt::format("light_source {{ {}, rgb {} parallel point_at {} }}\n",
+                         vec(Eigen::Vector3d(center - dir * 50)),
+                         vec(Eigen::Vector3d(color * light.illuminance_lx /
+                                             reference::kCandelaPerBlenderUnit / kPi)),
+                         vec(center));
+    }
+    case ir::LightType::kPoint:
+      return fmt::format("light_source {{ {}, rgb {} {} }}\n", vec(light.position),
+                         vec(Eigen::Vector3d(color * light.power_w / (4 * kPi) * to_colour)), fade);
+    case ir::LightType::kSpot: {
+      const double half_deg = light.spot_angle_rad / 2 * 180 / kPi;
+      return fmt::format(
+          "light_source {{ {}, rgb {} {} spotlight point_at {} radius {} falloff {} tightness 0 "
+          "}}\n",
+          vec(light.position), vec(Eigen::Vector3d(color * light.power_w / (4 * kPi) * to_colour)),
+          fade, vec(Eigen::Vector3d(light.position + light.direction)),
+          number_text(half_deg * (1 - light.spot_blend)), number_text(half_deg));
+    }
+    case ir::LightType::kArea: {
+      const Eigen::Vector3d dir = light.direction.normalized();
+      Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(dir);
+      if (across.norm() < 1e-6) across = Eigen::Vector3d::UnitX();
+      across.normalize();
+      const Eigen::Vector3d along = dir.cross(across).normalized();
+      const int cells = 5;
+      // A Lambertian panel of power P: intensity P/π·cos θ, one-sided (the spotlight's cos).
+      return fmt::format(
+          "light_source {{ {}, rgb {} {} spotlight point_at {} radius 90 falloff 90 tightness 1\n"
+          "  area_light {}, {}, {}, {} adaptive 1 }}\n",
+          vec(light.position), vec(Eigen::Vector3d(color * light.power_w / kPi * to_colour)),
+          fade, vec(Eigen::Vector3d(light.position + dir)),
+          vec(Eigen::Vector3d(across * std::max(light.size_m.x(), 1e-4))),
+          vec(Eigen::Vector3d(along * std::max(light.size_m.y(), 1e-4))), cells, cells);
+    }
+  }
+  return "";
+}
+
+int antialias_depth(int samples) {
+  if (samples <= 0) return 3;
+  return std::clamp(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(samples)))), 1, 9);
+}
+
+int subframes_for(const ir::Scene& scene, const preview::StudioScene& studio, const ir::Shot& shot,
+                  double scale) {
+  return std::clamp(preview::motion_blur_subframes(scene, studio, shot, scale), 1, kMaxSubframes);
+}
+
+std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::Intrinsics& canvas,
+                     int subframes, int samples) {
+  const ir::Camera& camera = scene.camera;
+  const Eigen::Matrix3d rotation = shot.world_from_camera.block<3, 3>(0, 0);
+  const Eigen::Vector3d eye = shot.world_from_camera.block<3, 1>(0, 3);
+  const Eigen::Vector3d right = rotation.col(0), down = rotation.col(1), forward = rotation.col(2);
+  // Ray = direction + x·right + y·up for x, y in [-1/2, 1/2]: the pinhole of the canvas, with
+  // its principal point (pixel centres at +0.5, as POV-Ray traces them).
+  const Eigen::Vector3d direction = forward + (canvas.width / 2.0 - canvas.cx) / canvas.fx * right +
+                                    (canvas.height / 2.0 - canvas.cy) / canvas.fy * down;
+  const double horizontal_fov_deg = 2 * std::atan(canvas.width / (2 * canvas.fx)) * 180 / kPi;
+  std::string text = fmt::format(
+      "// RigC shot {} of scene '{}'. Render with: povray {}.ini\n"
+      "#version 3.7;\n#include \"scene.inc\"\n\n"
+      "// Horizontal field of view {:.4f} deg, {} x {} px.\n"
+      "camera {{\n  perspective\n  location {}\n  direction {}\n  right {}\n  up {}\n",
+      reference::comment_text(shot.name), reference::comment_text(scene.name),
+      reference::comment_text(shot.name), horizontal_fov_deg, canvas.width, canvas.height,
+      vec(eye), vec(direction), vec(Eigen::Vector3d(right * (canvas.width / canvas.fx))),
+      vec(Eigen::Vector3d(-down * (canvas.height / canvas.fy))));
+  if (camera.effects.depth_of_field) {
+    const double pupil = camera.focal_length_m / camera.aperture_f_number;
+    text += fmt::format(
+        "  #if (!RIGC_MASK)\n  // f/{:.3g}: pupil diameter {:.3f} mm\n  aperture {}\n"
+        "  focal_point {}\n  blur_samples {}, {}\n  confidence 0.95\n  variance 1/2000\n"
+        "  #end\n",
+        camera.aperture_f_number, pupil * 1000,
+        number_text(pupil * kApertureMetersPerPupilDiameter),
+        vec(Eigen::Vector3d(eye + forward * shot.focus_distance_m)),
+        std::max(8, samples / 2), std::max(32, samples));
+  }
+  text += "}\n\n";
+  const double sweep = subframes > 1 ? shot.turntable_velocity_rad_s * camera.shutter_s : 0;
+  text += fmt::format(
+      "// Motion blur: {} sub-frames spread over the open shutter (the turntable turns {} rad).\n"
+      "#declare RigcSubframes = {};\n"
+      "#if (RigcSubframes > 1 & !RIGC_MASK)\n"
+      "  #declare RigcDelta = {} * ((frame_number - 0.5) / RigcSubframes - 0.5);\n"
+      "#else\n  #declare RigcDelta = 0;\n#end\n"
+      "object {{ RigcObject\n"
+      "  matrix <cos(RigcDelta), sin(RigcDelta), 0, -sin(RigcDelta), cos(RigcDelta), 0, 0, 0, 1, "
+      "0, 0, 0>\n  {}\n}}\nobject {{ RigcStudio }}\n",
+      subframes, number_text(sweep), subframes, number_text(sweep),
+      pov_matrix(ir::world_from_object(scene, shot.turntable_angle_rad)));
+  return text;
+}
+
+std::string shot_ini(const ir::Shot& shot, const dslr::Intrinsics& canvas, int subframes,
+                     int samples, bool mask) {
+  const std::string stem = shot.name;
+  std::string text = fmt::format(
+      "; RigC: the {} of {}. Run: povray {}{}.ini\n"
+      "Input_File_Name={}.pov\n",
+      mask ? "object mask" : "image", stem, stem, mask ? "_mask" : "", stem);
+  if (mask) {
+    text += fmt::format("Declare=RIGC_MASK=1\nOutput_File_Name={}_mask.exr\n", stem);
+  } else if (subframes > 1) {
+    text += fmt::format(
+        "Output_File_Name={}_f.exr\nInitial_Frame=1\nFinal_Frame={}\nInitial_Clock=0\n"
+        "Final_Clock=1\n",
+        stem, subframes);
+  } else {
+    text += fmt::format("Output_File_Name={}.exr\n", stem);
+  }
+  text += fmt::format(
+      "Output_File_Type=E\nOutput_Alpha=off\nWidth={}\nHeight={}\n"
+      "Antialias=on\nSampling_Method=1\nAntialias_Threshold=0.0\nAntialias_Depth={}\n"
+      "Jitter=off\nDisplay=off\nPause_When_Done=off\nVerbose=off\n",
+      canvas.width, canvas.height, mask ? 3 : antialias_depth(samples));
+  return text;
+}
+
+bool write_text_file(const fs::path& path, const std::string& text, std::string* error) {
+  return backends::write_file_atomically(path, text, error);
+}
+
+class PovrayRenderer : public reference::Renderer {
+ public:
+  std::string name() const override { return "povray"; }
+  std::string executable() const override { return "povray"; }
+  std::string package() const override { return "povray"; }
+
+  bool emit(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
+            std::string* error) override {
+    return emit_files(scene, dir, scale, samples, &subframes_, error);
+  }
+
+  bool render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot, double scale,
+              int samples, const fs::path& log_path, RenderedShot* out,
+              std::string* error) override;
+
+  static bool emit_files(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
+                         std::vector<int>* subframes, std::string* error);
+
+ private:
+  std::vector<int> subframes_;  // per shot index, from the last emit
+};
+
+bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
+                                int samples, std::vector<int>* subframes, std::string* error) {
+  if (!(scale > 0) || !std::isfinite(scale)) {
+    *error = "the render scale must be a positive number";
+    return false;
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) {
+    *error = fmt::format("cannot create the folder '{}'", dir.string());
+    return false;
+  }
+  for (const auto& shot : scene.shots) {
+    if (!reference::is_plain_file_stem(shot.name)) {
+      *error = fmt::format("shot name '{}' cannot be a file name",
+                           reference::comment_text(shot.name));
+      return false;
+    }
+  }
+  const preview::StudioScene studio = preview::prepare_studio_scene(scene);
+  const int object_materials = static_cast<int>(scene.materials.size());
+  const int total_materials = static_cast<int>(studio.materials.size());
+
+  fmt::memory_buffer inc;
+  auto out = std::back_inserter(inc);
+  fmt::format_to(out,
+                 "// RigC POV-Ray scene '{}' (from {}; object {}).\n"
+                 "// World frame: +Z up, floor at z = 0, metres. Colours are linear; light is in "
+                 "Blender's units (1 = 683 cd/m2).\n"
+                 "#version 3.7;\n#ifndef (RIGC_MASK)\n  #declare RIGC_MASK = 0;\n#end\n\n",
+                 reference::comment_text(scene.name), reference::comment_text(scene.source_file),
+                 reference::comment_text(scene.object.source));
+  const double ambient = scene.studio.ambient_lx / reference::kCandelaPerBlenderUnit / kPi;
+  fmt::format_to(out,
+                 "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 5\n"
+                 "  #if (RIGC_MASK)\n    ambient_light rgb 1\n  #else\n    ambient_light rgb {}\n"
+                 "  #end\n}}\n\n",
+                 number_text(ambient));
+  for (int m = 0; m < total_materials; ++m) {
+    const preview::ShadedMaterial& material = studio.materials[m];
+    const bool is_object = m < object_materials;
+    if (material.texture >= 0) {
+      if (material.texture >= static_cast<int>(scene.textures.size()) ||
+          !write_baked_texture(dir / texture_file_name(m), scene.textures[material.texture],
+                               material.base_color, error)) {
+        if (error->empty()) *error = "a material refers to a missing texture";
+        return false;
+      }
+    }
+    fmt::format_to(out,
+                   "#declare {} =\n#if (RIGC_MASK)\n"
+                   "  texture {{ pigment {{ rgb {} }} finish {{ ambient 1 diffuse 0 }} }}\n"
+                   "#else\n  texture {{\n    pigment {{ {} }}\n    {}\n  }}\n#end\n",
+                   material_identifier(m), is_object ? 1 : 0,
+                   pigment_text(material, m, is_object), finish_text(material));
+  }
+  inc.push_back('\n');
+  std::vector<int> object_triangles(studio.object.triangles.size());
+  for (size_t t = 0; t < object_triangles.size(); ++t) object_triangles[t] = static_cast<int>(t);
+  append_mesh2(inc, "RigcObject", studio.object, object_triangles, 0, object_materials);
+  std::vector<int> studio_triangles(studio.studio.triangles.size());
+  for (size_t t = 0; t < studio_triangles.size(); ++t) studio_triangles[t] = static_cast<int>(t);
+  append_mesh2(inc, "RigcStudio", studio.studio, studio_triangles, object_materials,
+               total_materials - object_materials);
+  fmt::format_to(out, "\n#if (!RIGC_MASK)\n");
+  for (const auto& light : scene.studio.lights) fmt::format_to(out, "{}", light_text(light));
+  fmt::format_to(out, "#end\n");
+  if (!write_text_file(dir / "scene.inc", fmt::to_string(inc), error)) return false;
+
+  const dslr::Intrinsics canvas = dslr::render_geometry_for(scene.camera, scale);
+  subframes->assign(scene.shots.size(), 1);
+  for (const auto& shot : scene.shots) {
+    const int count = subframes_for(scene, studio, shot, scale);
+    (*subframes)[shot.index] = count;
+    if (!write_text_file(dir / (shot.name + ".pov"),
+                         shot_pov(scene, shot, canvas, count, samples), error) ||
+        !write_text_file(dir / (shot.name + ".ini"),
+                         shot_ini(shot, canvas, count, samples, false), error) ||
+        !write_text_file(dir / (shot.name + "_mask.ini"),
+                         shot_ini(shot, canvas, count, samples, true), error)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool run_povray(const fs::path& dir, const std::string& ini, const fs::path& log_path,
+                std::string* error) {
+  const reference::ProgramResult result = reference::run_program({"povray", ini}, dir, log_path);
+  if (!result.started) {
+    *error = result.error;
+    return false;
+  }
+  if (result.exit_code != 0) {
+    *error = fmt::format("povray {} failed with exit code {}", ini, result.exit_code);
+    return false;
+  }
+  return true;
+}
+
+bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
+                            double scale, int /*samples*/, const fs::path& log_path,
+                            RenderedShot* out, std::string* error) {
+  const std::string stem = shot.name;
+  const int subframes =
+      shot.index < static_cast<int>(subframes_.size()) ? subframes_[shot.index] : 1;
+  // Outputs of an earlier run must not pass for this one's.
+  const std::regex frame_pattern(stem + "_f[0-9]+\\.exr");
+  std::error_code ec;
+  std::vector<fs::path> stale = {dir / (stem + ".exr"), dir / (stem + "_mask.exr")};
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (std::regex_match(entry.path().filename().string(), frame_pattern)) {
+      stale.push_back(entry.path());
+    }
+  }
+  for (const auto& path : stale) fs::remove(path, ec);
+
+  if (!run_povray(dir, stem + ".ini", log_path, error) ||
+      !run_povray(dir, stem + "_mask.ini", log_path, error)) {
+    return false;
+  }
+  std::vector<fs::path> frames;
+  if (subframes > 1) {
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      if (std::regex_match(entry.path().filename().string(), frame_pattern)) {
+        frames.push_back(entry.path());
+      }
+    }
+    if (static_cast<int>(frames.size()) != subframes) {
+      *error = fmt::format("povray wrote {} of {} sub-frames", frames.size(), subframes);
+      return false;
+    }
+  } else {
+    frames.push_back(dir / (stem + ".exr"));
+  }
+  const dslr::RenderGeometry canvas = dslr::render_geometry_for(scene.camera, scale);
+  dslr::LinearFrame& frame = out->frame;
+  frame.width = canvas.width;
+  frame.height = canvas.height;
+  frame.fx = canvas.fx;
+  frame.fy = canvas.fy;
+  frame.cx = canvas.cx;
+  frame.cy = canvas.cy;
+  const size_t pixels = static_cast<size_t>(canvas.width) * canvas.height;
+  frame.rgb.assign(pixels * 3, 0.0f);
+  for (const auto& path : frames) {
+    reference::LinearImage image;
+    if (!reference::read_linear_image(path, &image, error)) return false;
+    if (image.width != canvas.width || image.height != canvas.height) {
+      *error = fmt::format("{} is {} x {}, expected {} x {}", path.filename().string(),
+                           image.width, image.height, canvas.width, canvas.height);
+      return false;
+    }
+    const float weight = static_cast<float>(reference::kCandelaPerBlenderUnit / frames.size());
+    for (size_t i = 0; i < frame.rgb.size(); ++i) frame.rgb[i] += image.rgb[i] * weight;
+  }
+  reference::LinearImage mask;
+  if (!reference::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) return false;
+  if (mask.width != canvas.width || mask.height != canvas.height) {
+    *error = "the mask render has the wrong size";
+    return false;
+  }
+  frame.mask.resize(pixels);
+  // Half or more of the pixel's samples on the object, as the preview decides.
+  for (size_t i = 0; i < pixels; ++i) frame.mask[i] = mask.rgb[i * 3 + 1] >= 0.5f ? 255 : 0;
+  out->depth_of_field_rendered = scene.camera.effects.depth_of_field;
+  out->subframes = subframes;
+  return true;
+}
+
+}  // namespace
+
+std::unique_ptr<reference::Renderer> make_renderer() { return std::make_unique<PovrayRenderer>(); }
+
+bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
+          int samples) {
+  std::vector<int> subframes;
+  return PovrayRenderer::emit_files(scene, dir, scale, samples, &subframes, error);
+}
+
+int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
+        std::vector<ShotTiming>* timings) {
+  PovrayRenderer renderer;
+  return reference::run_reference(scene, options, renderer, log, timings);
+}
+
+}  // namespace rigc::povray

@@ -1,0 +1,187 @@
+#include "eval/colmap.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+extern char** environ;
+
+namespace rigc::eval {
+
+namespace fs = std::filesystem;
+
+int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::string* error) {
+  if (argv.empty()) {
+    *error = "no program to run";
+    return -1;
+  }
+  {
+    std::ofstream header(log, std::ios::app);
+    if (!header) {
+      *error = fmt::format("cannot write the log {}", log.string());
+      return -1;
+    }
+    header << "$";
+    for (const auto& a : argv) header << " " << a;
+    header << "\n";
+  }
+  std::vector<std::string> env_strings;
+  bool has_qt = false;
+  for (char** e = environ; *e; ++e) {
+    env_strings.emplace_back(*e);
+    if (std::strncmp(*e, "QT_QPA_PLATFORM=", 16) == 0) has_qt = true;
+  }
+  if (!has_qt) env_strings.emplace_back("QT_QPA_PLATFORM=offscreen");
+  std::vector<char*> envp;
+  for (auto& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
+  std::vector<std::string> args = argv;
+  std::vector<char*> cargv;
+  for (auto& a : args) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, cargv[0], &actions, nullptr, cargv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    *error = fmt::format("cannot run {}: {}", argv[0], std::strerror(rc));
+    return -1;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      *error = fmt::format("waiting for {} failed: {}", argv[0], std::strerror(errno));
+      return -1;
+    }
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return -1;
+}
+
+namespace {
+
+std::string read_all(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+std::optional<ColmapFlags> probe_colmap(const std::string& executable, const fs::path& log_dir,
+                                        std::string* error) {
+  ColmapFlags flags;
+  const fs::path log = log_dir / "colmap_probe.log";
+  std::error_code ec;
+  fs::remove(log, ec);
+  std::string why;
+  int rc = run_logged({executable, "feature_extractor", "-h"}, log, &why);
+  if (rc < 0) {
+    *error = fmt::format("COLMAP is not available ({}); install Debian's colmap package "
+                         "(scripts/setup.sh) or pass --colmap PATH",
+                         why);
+    return std::nullopt;
+  }
+  std::string text = read_all(log);
+  if (text.find("SiftExtraction.use_gpu") != std::string::npos) {
+    flags.extraction_gpu = "--SiftExtraction.use_gpu";
+  } else if (text.find("FeatureExtraction.use_gpu") != std::string::npos) {
+    flags.extraction_gpu = "--FeatureExtraction.use_gpu";
+  } else if (text.find("ImageReader") == std::string::npos) {
+    *error = fmt::format("`{} feature_extractor -h` does not look like COLMAP (exit {}); see {}",
+                         executable, rc, log.string());
+    return std::nullopt;
+  }
+  fs::remove(log, ec);
+  rc = run_logged({executable, "exhaustive_matcher", "-h"}, log, &why);
+  text = read_all(log);
+  if (text.find("SiftMatching.use_gpu") != std::string::npos) {
+    flags.matching_gpu = "--SiftMatching.use_gpu";
+  } else if (text.find("FeatureMatching.use_gpu") != std::string::npos) {
+    flags.matching_gpu = "--FeatureMatching.use_gpu";
+  }
+  fs::remove(log, ec);
+  run_logged({executable, "-h"}, log, &why);
+  std::istringstream lines(read_all(log));
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("COLMAP", 0) == 0) {
+      flags.version = line;
+      break;
+    }
+  }
+  return flags;
+}
+
+double SparseModel::mean_track_length() const {
+  if (points.empty()) return 0;
+  double sum = 0;
+  for (const auto& p : points) sum += static_cast<double>(p.track_images.size());
+  return sum / static_cast<double>(points.size());
+}
+
+double SparseModel::mean_reprojection_error() const {
+  double sum = 0, weight = 0;
+  for (const auto& p : points) {
+    const double w = static_cast<double>(p.track_images.size());
+    sum += p.error * w;
+    weight += w;
+  }
+  return weight > 0 ? sum / weight : 0;
+}
+
+std::optional<std::vector<Point3D>> read_colmap_points(const fs::path& path, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = fmt::format("{}: cannot read", path.string());
+    return std::nullopt;
+  }
+  std::vector<Point3D> points;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    Point3D p;
+    if (!(s >> p.id >> p.position.x() >> p.position.y() >> p.position.z() >> p.rgb[0] >>
+          p.rgb[1] >> p.rgb[2] >> p.error)) {
+      *error = fmt::format("{}:{}: malformed point line", path.string(), number);
+      return std::nullopt;
+    }
+    int image = 0, index = 0;
+    while (s >> image >> index) p.track_images.push_back(image);
+    points.push_back(std::move(p));
+  }
+  return points;
+}
+
+std::optional<SparseModel> read_sparse_model(const fs::path& dir, std::string* error) {
+  SparseModel model;
+  auto cameras = backends::read_colmap_cameras(dir / "cameras.txt", error);
+  if (!cameras) return std::nullopt;
+  auto images = backends::read_colmap_images(dir / "images.txt", error);
+  if (!images) return std::nullopt;
+  auto points = read_colmap_points(dir / "points3D.txt", error);
+  if (!points) return std::nullopt;
+  model.cameras = std::move(*cameras);
+  model.images = std::move(*images);
+  model.points = std::move(*points);
+  return model;
+}
+
+}  // namespace rigc::eval

@@ -1,0 +1,61 @@
+// `rigc eval` and `rigc compare` (issue #6): reconstruct an image set with COLMAP (CPU), align the
+// result to the ground truth, and measure it the way the paper's Table 1 did, plus Tanks and
+// Temples' F-score and camera errors.
+//
+// Output folder (default RUN_DIR/eval):
+//   eval.json                    every number, the files and the COLMAP steps with their logs
+//   cloud_signed_distance.ply    reconstructed points (object frame, m) coloured by signed distance
+//   histogram.png, heatmap.png   the distances as a bar chart and over the ground-truth surface
+//   colmap/                      database, masks, models; logs/*.log: each COLMAP step's output
+#pragma once
+
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rigc::eval {
+
+struct EvalOptions {
+  std::string run_dir;        // a run folder (images/, sparse/, manifest.json) ...
+  std::string photos_dir;     // ... or a folder of photos (no ground-truth poses)
+  std::string ground_truth;   // mesh file (its own frame); default: the run's scene object
+  std::string scene;          // scene file; default: manifest.json's inputs.source_file
+  std::string output_dir;     // default: RUN_DIR/eval (PHOTOS_DIR/eval)
+  std::string colmap = "colmap";
+  std::string matcher = "auto";  // auto, exhaustive, sequential
+  bool use_masks = true;         // the run's masks/ (what a green screen gives)
+  bool refine_intrinsics = false;  // let COLMAP refine a known (ground-truth) intrinsics prior
+  bool reuse_colmap = false;     // skip COLMAP when the output folder has its model already
+  bool icp = true;
+  bool poisson = false;  // also mesh the points (Open3D's screened Poisson) and compare the mesh
+  int poisson_depth = 9;
+  double tau_mm = 1.0;               // F-score threshold
+  int ground_truth_samples = 200000; // surface samples before the visibility test
+  double color_range_mm = 0;         // heat-map colour range; 0 = 3 x RMS of the distances
+  bool quiet = false;
+};
+
+// The headline numbers (all of them are in `report`, which is eval.json).
+struct EvalSummary {
+  bool reconstructed = false;
+  std::string failure;  // why there are no numbers
+  int images = 0, registered = 0;
+  long points = 0;
+  double mean_mm = 0, std_mm = 0, fscore = 0;
+  double colmap_s = 0, rigc_s = 0;
+  std::string output_dir, heatmap_png, histogram_png;
+  nlohmann::json report;
+};
+
+// Runs the whole evaluation, progress and errors to `log`. Returns 0, 1 (user error: bad
+// folder, no ground truth) or 2 (COLMAP missing or failing, or no reconstruction; the message
+// names the log).
+int evaluate(const EvalOptions& options, std::ostream& log, EvalSummary* summary);
+
+// The verbs; args[0] is the program name ("rigc eval"). 0 ok, 1 user error, 2 external failure.
+int run_eval_command(std::vector<std::string> args);
+int run_compare_command(std::vector<std::string> args);
+
+}  // namespace rigc::eval
