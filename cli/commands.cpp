@@ -9,6 +9,9 @@
 
 #include <unistd.h>
 
+#include "analysis/advice.h"
+#include "analysis/coverage.h"
+#include "analysis/coverage_output.h"
 #include "backends/common/shots.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
@@ -79,12 +82,22 @@ int run_check(std::vector<std::string> args) {
   std::string scene_path;
   bool json = false;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  bool no_advice = false;
   app.add_flag("--json", json, "print diagnostics and a summary as JSON");
+  app.add_flag("--no-advice", no_advice, "skip the capture advice (coverage, focus, exposure)");
   if (auto code = parse_options(app, args)) return *code;
 
   DiagnosticEngine diag;
   if (json) diag.set_handler([](const Diagnostic&, const std::string&) {});
   auto scene = compile_scene_file(scene_path, diag);
+  if (scene && !no_advice) {
+    // Capture advice from a coverage analysis at reduced resolution (about 700 px across).
+    const preview::StudioScene studio = preview::prepare_studio_scene(*scene);
+    analysis::CoverageOptions options;
+    options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
+    const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
+    analysis::report_capture_advice(*scene, studio, coverage, diag);
+  }
   if (json) {
     nlohmann::json out{{"ok", scene.has_value()}, {"diagnostics", diagnostics_json(diag)}};
     if (scene) out["scene"] = ir_to_json(*scene, false);
@@ -176,6 +189,40 @@ int run_render(std::vector<std::string> args) {
   return preview::run_preview(*scene, options, std::cerr);
 }
 
+int run_coverage(std::vector<std::string> args) {
+  CLI::App app{"Which faces each shot sees, whether SfM can use them, and pictures of it."};
+  std::string scene_path, output;
+  int picture_width = 960;
+  double visibility_scale = 0;
+  app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  app.add_option("-o,--output", output, "output folder (default: out/<scene>/coverage)");
+  app.add_option("--picture-width", picture_width, "width of the pictures in pixels")
+      ->check(CLI::Range(64, 8192))
+      ->capture_default_str();
+  app.add_option("--visibility-scale", visibility_scale,
+                 "resolution of the visibility buffers relative to the sensor (0: ~1400 px)")
+      ->check(CLI::Range(0.0, 1.0));
+  if (auto code = parse_options(app, args)) return *code;
+
+  DiagnosticEngine diag;
+  auto scene = compile_scene_file(scene_path, diag);
+  if (!scene) return kExitUserError;
+  if (output.empty()) output = (fs::path("out") / scene->name / "coverage").string();
+  const preview::StudioScene studio = preview::prepare_studio_scene(*scene);
+  analysis::CoverageOptions options;
+  options.visibility_scale = visibility_scale;
+  const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
+  analysis::report_capture_advice(*scene, studio, coverage, diag);
+  std::string error;
+  if (!analysis::write_coverage_outputs(*scene, studio, coverage, output, picture_width, &error)) {
+    std::cerr << "rigc: error: " << error << '\n';
+    return kExitUserError;
+  }
+  analysis::print_coverage_table(*scene, coverage, std::cout);
+  std::cout << fmt::format("coverage of '{}' in {}\n", scene->name, output);
+  return kExitOk;
+}
+
 int run_version(std::vector<std::string> args) {
   CLI::App app{"Print the version of rigc and of the scene language."};
   if (auto code = parse_options(app, args)) return *code;
@@ -190,6 +237,7 @@ const std::vector<Command>& commands() {
       {"check", "check a scene and report errors and capture warnings", run_check},
       {"compile", "compile a scene to a target (ir)", run_compile},
       {"render", "render every shot with a backend (preview)", run_render},
+      {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
       {"version", "print the version", run_version},
   };
   return table;

@@ -160,26 +160,37 @@ TEST(Frontend, OrbitRingsExpandAroundTheObject) {
   Compiled compiled = compile_repo_file("scenes/multi-ring.yaml");
   ASSERT_TRUE(compiled.scene) << compiled.diagnostics;
   const ir::Scene& scene = *compiled.scene;
-  ASSERT_EQ(scene.shots.size(), 16u + 12u + 6u + 2u);
+  ASSERT_EQ(scene.shots.size(), 16u + 12u + 2u + 6u);
   const ir::Vec3 center =
       (ir::world_from_object(scene, 0) *
        ((scene.object.bounds_min_object + scene.object.bounds_max_object) / 2).homogeneous())
           .head<3>();
-  for (int i = 0; i < 34; ++i) {
-    const ir::Shot& shot = scene.shots[i];
+  int orbit_shots = 0;
+  for (const auto& shot : scene.shots) {
     const ir::Vec3 eye = shot.world_from_camera.block<3, 1>(0, 3);
-    EXPECT_NEAR((eye - center).norm(), 1.2, 1e-9) << shot.name;
-    // Every camera looks at the centre.
-    const ir::Vec3 forward = shot.world_from_camera.block<3, 1>(0, 2);
-    EXPECT_GT(forward.dot((center - eye).normalized()), 1 - 1e-9);
+    // Every camera looks at its aim; orbit cameras stand 1.2 m from the object's centre.
+    if (shot.kind == ir::ShotKind::kOrbit) {
+      ++orbit_shots;
+      EXPECT_NEAR((eye - center).norm(), 1.2, 1e-9) << shot.name;
+      const ir::Vec3 forward = shot.world_from_camera.block<3, 1>(0, 2);
+      EXPECT_GT(forward.dot((center - eye).normalized()), 1 - 1e-9);
+    }
     // Rotation is orthonormal and right-handed.
     const Eigen::Matrix3d r = shot.world_from_camera.block<3, 3>(0, 0);
     EXPECT_TRUE((r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-9));
     EXPECT_NEAR(r.determinant(), 1, 1e-9);
   }
+  EXPECT_EQ(orbit_shots, 34);
+  EXPECT_EQ(scene.shots[28].kind, ir::ShotKind::kPose);
   const double elevation_ring3 =
-      std::asin((scene.shots[28].world_from_camera(2, 3) - center.z()) / 1.2);
+      std::asin((scene.shots[30].world_from_camera(2, 3) - center.z()) / 1.2);
   EXPECT_NEAR(elevation_ring3, 65 * kDeg, 1e-9);
+  // The detail shot looks at the point it names.
+  const ir::Shot& detail = scene.shots[29];
+  const ir::Vec3 to_target =
+      (ir::Vec3(0, 0, 0.9) - detail.world_from_camera.block<3, 1>(0, 3)).normalized();
+  const double alignment = detail.world_from_camera.block<3, 1>(0, 2).dot(to_target);
+  EXPECT_GT(alignment, 1 - 1e-9);
 }
 
 TEST(Frontend, BareNumbersTakeDocumentedUnits) {

@@ -177,7 +177,7 @@ struct Camera {
 struct CoverageSettings {
   double min_pixels_per_mm2 = 1.0;        // image resolution on the surface
   double max_view_angle_rad = 1.3089969389957472;    // 75 deg between normal and view ray
-  double max_blur_px = 2.0;               // circle of confusion, in pixels, still "in focus"
+  double max_blur_px = 0;  // circle of confusion still "in focus", pixels; 0: diagonal/1500
   double min_triangulation_angle_rad = 0.08726646259971647;  // 5 deg between two usable views
   double min_signal = 0.02;               // normalised signal below: too dark (noise)
   double max_signal = 0.98;               // above: clipped

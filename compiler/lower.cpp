@@ -220,6 +220,11 @@ void Lowering::lower_camera() {
   camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
   camera.cx = camera.width_px / 2.0;
   camera.cy = camera.height_px / 2.0;
+  // The photographer's acceptable circle of confusion unless the scene sets its own.
+  if (scene_.coverage.max_blur_px <= 0) {
+    scene_.coverage.max_blur_px =
+        camera.circle_of_confusion_m / (camera.sensor_width_m / camera.width_px);
+  }
 }
 
 void Lowering::lower_lights() {

@@ -10,7 +10,9 @@
 
 namespace rigc::dslr {
 
-ir::Vec3 blackbody_rgb(double kelvin) { return blackbody_linear_srgb(kelvin); }
+ir::Vec3 blackbody_rgb(double kelvin) {
+  return blackbody_linear_srgb(kelvin);
+}
 
 std::array<double, 3> white_balance_gains(const ir::Camera& camera,
                                           const std::vector<float>& linear,
@@ -68,7 +70,8 @@ const std::vector<std::uint16_t>& srgb_table(int bits) {
     const int size = 1 << index_bits;
     std::vector<std::uint16_t> table(size);
     for (int i = 0; i < size; ++i) {
-      table[i] = static_cast<std::uint16_t>(std::lround(srgb_oetf(double(i) / (size - 1)) * out_max));
+      table[i] =
+          static_cast<std::uint16_t>(std::lround(srgb_oetf(double(i) / (size - 1)) * out_max));
     }
     return table;
   };

@@ -12,7 +12,9 @@ namespace {
 using testing::canon_6d;
 using testing::flat_frame;
 
-double luminance(const ir::Vec3& c) { return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z(); }
+double luminance(const ir::Vec3& c) {
+  return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
+}
 
 TEST(DslrDevelop, BlackbodyIsNormalisedToLuminanceOne) {
   for (double k : {2000.0, 3200.0, 5600.0, 6504.0, 10000.0}) {
@@ -51,7 +53,8 @@ DevelopResult white_under(const ir::Camera& camera, double kelvin, bool mask_gre
       const bool object = x < frame.width / 2;
       const ir::Vec3 albedo = object ? ir::Vec3(0.8, 0.8, 0.8) : ir::Vec3(0.0, 0.69, 0.25);
       frame.mask[p] = object ? 255 : 0;
-      for (int c = 0; c < 3; ++c) frame.rgb[3 * p + c] = static_cast<float>(800 * albedo[c] * light[c]);
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * p + c] = static_cast<float>(800 * albedo[c] * light[c]);
     }
   }
   if (!mask_green_background) frame.mask.clear();
@@ -85,8 +88,8 @@ TEST(DslrDevelop, AutoWhiteBalanceUsesTheObjectMask) {
   expect_neutral_object(white_under(camera, 3200, true));
   // Without the mask the green screen pulls the grey world towards magenta.
   const DevelopResult unmasked = white_under(camera, 3200, false);
-  const std::size_t p = 3 * (static_cast<std::size_t>(unmasked.height / 2) * unmasked.width +
-                             unmasked.width / 4);
+  const std::size_t p =
+      3 * (static_cast<std::size_t>(unmasked.height / 2) * unmasked.width + unmasked.width / 4);
   EXPECT_GT(unmasked.encoded[p] + unmasked.encoded[p + 2], 2 * unmasked.encoded[p + 1] + 20);
 }
 

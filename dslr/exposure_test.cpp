@@ -50,8 +50,8 @@ TEST(DslrExposure, MeteredAverageLandsAtTheReflectedLightConstant) {
   // A meter (K = 12.5) sets N²/t = L·ISO/K, which gives v = K·q/78 whatever L is.
   ir::Camera camera = canon_6d();
   const double luminance = 250;
-  camera.shutter_s = camera.aperture_f_number * camera.aperture_f_number * 12.5 /
-                     (luminance * camera.iso);
+  camera.shutter_s =
+      camera.aperture_f_number * camera.aperture_f_number * 12.5 / (luminance * camera.iso);
   EXPECT_NEAR(exposure_scale(camera) * luminance, 12.5 * 0.65 / 78, 1e-9);
 }
 

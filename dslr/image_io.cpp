@@ -1,8 +1,7 @@
 #include "dslr/image_io.h"
 
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cmath>
@@ -68,7 +67,8 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
                        eight_bits ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   spec.attribute("oiio:ColorSpace", "sRGB");
   if (jpeg) {
-    spec.attribute("Compression", "jpeg:" + std::to_string(std::clamp(camera.jpeg_quality, 1, 100)));
+    spec.attribute("Compression",
+                   "jpeg:" + std::to_string(std::clamp(camera.jpeg_quality, 1, 100)));
   }
   spec.attribute("Make", camera.make);
   spec.attribute("Model", camera.model);
@@ -96,8 +96,8 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
     std::vector<std::uint8_t> pixels(values);
     const int shift = result.bits == 8 ? 0 : 1;
     for (std::size_t i = 0; i < values; ++i) {
-      pixels[i] = static_cast<std::uint8_t>(
-          shift ? (result.encoded[i] * 255u + 32767u) / 65535u : result.encoded[i]);
+      pixels[i] = static_cast<std::uint8_t>(shift ? (result.encoded[i] * 255u + 32767u) / 65535u
+                                                  : result.encoded[i]);
     }
     return write_atomically(path, spec, pixels.data(), error);
   }

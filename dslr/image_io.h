@@ -21,7 +21,7 @@ bool write_image(const std::filesystem::path& path, const DevelopResult& result,
                  const ir::Camera& camera, std::string* error);
 
 // Writes an 8-bit single-channel PNG (0/255) atomically.
-bool write_mask(const std::filesystem::path& path, const std::vector<std::uint8_t>& mask,
-                int width, int height, std::string* error);
+bool write_mask(const std::filesystem::path& path, const std::vector<std::uint8_t>& mask, int width,
+                int height, std::string* error);
 
 }  // namespace rigc::dslr

@@ -1,8 +1,7 @@
 #include "dslr/image_io.h"
 
-#include <gtest/gtest.h>
-
 #include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
 
 #include "dslr/pipeline.h"
 #include "dslr/test_helpers.h"

@@ -15,11 +15,10 @@ Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale) {
   k.height = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
   const double sx = static_cast<double>(k.width) / camera.width_px;
   const double sy = static_cast<double>(k.height) / camera.height_px;
-  const double fx = camera.fx > 0 ? camera.fx
-                                  : camera.focal_length_m * camera.width_px / camera.sensor_width_m;
-  const double fy = camera.fy > 0
-                        ? camera.fy
-                        : camera.focal_length_m * camera.height_px / camera.sensor_height_m;
+  const double fx =
+      camera.fx > 0 ? camera.fx : camera.focal_length_m * camera.width_px / camera.sensor_width_m;
+  const double fy =
+      camera.fy > 0 ? camera.fy : camera.focal_length_m * camera.height_px / camera.sensor_height_m;
   k.fx = fx * sx;
   k.fy = fy * sy;
   k.cx = (camera.cx > 0 ? camera.cx : camera.width_px / 2.0) * sx;
@@ -123,7 +122,7 @@ RenderGeometry render_geometry_for(const ir::Camera& camera, double scale) {
 
 double vignetting_gain(double fraction_lost, double r2, double r2_corner) {
   if (fraction_lost <= 0 || r2_corner <= 0) return 1;
-  auto cos4 = [](double q) { return 1 / (1 + q); };
+  auto cos4 = [](double q) { return 1 / ((1 + q) * (1 + q)); };
   return 1 - fraction_lost * (1 - cos4(r2)) / (1 - cos4(r2_corner));
 }
 
@@ -136,37 +135,41 @@ constexpr int kMapStep = 8;
 
 struct CanvasMap {
   int nodes_x = 0, nodes_y = 0;
-  std::vector<double> u, v;   // canvas index-space position (pixel centres at integers)
-  std::vector<char> valid;    // false beyond the fold of the lens
+  std::vector<double> u, v;  // canvas index-space position (pixel centres at integers)
+  std::vector<double> gain;  // vignetting
+  std::vector<char> valid;   // false beyond the fold of the lens
 
   std::size_t node(int a, int b) const { return static_cast<std::size_t>(b) * nodes_x + a; }
 };
 
-CanvasMap build_canvas_map(const ir::Distortion& distortion, bool distort, const Intrinsics& sensor,
-                           const Intrinsics& canvas) {
+CanvasMap build_canvas_map(const ir::Distortion& distortion, bool distort, double vignetting,
+                           double r2_corner, const Intrinsics& sensor, const Intrinsics& canvas) {
   CanvasMap map;
   map.nodes_x = sensor.width / kMapStep + 2;
   map.nodes_y = sensor.height / kMapStep + 2;
   const std::size_t n = static_cast<std::size_t>(map.nodes_x) * map.nodes_y;
   map.u.resize(n);
   map.v.resize(n);
+  map.gain.resize(n);
   map.valid.resize(n);
-  tbb::parallel_for(tbb::blocked_range<int>(0, map.nodes_y), [&](const tbb::blocked_range<int>& rows) {
-    for (int b = rows.begin(); b < rows.end(); ++b) {
-      const double yd = (b * kMapStep - sensor.cy) / sensor.fy;
-      ir::Vec2 guess(0, yd);
-      for (int a = 0; a < map.nodes_x; ++a) {
-        const double xd = (a * kMapStep - sensor.cx) / sensor.fx;
-        ir::Vec2 xu(xd, yd);
-        const bool ok = !distort || try_undistort_normalized(distortion, xd, yd, &xu, &guess);
-        if (ok) guess = xu;
-        const std::size_t k = map.node(a, b);
-        map.valid[k] = ok;
-        map.u[k] = canvas.fx * xu.x() + canvas.cx - 0.5;
-        map.v[k] = canvas.fy * xu.y() + canvas.cy - 0.5;
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, map.nodes_y), [&](const tbb::blocked_range<int>& rows) {
+        for (int b = rows.begin(); b < rows.end(); ++b) {
+          const double yd = (b * kMapStep - sensor.cy) / sensor.fy;
+          ir::Vec2 guess(0, yd);
+          for (int a = 0; a < map.nodes_x; ++a) {
+            const double xd = (a * kMapStep - sensor.cx) / sensor.fx;
+            ir::Vec2 xu(xd, yd);
+            const bool ok = !distort || try_undistort_normalized(distortion, xd, yd, &xu, &guess);
+            if (ok) guess = xu;
+            const std::size_t k = map.node(a, b);
+            map.valid[k] = ok;
+            map.u[k] = canvas.fx * xu.x() + canvas.cx - 0.5;
+            map.v[k] = canvas.fy * xu.y() + canvas.cy - 0.5;
+            map.gain[k] = vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner);
+          }
+        }
+      });
   return map;
 }
 
@@ -193,8 +196,7 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
   if (has_mask) out.mask.resize(n);
 
   const bool distort = camera.effects.distortion && !camera.distortion.is_zero();
-  const double vignetting =
-      camera.effects.vignetting ? std::clamp(camera.vignetting, 0.0, 1.0) : 0;
+  const double vignetting = camera.effects.vignetting ? std::clamp(camera.vignetting, 0.0, 1.0) : 0;
   double r2_corner = 0;
   for (double u : {0.0, double(sensor.width)}) {
     for (double v : {0.0, double(sensor.height)}) {
@@ -203,90 +205,95 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
     }
   }
   const bool copy = !distort && same_grid(sensor, canvas);
-  const CanvasMap map = copy ? CanvasMap{} : build_canvas_map(camera.distortion, distort, sensor, canvas);
   const int cw = canvas.width, ch = canvas.height;
+  if (copy) {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, sensor.height), [&](const tbb::blocked_range<int>& rows) {
+          for (int j = rows.begin(); j < rows.end(); ++j) {
+            const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
+            const std::size_t row = static_cast<std::size_t>(j) * sensor.width;
+            for (int i = 0; i < sensor.width; ++i) {
+              const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
+              const float gain = vignetting > 0 ? static_cast<float>(vignetting_gain(
+                                                      vignetting, xd * xd + yd * yd, r2_corner))
+                                                : 1.0f;
+              for (int c = 0; c < 3; ++c)
+                out.rgb[3 * (row + i) + c] = rgb[3 * (row + i) + c] * gain;
+            }
+            if (has_depth) std::copy_n(&depth_m[row], sensor.width, &out.depth_m[row]);
+            if (has_mask) std::copy_n(&mask[row], sensor.width, &out.mask[row]);
+          }
+        });
+    return out;
+  }
 
-  auto gain_at = [&](int i, double yd) {
-    if (vignetting <= 0) return 1.0f;
-    const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
-    return static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner));
-  };
-  // Exact position for pixels next to the fold, where the grid cannot be interpolated.
-  auto solve = [&](int i, int j, double* uc, double* vc) {
-    ir::Vec2 xu;
-    if (!try_undistort_normalized(camera.distortion, (i + 0.5 - sensor.cx) / sensor.fx,
-                                  (j + 0.5 - sensor.cy) / sensor.fy, &xu)) {
-      return false;
-    }
-    *uc = canvas.fx * xu.x() + canvas.cx - 0.5;
-    *vc = canvas.fy * xu.y() + canvas.cy - 0.5;
-    return true;
-  };
-
-  tbb::parallel_for(tbb::blocked_range<int>(0, sensor.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int j = rows.begin(); j < rows.end(); ++j) {
-      const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
-      const std::size_t row = static_cast<std::size_t>(j) * sensor.width;
-      if (copy) {
-        for (int i = 0; i < sensor.width; ++i) {
-          const float gain = gain_at(i, yd);
-          for (int c = 0; c < 3; ++c) out.rgb[3 * (row + i) + c] = rgb[3 * (row + i) + c] * gain;
+  const CanvasMap map =
+      build_canvas_map(camera.distortion, distort, vignetting, r2_corner, sensor, canvas);
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, sensor.height), [&](const tbb::blocked_range<int>& rows) {
+        // The map interpolated to this row, node by node.
+        std::vector<float> row_u(map.nodes_x), row_v(map.nodes_x), row_gain(map.nodes_x);
+        std::vector<char> row_valid(map.nodes_x);
+        for (int j = rows.begin(); j < rows.end(); ++j) {
+          const std::size_t row = static_cast<std::size_t>(j) * sensor.width;
+          const double gy = (j + 0.5) / kMapStep;
+          const int b = static_cast<int>(gy);
+          const double tb = gy - b;
+          for (int a = 0; a < map.nodes_x; ++a) {
+            const std::size_t k0 = map.node(a, b), k1 = k0 + map.nodes_x;
+            row_u[a] = static_cast<float>((1 - tb) * map.u[k0] + tb * map.u[k1]);
+            row_v[a] = static_cast<float>((1 - tb) * map.v[k0] + tb * map.v[k1]);
+            row_gain[a] = static_cast<float>((1 - tb) * map.gain[k0] + tb * map.gain[k1]);
+            row_valid[a] = map.valid[k0] && map.valid[k1];
+          }
+          for (int i = 0; i < sensor.width; ++i) {
+            const std::size_t o = row + i;
+            const int a = i / kMapStep;
+            const float ta = (i - a * kMapStep + 0.5f) / kMapStep;
+            float uc, vc, gain;
+            if (row_valid[a] && row_valid[a + 1]) {
+              uc = row_u[a] + ta * (row_u[a + 1] - row_u[a]);
+              vc = row_v[a] + ta * (row_v[a + 1] - row_v[a]);
+              gain = row_gain[a] + ta * (row_gain[a + 1] - row_gain[a]);
+            } else {
+              // Next to the fold the grid cannot be interpolated: solve this pixel exactly.
+              const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
+              const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
+              ir::Vec2 xu;
+              if (!try_undistort_normalized(camera.distortion, xd, yd, &xu)) {
+                for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] = 0;  // no light arrives here
+                if (has_depth) out.depth_m[o] = std::numeric_limits<float>::infinity();
+                if (has_mask) out.mask[o] = 0;
+                continue;
+              }
+              uc = static_cast<float>(canvas.fx * xu.x() + canvas.cx - 0.5);
+              vc = static_cast<float>(canvas.fy * xu.y() + canvas.cy - 0.5);
+              gain = static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner));
+            }
+            const float fu = std::floor(uc), fv = std::floor(vc);
+            const float au = uc - fu, av = vc - fv;
+            const int iu = static_cast<int>(fu), iv = static_cast<int>(fv);
+            const int i0 = std::clamp(iu, 0, cw - 1), i1 = std::clamp(iu + 1, 0, cw - 1);
+            const int j0 = std::clamp(iv, 0, ch - 1), j1 = std::clamp(iv + 1, 0, ch - 1);
+            const float* p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
+            const float* p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
+            const float* p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
+            const float* p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
+            for (int c = 0; c < 3; ++c) {
+              const float top = p00[c] + au * (p10[c] - p00[c]);
+              const float bottom = p01[c] + au * (p11[c] - p01[c]);
+              out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
+            }
+            if (has_depth || has_mask) {
+              const int ni = std::clamp(iu + (au >= 0.5f), 0, cw - 1);
+              const int nj = std::clamp(iv + (av >= 0.5f), 0, ch - 1);
+              const std::size_t s = static_cast<std::size_t>(nj) * cw + ni;
+              if (has_depth) out.depth_m[o] = depth_m[s];
+              if (has_mask) out.mask[o] = mask[s];
+            }
+          }
         }
-        if (has_depth) std::copy_n(&depth_m[row], sensor.width, &out.depth_m[row]);
-        if (has_mask) std::copy_n(&mask[row], sensor.width, &out.mask[row]);
-        continue;
-      }
-      const double gy = (j + 0.5) / kMapStep;
-      const int b = static_cast<int>(gy);
-      const double tb = gy - b;
-      for (int i = 0; i < sensor.width; ++i) {
-        const std::size_t o = row + i;
-        const double gx = (i + 0.5) / kMapStep;
-        const int a = static_cast<int>(gx);
-        const double ta = gx - a;
-        const std::size_t k00 = map.node(a, b), k10 = k00 + 1, k01 = k00 + map.nodes_x,
-                          k11 = k01 + 1;
-        double uc, vc;
-        bool ok = true;
-        if (map.valid[k00] && map.valid[k10] && map.valid[k01] && map.valid[k11]) {
-          uc = (1 - tb) * ((1 - ta) * map.u[k00] + ta * map.u[k10]) +
-               tb * ((1 - ta) * map.u[k01] + ta * map.u[k11]);
-          vc = (1 - tb) * ((1 - ta) * map.v[k00] + ta * map.v[k10]) +
-               tb * ((1 - ta) * map.v[k01] + ta * map.v[k11]);
-        } else {
-          ok = solve(i, j, &uc, &vc);
-        }
-        if (!ok) {  // beyond the fold of the lens: no light arrives here
-          for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] = 0;
-          if (has_depth) out.depth_m[o] = std::numeric_limits<float>::infinity();
-          if (has_mask) out.mask[o] = 0;
-          continue;
-        }
-        const float gain = gain_at(i, yd);
-        const double fu = std::floor(uc), fv = std::floor(vc);
-        const float au = static_cast<float>(uc - fu), av = static_cast<float>(vc - fv);
-        const int iu = static_cast<int>(fu), iv = static_cast<int>(fv);
-        const int i0 = std::clamp(iu, 0, cw - 1), i1 = std::clamp(iu + 1, 0, cw - 1);
-        const int j0 = std::clamp(iv, 0, ch - 1), j1 = std::clamp(iv + 1, 0, ch - 1);
-        const float* p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
-        const float* p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
-        const float* p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
-        const float* p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
-        for (int c = 0; c < 3; ++c) {
-          const float top = p00[c] + au * (p10[c] - p00[c]);
-          const float bottom = p01[c] + au * (p11[c] - p01[c]);
-          out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
-        }
-        if (has_depth || has_mask) {
-          const int ni = std::clamp(static_cast<int>(std::floor(uc + 0.5)), 0, cw - 1);
-          const int nj = std::clamp(static_cast<int>(std::floor(vc + 0.5)), 0, ch - 1);
-          const std::size_t s = static_cast<std::size_t>(nj) * cw + ni;
-          if (has_depth) out.depth_m[o] = depth_m[s];
-          if (has_mask) out.mask[o] = mask[s];
-        }
-      }
-    }
-  });
+      });
   return out;
 }
 

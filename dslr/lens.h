@@ -38,9 +38,9 @@ double vignetting_gain(double fraction_lost, double r2, double r2_corner);
 
 struct SensorImage {
   Intrinsics intrinsics;
-  std::vector<float> rgb;            // 3 per pixel
-  std::vector<float> depth_m;        // nearest sample; +inf where nothing maps
-  std::vector<std::uint8_t> mask;    // nearest sample; empty if the canvas has none
+  std::vector<float> rgb;          // 3 per pixel
+  std::vector<float> depth_m;      // nearest sample; +inf where nothing maps
+  std::vector<std::uint8_t> mask;  // nearest sample; empty if the canvas has none
 };
 
 // Resamples the canvas onto the sensor grid: for each sensor pixel, undistort its normalised
@@ -48,6 +48,7 @@ struct SensorImage {
 // vignetting. camera.effects.distortion / .vignetting switch the two effects.
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
-                           const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask);
+                           const std::vector<float>& depth_m,
+                           const std::vector<std::uint8_t>& mask);
 
 }  // namespace rigc::dslr

@@ -46,8 +46,8 @@ TEST(DslrDistortion, UndistortInvertsDistortOverTheImage) {
       ir::Vec2 u;
       ASSERT_TRUE(try_undistort_normalized(d, x, y, &u)) << x << "," << y;
       worst = std::max(worst, (distort_normalized(d, u.x(), u.y()) - ir::Vec2(x, y)).norm());
-      const ir::Vec2 back = undistort_normalized(d, distort_normalized(d, x, y).x(),
-                                                 distort_normalized(d, x, y).y());
+      const ir::Vec2 back =
+          undistort_normalized(d, distort_normalized(d, x, y).x(), distort_normalized(d, x, y).y());
       worst = std::max(worst, (back - ir::Vec2(x, y)).norm());
     }
   }
@@ -129,7 +129,8 @@ TEST(DslrDistortion, WarpedDotsLandWhereDistortSays) {
         const double dx = x + 0.5 - dot.x(), dy = y + 0.5 - dot.y();
         if (dx * dx + dy * dy < 36) value += std::exp(-(dx * dx + dy * dy) / (2 * 1.2 * 1.2));
       }
-      for (int c = 0; c < 3; ++c) frame.rgb[3 * (static_cast<std::size_t>(y) * g.width + x) + c] = 5000 * value;
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * (static_cast<std::size_t>(y) * g.width + x) + c] = 5000 * value;
     }
   }
   const DevelopResult r = develop_frame(camera, frame, {1, 0, 1}, scale);
@@ -137,8 +138,8 @@ TEST(DslrDistortion, WarpedDotsLandWhereDistortSays) {
   int checked = 0;
   double worst = 0;
   for (const ir::Vec2& dot : dots) {
-    const ir::Vec2 xd = distort_normalized(camera.distortion, (dot.x() - g.cx) / g.fx,
-                                           (dot.y() - g.cy) / g.fy);
+    const ir::Vec2 xd =
+        distort_normalized(camera.distortion, (dot.x() - g.cx) / g.fx, (dot.y() - g.cy) / g.fy);
     const double eu = s.fx * xd.x() + s.cx, ev = s.fy * xd.y() + s.cy;  // expected, continuous
     if (eu < 8 || ev < 8 || eu > s.width - 8 || ev > s.height - 8) continue;
     double sum = 0, su = 0, sv = 0;
@@ -163,7 +164,9 @@ TEST(DslrVignetting, CornersLoseTheConfiguredFraction) {
   const double scale = 0.1;
   const Intrinsics s = sensor_intrinsics(camera, scale);
   const DevelopResult r = develop_frame(camera, flat_frame(s, 500, 1.0f), {1, 0, 1}, scale);
-  auto at = [&](int x, int y) { return r.linear[3 * (static_cast<std::size_t>(y) * s.width + x) + 1]; };
+  auto at = [&](int x, int y) {
+    return r.linear[3 * (static_cast<std::size_t>(y) * s.width + x) + 1];
+  };
   const double centre = at(s.width / 2, s.height / 2);
   EXPECT_NEAR(at(0, 0) / centre, 0.6, 0.01);
   EXPECT_NEAR(at(s.width - 1, s.height - 1) / centre, 0.6, 0.01);

@@ -134,13 +134,16 @@ struct GroupSums {
 // One row of kLanes neighbouring pixels against taps [0, tap_count): the loads for a tap are
 // contiguous, so this vectorises. AVX2 where the CPU has it, SSE otherwise.
 __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes& pl,
-                                                                     const TapSet& set,
-                                                                     int tap_count, std::size_t i,
-                                                                     GroupSums& s) {
+                                                                    const TapSet& set,
+                                                                    int tap_count, std::size_t i,
+                                                                    GroupSums& s) {
   const Floats zp = load(&pl.z[i]), rp = load(&pl.radius[i]);
   const Floats z_front = zp * (1 - kSameDepth), z_back = zp * (1 + kSameDepth);
   const Floats zero = {};
-  s = GroupSums{};
+  // Locals rather than s's members, so the accumulators can stay in registers.
+  Floats wf_sum = zero, ws_sum = zero, wb_sum = zero;
+  Floats fr = zero, fg = zero, fb = zero, sr = zero, sg = zero, sb = zero, br = zero, bg = zero,
+         bb = zero;
   for (int t = 0; t < tap_count; ++t) {
     const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
     const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
@@ -149,20 +152,20 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
     const Floats w_disc = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
     // Behind: seen only through p's own disc, so a sharp p never picks it up.
     const Floats w_behind = area * clamp01((rp - d) * inv_soft + 0.5f);
-    const auto front = zq < z_front, behind = zq > z_back;
+    const auto front = zq<z_front, behind = zq> z_back;
     const Floats wf = front ? w_disc : zero;
     const Floats wb = behind ? w_behind : zero;
     const Floats ws = (front | behind) ? zero : w_disc;
-    const Floats c[3] = {load(&pl.r[q]), load(&pl.g[q]), load(&pl.b[q])};
-    s.wf += wf;
-    s.ws += ws;
-    s.wb += wb;
-    for (int k = 0; k < 3; ++k) {
-      s.front[k] += wf * c[k];
-      s.same[k] += ws * c[k];
-      s.behind[k] += wb * c[k];
-    }
+    const Floats r = load(&pl.r[q]), g = load(&pl.g[q]), b = load(&pl.b[q]);
+    wf_sum += wf, ws_sum += ws, wb_sum += wb;
+    fr += wf * r, fg += wf * g, fb += wf * b;
+    sr += ws * r, sg += ws * g, sb += ws * b;
+    br += wb * r, bg += wb * g, bb += wb * b;
   }
+  s.wf = wf_sum, s.ws = ws_sum, s.wb = wb_sum;
+  s.front[0] = fr, s.front[1] = fg, s.front[2] = fb;
+  s.same[0] = sr, s.same[1] = sg, s.same[2] = sb;
+  s.behind[0] = br, s.behind[1] = bg, s.behind[2] = bb;
 }
 
 // Front-to-back compositing of the three layers for one pixel (lane).
@@ -191,11 +194,15 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
     std::copy(rgb.begin(), rgb.end(), out.begin());
     return;
   }
-  const double px_per_m = canvas.fx / f;  // sensor metres to canvas pixels
+  // The thin-lens radius in canvas pixels, factored as K·|1 - S1/z| (K: the radius at infinity)
+  // so the per-pixel cost is one division; z = +inf gives K.
+  const float radius_at_infinity = static_cast<float>(
+      0.5 * coc_diameter_m(f, f_number, focus_distance_m, std::numeric_limits<double>::infinity()) *
+      canvas.fx / f);
+  const float focus = static_cast<float>(focus_distance_m);
   auto radius_at = [&](float z) {
-    return static_cast<float>(std::clamp(
-        0.5 * coc_diameter_m(f, f_number, focus_distance_m, z) * px_per_m, 0.5,
-        static_cast<double>(kMaxCocRadiusPx)));
+    return std::clamp(radius_at_infinity * std::abs(1 - focus / z), 0.5f,
+                      static_cast<float>(kMaxCocRadiusPx));
   };
 
   // Largest disc per tile, then the largest disc reaching each tile.
@@ -324,34 +331,50 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
   const int radius = static_cast<int>(std::ceil(3 * sigma));
   std::vector<float> kernel(2 * radius + 1);
   double sum = 0;
-  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  for (int k = -radius; k <= radius; ++k)
+    sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
   for (float& k : kernel) k = static_cast<float>(k / sum);
   const int w = canvas.width, h = canvas.height;
   scratch.resize(rgb.size());
+  // Horizontal: on interleaved rows a tap k is an offset of 3k values, so the interior is one
+  // contiguous multiply-add per tap; only the first and last `radius` pixels clamp.
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
       const float* row = &rgb[3 * static_cast<std::size_t>(y) * w];
       float* dst = &scratch[3 * static_cast<std::size_t>(y) * w];
-      for (int x = 0; x < w; ++x) {
+      const int inner_begin = std::min(w, radius), inner_end = std::max(inner_begin, w - radius);
+      for (int i = 3 * inner_begin; i < 3 * inner_end; ++i) dst[i] = 0;
+      for (int k = -radius; k <= radius; ++k) {
+        const float kw = kernel[k + radius];
+        const float* src = row + 3 * k;
+        for (int i = 3 * inner_begin; i < 3 * inner_end; ++i) dst[i] += kw * src[i];
+      }
+      auto clamped = [&](int x) {
         float acc[3] = {0, 0, 0};
         for (int k = -radius; k <= radius; ++k) {
           const int xs = std::clamp(x + k, 0, w - 1);
-          const float kw = kernel[k + radius];
-          for (int c = 0; c < 3; ++c) acc[c] += kw * row[3 * xs + c];
+          for (int c = 0; c < 3; ++c) acc[c] += kernel[k + radius] * row[3 * xs + c];
         }
         for (int c = 0; c < 3; ++c) dst[3 * x + c] = acc[c];
-      }
+      };
+      for (int x = 0; x < inner_begin; ++x) clamped(x);
+      for (int x = inner_end; x < w; ++x) clamped(x);
     }
   });
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
       float* dst = &rgb[3 * static_cast<std::size_t>(y) * w];
-      for (int i = 0; i < 3 * w; ++i) dst[i] = 0;
-      for (int k = -radius; k <= radius; ++k) {
-        const int ys = std::clamp(y + k, 0, h - 1);
-        const float kw = kernel[k + radius];
-        const float* src = &scratch[3 * static_cast<std::size_t>(ys) * w];
-        for (int i = 0; i < 3 * w; ++i) dst[i] += kw * src[i];
+      // In chunks that stay in L1 while every tap row adds to them.
+      constexpr int kChunk = 2048;
+      for (int begin = 0; begin < 3 * w; begin += kChunk) {
+        const int end = std::min(3 * w, begin + kChunk);
+        std::fill(dst + begin, dst + end, 0.0f);
+        for (int k = -radius; k <= radius; ++k) {
+          const int ys = std::clamp(y + k, 0, h - 1);
+          const float kw = kernel[k + radius];
+          const float* src = &scratch[3 * static_cast<std::size_t>(ys) * w];
+          for (int i = begin; i < end; ++i) dst[i] += kw * src[i];
+        }
       }
     }
   });

@@ -60,7 +60,8 @@ EdgeScene step_edge(double f_number, double depth_m, double scale) {
   s.frame = flat_frame(sensor_intrinsics(s.camera, scale), 100, static_cast<float>(depth_m));
   for (int y = 0; y < s.frame.height; ++y) {
     for (int x = s.frame.width / 2; x < s.frame.width; ++x) {
-      for (int c = 0; c < 3; ++c) s.frame.rgb[3 * (static_cast<std::size_t>(y) * s.frame.width + x) + c] = 1000;
+      for (int c = 0; c < 3; ++c)
+        s.frame.rgb[3 * (static_cast<std::size_t>(y) * s.frame.width + x) + c] = 1000;
     }
   }
   return s;
@@ -114,9 +115,9 @@ void expect_disc_blur(double depth_m, double scale, double min_diameter_px) {
 
 TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
   EXPECT_NEAR(disc_10_90_width_over_diameter(), 0.687, 0.001);
-  expect_disc_blur(1.3, 0.125, 8);     // ~8.8 px: the dense taps
-  expect_disc_blur(3.0, 0.25, 30);     // ~33 px: the ring taps
-  expect_disc_blur(0.5, 0.125, 12);    // ~13.6 px, in front of the focus
+  expect_disc_blur(1.3, 0.125, 8);   // ~8.8 px: the dense taps
+  expect_disc_blur(3.0, 0.25, 30);   // ~33 px: the ring taps
+  expect_disc_blur(0.5, 0.125, 12);  // ~13.6 px, in front of the focus
 }
 
 TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {
@@ -217,7 +218,8 @@ double diffraction_edge_width(const ir::Camera& camera) {
   LinearFrame frame = flat_frame(sensor_intrinsics(camera, 1.0), 100, 1.0f);
   for (int y = 0; y < frame.height; ++y) {
     for (int x = frame.width / 2; x < frame.width; ++x) {
-      for (int c = 0; c < 3; ++c) frame.rgb[3 * (static_cast<std::size_t>(y) * frame.width + x) + c] = 300;
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * (static_cast<std::size_t>(y) * frame.width + x) + c] = 300;
     }
   }
   const DevelopResult r = develop_frame(camera, frame, {1, 0, 1}, 1.0);
@@ -227,7 +229,8 @@ double diffraction_edge_width(const ir::Camera& camera) {
 TEST(DslrDiffraction, GaussianWidthFollowsTheFNumber) {
   // σ = 0.42·λ·N: 14.8 µm at f/64 = 2.26 px of 6.54 µm; a Gaussian edge is 2.563·σ wide (10-90 %).
   const double sigma_px = 0.42 * 550e-9 * 64 / (0.0358 / 5472);
-  EXPECT_NEAR(diffraction_edge_width(small_sensor_camera(64)), 2.563 * sigma_px, 0.1 * 2.563 * sigma_px);
+  EXPECT_NEAR(diffraction_edge_width(small_sensor_camera(64)), 2.563 * sigma_px,
+              0.1 * 2.563 * sigma_px);
   EXPECT_NEAR(diffraction_sigma_m(8), 1.848e-6, 1e-9);
   // At f/2.8 σ is 0.1 px: skipped, the edge stays a step.
   EXPECT_LT(diffraction_edge_width(small_sensor_camera(2.8)), 1.0);

@@ -34,7 +34,8 @@ class StageClock {
 };
 
 std::string check_frame(const LinearFrame& frame) {
-  const std::size_t n = static_cast<std::size_t>(std::max(0, frame.width)) * std::max(0, frame.height);
+  const std::size_t n =
+      static_cast<std::size_t>(std::max(0, frame.width)) * std::max(0, frame.height);
   if (frame.width <= 0 || frame.height <= 0) return "the frame has no pixels";
   if (!(frame.fx > 0) || !(frame.fy > 0)) return "the frame has no focal length in pixels";
   if (frame.rgb.size() != 3 * n) {
@@ -69,7 +70,8 @@ DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
   const float exposure = static_cast<float>(exposure_scale(camera));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1 << 16),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i < r.end(); ++i) work[i] = frame.rgb[i] * exposure;
+                      for (std::size_t i = r.begin(); i < r.end(); ++i)
+                        work[i] = frame.rgb[i] * exposure;
                     });
   result.timings.exposure_ms = clock.lap_ms();
 

@@ -47,7 +47,8 @@ TEST(DslrNoise, ReadNoiseIsInterpolatedInLogIso) {
   const ir::SensorNoise n = canon_6d().noise;
   EXPECT_NEAR(read_noise_electrons(n, 100), n.read_noise_e, 1e-9);
   EXPECT_NEAR(read_noise_electrons(n, 6400), n.read_noise_high_iso_e, 1e-9);
-  EXPECT_NEAR(read_noise_electrons(n, 800), std::sqrt(n.read_noise_e * n.read_noise_high_iso_e), 1e-9);
+  EXPECT_NEAR(read_noise_electrons(n, 800), std::sqrt(n.read_noise_e * n.read_noise_high_iso_e),
+              1e-9);
   EXPECT_NEAR(read_noise_electrons(n, 25600), n.read_noise_high_iso_e, 1e-9);
   EXPECT_NEAR(electrons_at_clipping(n, 6400), 79546.0 / 64, 1e-9);
 }
@@ -61,7 +62,7 @@ void expect_patch_noise(double iso) {
   const double e = v * fwc + n.dark_current_e_per_s * camera.shutter_s;
   const double read = read_noise_electrons(n, iso);
   const double lsb = fwc / (std::pow(2.0, n.adc_bits) - 1);
-  const double expected = std::sqrt(e                                 // shot noise
+  const double expected = std::sqrt(e                                // shot noise
                                     + std::pow(n.prnu * v * fwc, 2)  // pixel gain (fixed)
                                     + read * read + n.dsnu_e * n.dsnu_e + lsb * lsb / 12);
   const Stats s = stats(flat_patch(camera, v).linear, fwc);
@@ -113,7 +114,8 @@ double correlation(const std::vector<float>& a, const std::vector<float>& b) {
   ma /= a.size(), mb /= b.size();
   double sab = 0, saa = 0, sbb = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    sab += (a[i] - ma) * (b[i] - mb), saa += (a[i] - ma) * (a[i] - ma), sbb += (b[i] - mb) * (b[i] - mb);
+    sab += (a[i] - ma) * (b[i] - mb), saa += (a[i] - ma) * (a[i] - ma),
+        sbb += (b[i] - mb) * (b[i] - mb);
   }
   return sab / std::sqrt(saa * sbb);
 }
@@ -155,10 +157,12 @@ LinearFrame busy_frame(const ir::Camera& camera, double scale) {
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * frame.width + x;
-      const bool object = std::hypot(x - frame.width / 2.0, y - frame.height / 2.0) < frame.height / 3.0;
+      const bool object =
+          std::hypot(x - frame.width / 2.0, y - frame.height / 2.0) < frame.height / 3.0;
       frame.depth_m[p] = object ? 0.8f + 0.001f * (x % 50) : 2.0f;
       frame.mask[p] = object ? 255 : 0;
-      for (int c = 0; c < 3; ++c) frame.rgb[3 * p + c] = 200.0f + 600.0f * ((x / 7 + y / 5 + c) % 3);
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * p + c] = 200.0f + 600.0f * ((x / 7 + y / 5 + c) % 3);
     }
   }
   return frame;

@@ -376,7 +376,7 @@ std::vector<double> nearest_distances(const std::vector<Vec3>& queries,
   if (cloud.empty()) {
     return std::vector<double>(queries.size(), std::numeric_limits<double>::infinity());
   }
-  const auto q = to_cloud(queries);
+  auto q = to_cloud(queries);
   const auto c = to_cloud(cloud);
   return q.ComputePointCloudDistance(c);
 }

@@ -56,8 +56,8 @@ struct Label {
 bool write_canvas(const fs::path& path, const Canvas& canvas, const std::vector<Label>& labels,
                   float text_grey, std::string* error) {
   OIIO::ImageSpec spec(canvas.width, canvas.height, 3, OIIO::TypeDesc::UINT8);
-  OIIO::ImageBuf buf(spec, const_cast<std::uint8_t*>(canvas.rgb.data()));
-  OIIO::ImageBuf copy = buf.copy();
+  OIIO::ImageBuf copy(spec);
+  copy.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::UINT8, canvas.rgb.data());
   const float colour[3] = {text_grey, text_grey, text_grey};
   for (const Label& l : labels) {
     // Needs a font (fonts-dejavu); without one the picture just has no text.

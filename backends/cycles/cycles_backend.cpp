@@ -272,9 +272,11 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
   std::error_code ec;
   fs::remove(dir / (stem + ".exr"), ec);
   fs::remove(dir / (stem + "_mask.exr"), ec);
-  std::vector<std::string> argv = {"blender",     "-b",         "--factory-startup", "-noaudio",
-                                   "--python-exit-code", "2", "--python",          "scene.py",
-                                   "--",          "--shot",     std::to_string(shot.index)};
+  // An absolute script path: Blender resolves relative ones against $PWD, not the working folder.
+  const std::string script = fs::absolute(dir / "scene.py").string();
+  std::vector<std::string> argv = {"blender",  "-b",     "--factory-startup", "-noaudio",
+                                   "--python-exit-code", "2", "--python", script,
+                                   "--",       "--shot", std::to_string(shot.index)};
   if (samples > 0) {
     argv.push_back("--samples");
     argv.push_back(std::to_string(samples));

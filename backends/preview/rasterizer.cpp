@@ -683,6 +683,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
 
 namespace rigc::preview {
 
+Eigen::Vector3f light_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
+                                  const Eigen::Vector3f& normal) {
+  LightSample sample;
+  if (!sample_light(light, light.color.cast<float>(), point, &sample)) return Vector3f::Zero();
+  return sample.illuminance * std::max(0.0f, normal.dot(sample.to_light));
+}
+
 VisibilityBuffer render_visibility(const ir::Scene& scene, const StudioScene& studio,
                                    const FrameRequest& request) {
   const FrameContext context(scene, studio, request);

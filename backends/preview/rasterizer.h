@@ -28,6 +28,11 @@ struct RasterTimings {
 dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio,
                                const FrameRequest& request, RasterTimings* timings = nullptr);
 
+// Illuminance (lux, per linear RGB channel) that a light casts on a surface point with normal n,
+// shadows ignored: the same radiometry the renderer shades with.
+Eigen::Vector3f light_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
+                                  const Eigen::Vector3f& normal);
+
 // Visibility only, one sample per pixel centre: the nearest object triangle (-1 where the studio
 // or nothing is seen) and the camera-space depth of whatever is nearest. For coverage analysis.
 struct VisibilityBuffer {

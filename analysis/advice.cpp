@@ -1,0 +1,157 @@
+#include "analysis/advice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "dslr/exposure.h"
+
+namespace rigc::analysis {
+namespace {
+
+constexpr double kWavelengthM = 550e-9;
+// Shares of the seen surface above which a problem is worth a warning.
+constexpr double kWarnShare = 0.05;
+
+const SourceLoc& first_known(const SourceLoc& a, const SourceLoc& b) {
+  return a.line > 0 ? a : b;
+}
+
+}  // namespace
+
+double next_standard_f_number(double f_number) {
+  static const double stops[] = {1.2, 1.4, 1.6, 1.8, 2,  2.2, 2.5, 2.8, 3.2, 3.5, 4,  4.5,
+                                 5,   5.6, 6.3, 7.1, 8,  9,   10,  11,  13,  14,  16, 18,
+                                 20,  22,  25,  29,  32, 36,  40,  45,  51,  57,  64};
+  for (double stop : stops) {
+    if (stop >= f_number * 0.999) return stop;
+  }
+  return 64;
+}
+
+void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& studio,
+                           const CoverageResult& coverage, DiagnosticEngine& diag) {
+  const ir::Camera& camera = scene.camera;
+  const ir::CoverageSettings& settings = scene.coverage;
+  const SourceLoc& aperture_loc = first_known(camera.aperture_loc, camera.loc);
+  const SourceLoc& shutter_loc = first_known(camera.shutter_loc, camera.loc);
+  const double pixel_pitch_m = camera.sensor_width_m / camera.width_px;
+  const double n = camera.aperture_f_number;
+
+  // Area-weighted means over all views.
+  double visible = 0, out_of_focus = 0, clipped = 0, dark = 0;
+  for (const auto& shot : coverage.shots) {
+    visible += shot.visible_area_m2;
+    out_of_focus += shot.out_of_focus * shot.visible_area_m2;
+    clipped += shot.clipped * shot.visible_area_m2;
+    dark += shot.too_dark * shot.visible_area_m2;
+  }
+  visible = std::max(visible, 1e-30);
+
+  // Depth of field: the blur scales as 1/N, so the aperture that keeps 95 % sharp follows.
+  const double needed_n = n * coverage.blur_ratio_95;
+  if (out_of_focus / visible > kWarnShare) {
+    diag.warning(aperture_loc,
+                 fmt::format("depth of field at f/{:g} is shallower than the object: {:.0f}% of "
+                             "the seen surface is blurred beyond {:.1f} px; f/{:g} would keep 95% "
+                             "sharp (or focus nearer the object's front)",
+                             n, 100 * out_of_focus / visible, settings.max_blur_px,
+                             next_standard_f_number(needed_n)));
+  }
+  // Diffraction: an Airy disc wider than the blur budget, where depth of field does not need it.
+  const double airy_px = 2.44 * kWavelengthM * n / pixel_pitch_m;
+  if (airy_px > settings.max_blur_px && n > next_standard_f_number(needed_n) * 1.01) {
+    const double limit_n = settings.max_blur_px * pixel_pitch_m / (2.44 * kWavelengthM);
+    diag.warning(aperture_loc,
+                 fmt::format("f/{:g} is diffraction-limited on this sensor ({:.1f} µm pixels): the "
+                             "Airy disc is {:.1f} px; the depth of field only needs f/{:g}, and "
+                             "f/{:.1f} or wider keeps diffraction under {:.1f} px",
+                             n, pixel_pitch_m * 1e6, airy_px,
+                             next_standard_f_number(std::max(needed_n, 1.2)), limit_n,
+                             settings.max_blur_px));
+  }
+  // Exposure.
+  if (clipped / visible > kWarnShare) {
+    diag.warning(shutter_loc,
+                 fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
+                             "(EV100 {:.1f}); shorten the shutter or stop down by one stop",
+                             100 * clipped / visible,
+                             dslr::ev100(n, camera.shutter_s, camera.iso)));
+  }
+  if (dark / visible > kWarnShare) {
+    diag.warning(shutter_loc,
+                 fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
+                             "full scale, where sensor noise hides texture; lengthen the shutter, "
+                             "raise the ISO or add light",
+                             100 * dark / visible, 100 * settings.min_signal));
+  }
+  // Motion blur from a turning table, per shot group (reported once per source line).
+  int last_line = -1;
+  for (const auto& shot : scene.shots) {
+    if (shot.turntable_velocity_rad_s == 0 || shot.loc.line == last_line) continue;
+    const double radius = studio.object_center.head<2>().norm() + studio.object_radius;
+    const double depth = std::max(0.05, coverage.shots[shot.index].nearest_depth_m);
+    const double blur_px = dslr::motion_blur_length_px(
+        camera, 1.0, std::abs(shot.turntable_velocity_rad_s), radius, depth);
+    if (blur_px > 1) {
+      last_line = shot.loc.line;
+      diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} px "
+                                         "during the {:g} s exposure; stop the table for each "
+                                         "shot or use 1/{:.0f} s or shorter",
+                                         blur_px, camera.shutter_s,
+                                         std::ceil(blur_px / camera.shutter_s)));
+    }
+  }
+  // Faces never seen (the base resting on the table cannot be, so it does not count).
+  double unseen = 0, resting = 0;
+  Eigen::Vector3d unseen_normal = Eigen::Vector3d::Zero();
+  const auto& mesh = studio.object;
+  for (size_t f = 0; f < coverage.views.size(); ++f) {
+    if (coverage.resting[f]) {
+      resting += coverage.face_area_m2[f];
+      continue;
+    }
+    if (coverage.views[f] > 0) continue;
+    unseen += coverage.face_area_m2[f];
+    const auto& t = mesh.triangles[f];
+    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>();
+    unseen_normal += (mesh.positions[t[1]].cast<double>() - a)
+                         .cross(mesh.positions[t[2]].cast<double>() - a) / 2;
+  }
+  const double visible_total = std::max(coverage.total_area_m2 - resting, 1e-30);
+  if (!scene.shots.empty() && unseen / visible_total > kWarnShare) {
+    std::string fix = "add shots from the directions the red faces face";
+    if (unseen_normal.norm() > 0.3 * unseen) {
+      const double elevation = std::asin(std::clamp(unseen_normal.normalized().z(), -1.0, 1.0));
+      if (elevation > 0.35) fix = "add a ring at a higher elevation, e.g. 60deg";
+      else if (elevation < -0.35) fix = "add a ring from below (elevation -30deg) or turn the "
+                                        "object over for a second pass";
+    }
+    diag.warning(scene.shots.front().loc,
+                 fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",
+                             100 * unseen / visible_total, fix));
+  }
+  // Overlap between consecutive shots and the object's size in the frame.
+  for (size_t i = 1; i < coverage.shots.size(); ++i) {
+    const ShotCoverage& shot = coverage.shots[i];
+    if (shot.visible_area_m2 > 0 && shot.overlap_with_previous < settings.min_overlap) {
+      diag.warning(scene.shots[i].loc,
+                   fmt::format("{} overlaps the previous shot by only {:.0f}% of its seen "
+                               "surface (SfM wants {:.0f}% or more); take smaller steps",
+                               scene.shots[i].name, 100 * shot.overlap_with_previous,
+                               100 * settings.min_overlap));
+      break;
+    }
+  }
+  for (const auto& shot : coverage.shots) {
+    if (shot.frame_fill < settings.min_frame_fill) {
+      diag.warning(scene.shots[shot.shot].loc,
+                   fmt::format("the object fills only {:.1f}% of {}'s frame; move the camera "
+                               "closer or use a longer lens",
+                               100 * shot.frame_fill, scene.shots[shot.shot].name));
+      break;
+    }
+  }
+}
+
+}  // namespace rigc::analysis

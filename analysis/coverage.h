@@ -1,0 +1,52 @@
+// Coverage analysis: for every shot, which faces of the object it sees and whether SfM can use the
+// view (resolution on the surface, viewing angle, focus, exposure); per face, the views and
+// whether some pair of usable views triangulates it. Area-weighted throughout.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "backends/preview/studio_scene.h"
+#include "compiler/ir.h"
+
+namespace rigc::analysis {
+
+struct ShotCoverage {
+  int shot = 0;
+  double visible_area_m2 = 0;
+  double new_area_m2 = 0;             // first seen in this shot
+  double overlap_with_previous = 0;   // share of this shot's visible area the previous shot saw
+  // Cumulative shares of the surface area after this shot.
+  double seen_1 = 0, seen_2 = 0, seen_3 = 0, reconstructable = 0;
+  // Shares of this shot's visible area.
+  double out_of_focus = 0, clipped = 0, too_dark = 0, too_oblique = 0, too_coarse = 0;
+  double frame_fill = 0;  // object's share of the image area
+  double nearest_depth_m = 0;
+};
+
+struct CoverageResult {
+  std::vector<double> face_area_m2;        // object frame
+  std::vector<std::uint16_t> views;        // shots that see each face
+  std::vector<std::uint16_t> usable_views;  // of those, views SfM can use
+  std::vector<std::uint8_t> reconstructable;
+  std::vector<std::uint8_t> resting;       // faces lying on the turntable: no camera can see them
+  // The shots in which each face was seen the first and second time (kNever if not).
+  static constexpr std::uint16_t kNever = 0xFFFF;
+  std::vector<std::uint16_t> first_seen, second_seen;
+  std::vector<ShotCoverage> shots;
+  double total_area_m2 = 0;
+  // Blur needed to keep 95 % of the seen surface sharp, as a multiple of max_blur_px at the
+  // current aperture (> 1: stop down by that factor).
+  double blur_ratio_95 = 0;
+};
+
+struct CoverageOptions {
+  // Scale of the visibility buffers relative to the sensor; footprints are always computed at
+  // full resolution. 0 picks about 1400 px across.
+  double visibility_scale = 0;
+};
+
+CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioScene& studio,
+                                const CoverageOptions& options = {});
+
+}  // namespace rigc::analysis

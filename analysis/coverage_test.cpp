@@ -1,0 +1,193 @@
+#include "analysis/coverage.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "analysis/advice.h"
+#include "analysis/coverage_output.h"
+#include "compiler/frontend.h"
+#include "compiler/mesh_io.h"
+#include "tests/test_support.h"
+
+namespace rigc::analysis {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Analysed {
+  ir::Scene scene;
+  CoverageResult coverage;
+  std::string warnings;
+  int warning_count = 0;
+};
+
+Analysed analyse(const std::string& text) {
+  Analysed out;
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  auto scene = compile_scene_text(text, "test.yaml", ".", diag);
+  EXPECT_TRUE(scene) << messages;
+  if (!scene) return out;
+  out.scene = *scene;
+  const preview::StudioScene studio = preview::prepare_studio_scene(out.scene);
+  CoverageOptions options;
+  options.visibility_scale = 0.2;
+  out.coverage = analyse_coverage(out.scene, studio, options);
+  DiagnosticEngine advice;
+  advice.set_handler([&](const Diagnostic&, const std::string& m) { out.warnings += m; });
+  report_capture_advice(out.scene, studio, out.coverage, advice);
+  out.warning_count = advice.warning_count();
+  return out;
+}
+
+std::string scene_text(const std::string& object, const std::string& exposure,
+                       const std::string& shots, const std::string& extra_camera = "") {
+  return "rigc: 1\nobject:\n" + object + R"(
+  surface: {pattern: speckle, scale: 3mm}
+studio:
+  turntable: {diameter: 40cm, height: 75cm}
+  lights:
+    - {type: area, position: [0.6m, -1.2m, 1.2m], size: [50cm, 50cm], power: 80W}
+    - {type: area, position: [-0.6m, -1.2m, 1.2m], size: [50cm, 50cm], power: 80W}
+  ambient: 300lx
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm}
+  exposure: )" + exposure + "\n" + extra_camera + "shots:\n" + shots;
+}
+
+const std::string kStatue = "  primitive: {shape: statue, detail: 5}\n  fit: {height: 30cm}";
+const std::string kGoodExposure = "{aperture: f/13, shutter: 1/125, iso: 200}";
+const std::string kGoodShots =
+    "  - turntable: {steps: 18, step: 20deg, camera: {distance: 90cm, height: 15cm}}\n"
+    "  - turntable: {steps: 18, step: 20deg, camera: {distance: 90cm, height: 50cm}}\n";
+
+// One far camera sees a spherical cap of (1 - r/D)/2 of a sphere's area.
+TEST(Coverage, SphereSeenFromOneCameraMatchesTheCapArea) {
+  const std::string sphere = "  primitive: {shape: sphere, detail: 6}\n  fit: {size: 10cm}";
+  Analysed a = analyse(scene_text(
+      sphere, kGoodExposure, "  - pose: {position: [0, -0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"));
+  ASSERT_EQ(a.coverage.shots.size(), 1u);
+  const double expected = (1 - 0.05 / 0.45) / 2;
+  EXPECT_NEAR(a.coverage.shots[0].seen_1, expected, 0.01);
+  // Two opposite cameras see two such caps, and no face twice.
+  Analysed b = analyse(scene_text(
+      sphere, kGoodExposure,
+      "  - pose: {position: [0, -0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"
+      "  - pose: {position: [0, 0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"));
+  EXPECT_NEAR(b.coverage.shots[1].seen_1, 2 * expected, 0.02);
+  EXPECT_NEAR(b.coverage.shots[1].seen_2, 0.0, 1e-9);
+  EXPECT_NEAR(b.coverage.shots[1].overlap_with_previous, 0.0, 1e-9);
+}
+
+// Cameras below the table top see the table's underside, not the box on it.
+TEST(Coverage, FacesHiddenBehindTheTurntableAreNotCounted) {
+  const std::string box = "  primitive: box\n  fit: {size: 10cm}";
+  Analysed below = analyse(scene_text(
+      box, kGoodExposure, "  - orbit: {distance: 60cm, rings: [{elevation: -25deg, count: 8}]}\n"));
+  EXPECT_LT(below.coverage.shots.back().seen_1, 0.001);
+  Analysed above = analyse(scene_text(
+      box, kGoodExposure, "  - orbit: {distance: 60cm, rings: [{elevation: 25deg, count: 8}]}\n"));
+  // Four sides and the top of the box: 5/6 of its area; the base is never seen.
+  EXPECT_NEAR(above.coverage.shots.back().seen_1, 5.0 / 6, 0.01);
+  double base = 0, base_seen = 0;
+  for (size_t f = 0; f < above.coverage.face_area_m2.size(); ++f) {
+    if (!above.coverage.resting[f]) continue;
+    base += above.coverage.face_area_m2[f];
+    if (above.coverage.views[f]) base_seen += above.coverage.face_area_m2[f];
+  }
+  EXPECT_NEAR(base / above.coverage.total_area_m2, 1.0 / 6, 1e-6);
+  EXPECT_EQ(base_seen, 0);
+}
+
+TEST(Coverage, AGoodTurntableCaptureReconstructsMostOfTheObject) {
+  Analysed a = analyse(scene_text(kStatue, kGoodExposure, kGoodShots));
+  const ShotCoverage& last = a.coverage.shots.back();
+  EXPECT_GT(last.seen_2, 0.9);
+  EXPECT_GT(last.reconstructable, 0.85);
+  EXPECT_LE(last.reconstructable, last.seen_2);
+  EXPECT_EQ(a.warning_count, 0) << a.warnings;
+  // Cumulative shares never fall, and per-shot overlap is high for 20 degree steps.
+  for (size_t s = 1; s < a.coverage.shots.size(); ++s) {
+    EXPECT_GE(a.coverage.shots[s].seen_1, a.coverage.shots[s - 1].seen_1);
+  }
+  EXPECT_GT(a.coverage.shots[1].overlap_with_previous, 0.7);
+}
+
+TEST(Coverage, AnOutOfFocusCaptureReconstructsNothing) {
+  Analysed a = analyse(scene_text(kStatue, "{aperture: f/1.4, shutter: 1/2000, iso: 100}",
+                                  kGoodShots, "  focus: 5m\n"));
+  EXPECT_GT(a.coverage.shots.back().seen_2, 0.9);
+  EXPECT_EQ(a.coverage.shots.back().reconstructable, 0.0);
+  EXPECT_NE(a.warnings.find("warning: depth of field at f/1.4"), std::string::npos) << a.warnings;
+}
+
+struct WarningCase {
+  const char* name;
+  std::string exposure;
+  std::string shots;
+  std::string extra_camera;
+  const char* expected;
+};
+
+TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
+  const std::vector<WarningCase> cases = {
+      {"shallow focus", "{aperture: f/2, shutter: 1/2000, iso: 100}", kGoodShots, "",
+       "depth of field at f/2 is shallower than the object"},
+      {"diffraction", "{aperture: f/64, shutter: 1/8, iso: 400}", kGoodShots, "",
+       "f/64 is diffraction-limited"},
+      {"over-exposure", "{aperture: f/13, shutter: 1/4, iso: 800}", kGoodShots, "",
+       "over-exposure"},
+      {"under-exposure", "{aperture: f/13, shutter: 1/8000, iso: 100}", kGoodShots, "",
+       "under-exposure"},
+      {"motion blur", kGoodExposure,
+       "  - turntable: {steps: 18, step: 20deg, speed: 20deg/s, camera: {distance: 90cm, "
+       "height: 15cm}}\n",
+       "", "the turning table smears the object"},
+      {"unseen top", kGoodExposure,
+       "  - turntable: {steps: 18, step: 20deg, camera: {distance: 90cm, height: -5cm}}\n", "",
+       "add a ring at a higher elevation"},
+      {"low overlap", kGoodExposure,
+       "  - turntable: {steps: 3, step: 120deg, camera: {distance: 90cm, height: 15cm}}\n", "",
+       "overlaps the previous shot by only"},
+      {"too small", kGoodExposure,
+       "  - turntable: {steps: 18, step: 20deg, camera: {distance: 6m, height: 15cm}}\n"
+       "  - turntable: {steps: 18, step: 20deg, camera: {distance: 6m, height: 2m}}\n",
+       "  focus: 6m\n", "the object fills only"},
+  };
+  for (const auto& c : cases) {
+    Analysed a = analyse(scene_text(kStatue, c.exposure, c.shots, c.extra_camera));
+    EXPECT_NE(a.warnings.find(c.expected), std::string::npos)
+        << c.name << ":\n" << a.warnings;
+  }
+}
+
+TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
+  testing::TempDir dir;
+  Analysed a = analyse(scene_text(
+      "  primitive: box\n  fit: {size: 10cm}", kGoodExposure,
+      "  - turntable: {steps: 4, step: 90deg, camera: {distance: 60cm, height: 20cm}}\n"));
+  const preview::StudioScene studio = preview::prepare_studio_scene(a.scene);
+  std::string error;
+  ASSERT_TRUE(write_coverage_outputs(a.scene, studio, a.coverage, dir.path(), 96, &error))
+      << error;
+  for (const char* file : {"coverage.ply", "coverage.glb", "views.ply", "views.glb",
+                           "coverage.json", "pictures/view_front.png",
+                           "pictures/after_shot_003.png"}) {
+    EXPECT_TRUE(fs::exists(dir.path() / file)) << file;
+  }
+  // The GLB and PLY load back with one face per box triangle.
+  auto glb = load_model((dir.path() / "coverage.glb").string(), &error);
+  ASSERT_TRUE(glb) << error;
+  EXPECT_EQ(glb->mesh.triangles.size(), a.coverage.face_area_m2.size());
+  const std::string ply = testing::read_text((dir.path() / "coverage.ply").string());
+  EXPECT_NE(ply.find("property uchar red"), std::string::npos);
+  EXPECT_EQ(paper_color(0), Eigen::Vector3f(1, 1, 1));
+  EXPECT_GT(paper_color(1).x(), 0.5f);
+  EXPECT_GT(paper_color(2).y(), 0.5f);
+}
+
+}  // namespace
+}  // namespace rigc::analysis
