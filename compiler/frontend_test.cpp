@@ -116,7 +116,7 @@ TEST(Frontend, PaperSceneHasHandComputedIntrinsicsAndPoses) {
   EXPECT_DOUBLE_EQ(camera.cx, 2736);
   EXPECT_DOUBLE_EQ(camera.cy, 1824);
   EXPECT_DOUBLE_EQ(camera.distortion.k1, -0.02);
-  EXPECT_DOUBLE_EQ(camera.aperture_f_number, 11);
+  EXPECT_DOUBLE_EQ(camera.aperture_f_number, 13);
   EXPECT_DOUBLE_EQ(camera.shutter_s, 1.0 / 125);
   EXPECT_DOUBLE_EQ(camera.iso, 200);
 

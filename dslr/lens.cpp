@@ -129,8 +129,8 @@ double vignetting_gain(double fraction_lost, double r2, double r2_corner) {
 namespace {
 
 // Where sensor positions land on the canvas, solved exactly on a grid of nodes kMapStep pixels
-// apart and interpolated bilinearly in between: the map is smooth, so for |k1| <= 0.2 the
-// interpolation error stays below 0.001 px, at 1/64 of the cost of a solve per pixel.
+// apart and interpolated bilinearly in between. The map is smooth: with k1 = -0.2 the error is
+// 0.007 px at 1/8 scale (the test) and ~0.001 px at full size, for 1/64 of the Newton solves.
 constexpr int kMapStep = 8;
 
 struct CanvasMap {

@@ -157,6 +157,37 @@ TEST(DslrDistortion, WarpedDotsLandWhereDistortSays) {
   EXPECT_LT(worst, 0.5);
 }
 
+TEST(DslrDistortion, WarpSamplesTheExactUndistortedPosition) {
+  // A canvas whose colour is its own pixel position: bilinear sampling of a ramp is exact, so the
+  // warped colour is where the warp sampled, to compare with a Newton solve per pixel.
+  ir::Camera camera = canon_6d();
+  camera.effects.distortion = true;
+  camera.distortion = opencv_coefficients();
+  camera.distortion.k1 = -0.2;
+  const double scale = 0.125;  // the coarsest map relative to the image: the worst case
+  const RenderGeometry g = render_geometry_for(camera, scale);
+  std::vector<float> ramp(3 * static_cast<std::size_t>(g.width) * g.height);
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      float* p = &ramp[3 * (static_cast<std::size_t>(y) * g.width + x)];
+      p[0] = static_cast<float>(x), p[1] = static_cast<float>(y), p[2] = 0;
+    }
+  }
+  const Intrinsics s = sensor_intrinsics(camera, scale);
+  const SensorImage warped = warp_to_sensor(camera, s, g, ramp, {}, {});
+  double worst = 0;
+  for (int j = 0; j < s.height; ++j) {
+    for (int i = 0; i < s.width; ++i) {
+      const ir::Vec2 u =
+          undistort_normalized(camera.distortion, (i + 0.5 - s.cx) / s.fx, (j + 0.5 - s.cy) / s.fy);
+      const float* p = &warped.rgb[3 * (static_cast<std::size_t>(j) * s.width + i)];
+      worst = std::max(worst, std::hypot(p[0] - (g.fx * u.x() + g.cx - 0.5),
+                                         p[1] - (g.fy * u.y() + g.cy - 0.5)));
+    }
+  }
+  EXPECT_LT(worst, 0.01);
+}
+
 TEST(DslrVignetting, CornersLoseTheConfiguredFraction) {
   ir::Camera camera = canon_6d();
   camera.effects.vignetting = true;

@@ -152,7 +152,8 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
     const Floats w_disc = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
     // Behind: seen only through p's own disc, so a sharp p never picks it up.
     const Floats w_behind = area * clamp01((rp - d) * inv_soft + 0.5f);
-    const auto front = zq<z_front, behind = zq> z_back;
+    const auto front = zq < z_front;
+    const auto behind = zq > z_back;
     const Floats wf = front ? w_disc : zero;
     const Floats wb = behind ? w_behind : zero;
     const Floats ws = (front | behind) ? zero : w_disc;

@@ -121,7 +121,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
   const double fwc = electrons_at_clipping(model, camera.iso);
   const int bits = std::clamp(model.adc_bits, 1, 24);
   const double dn_max = std::ldexp(1.0, bits) - 1;
-  // Single precision is plenty (electrons < 2^24 resolve to 0.01 e⁻) and twice as fast.
+  // Single precision is plenty: below 2^17 electrons it resolves 0.01 e⁻.
   const float fwc_f = static_cast<float>(fwc), prnu_f = static_cast<float>(model.prnu);
   const float read_f = static_cast<float>(read_noise_electrons(model, camera.iso));
   const float dsnu_f = static_cast<float>(model.dsnu_e);
@@ -142,8 +142,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
       tbb::blocked_range<std::size_t>(0, pixels, 4096),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t p = range.begin(); p < range.end(); ++p) {
-          // 64 bits give four 16-bit normals: PRNU for 3 channels + the first DSNU; then 2 more
-          // DSNU.
+          // Each hash gives four 16-bit normals: PRNU x3 and DSNU x3 take two.
           const std::uint64_t fixed_a = splitmix64((2 * p) ^ fixed_key);
           const std::uint64_t fixed_b = splitmix64((2 * p + 1) ^ fixed_key);
           const std::uint64_t read_bits = splitmix64(p ^ read_key);
