@@ -1,5 +1,8 @@
 #include "dslr/exposure.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 
 #include "dslr/lens.h"
@@ -15,9 +18,16 @@ double exposure_scale(const ir::Camera& camera) {
   return camera.shutter_s * camera.iso * kExposureQ / (78.0 * n * n);
 }
 
-void apply_exposure(const ir::Camera& camera, std::vector<float>& rgb) {
+std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance) {
   const float scale = static_cast<float>(exposure_scale(camera));
-  for (float& v : rgb) v *= scale;
+  std::vector<float> signal(radiance.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, radiance.size(), 1 << 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        signal[i] = radiance[i] * scale;
+                      }
+                    });
+  return signal;
 }
 
 double motion_blur_length_px(double angular_velocity_rad_s, double shutter_s,

@@ -17,8 +17,8 @@ double ev100(double f_number, double shutter_s, double iso);
 // (1.0 saturates the sensor at this ISO).
 double exposure_scale(const ir::Camera& camera);
 
-// rgb (cd/m²) times exposure_scale, in place. No clipping here: the sensor clips.
-void apply_exposure(const ir::Camera& camera, std::vector<float>& rgb);
+// Radiance (cd/m²) times exposure_scale. No clipping here: the sensor clips.
+std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance);
 
 // Length in pixels of the motion blur of a point at R⊥ metres from the turntable axis (the
 // component of its motion parallel to the sensor) and depth Z: ω·t·R⊥·f_px / Z.

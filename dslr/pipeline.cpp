@@ -1,8 +1,5 @@
 #include "dslr/pipeline.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <chrono>
 #include <string>
 
@@ -66,13 +63,7 @@ DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
   const Intrinsics canvas = frame.intrinsics();
   const Intrinsics sensor = sensor_intrinsics(camera, scale);
 
-  std::vector<float> work(frame.rgb.size());
-  const float exposure = static_cast<float>(exposure_scale(camera));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1 << 16),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i < r.end(); ++i)
-                        work[i] = frame.rgb[i] * exposure;
-                    });
+  std::vector<float> work = expose(camera, frame.rgb);
   result.timings.exposure_ms = clock.lap_ms();
 
   std::vector<float> scratch;

@@ -91,9 +91,10 @@ std::optional<ColmapFlags> probe_colmap(const std::string& executable, const fs:
   std::string why;
   int rc = run_logged({executable, "feature_extractor", "-h"}, log, &why);
   if (rc < 0) {
-    *error = fmt::format("COLMAP is not available ({}); install Debian's colmap package "
-                         "(scripts/setup.sh) or pass --colmap PATH",
-                         why);
+    *error = fmt::format(
+        "COLMAP is not available ({}); install Debian's colmap package "
+        "(scripts/setup.sh) or pass --colmap PATH",
+        why);
     return std::nullopt;
   }
   std::string text = read_all(log);
@@ -158,8 +159,8 @@ std::optional<std::vector<Point3D>> read_colmap_points(const fs::path& path, std
     if (line.empty() || line[0] == '#') continue;
     std::istringstream s(line);
     Point3D p;
-    if (!(s >> p.id >> p.position.x() >> p.position.y() >> p.position.z() >> p.rgb[0] >>
-          p.rgb[1] >> p.rgb[2] >> p.error)) {
+    if (!(s >> p.id >> p.position.x() >> p.position.y() >> p.position.z() >> p.rgb[0] >> p.rgb[1] >>
+          p.rgb[2] >> p.error)) {
       *error = fmt::format("{}:{}: malformed point line", path.string(), number);
       return std::nullopt;
     }

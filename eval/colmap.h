@@ -34,8 +34,8 @@ struct Point3D {
   long id = 0;
   ir::Vec3 position = ir::Vec3::Zero();
   std::array<int, 3> rgb{0, 0, 0};
-  double error = 0;                // mean reprojection error, pixels
-  std::vector<int> track_images;   // IMAGE_IDs observing the point
+  double error = 0;               // mean reprojection error, pixels
+  std::vector<int> track_images;  // IMAGE_IDs observing the point
 };
 
 struct SparseModel {

@@ -148,9 +148,9 @@ double rotation_angle_deg(const Eigen::Matrix3d& r) {
 }
 
 json stats_json(const DistanceStats& s) {
-  return {{"count", s.count},       {"mean", s.mean},         {"std", s.stddev},
-          {"median", s.median},     {"p90_abs", s.p90_abs},   {"mean_abs", s.mean_abs},
-          {"rms", s.rms},           {"min", s.min},           {"max", s.max}};
+  return {{"count", s.count},   {"mean", s.mean},       {"std", s.stddev},
+          {"median", s.median}, {"p90_abs", s.p90_abs}, {"mean_abs", s.mean_abs},
+          {"rms", s.rms},       {"min", s.min},         {"max", s.max}};
 }
 
 json similarity_json(const Similarity& s) {
@@ -239,8 +239,8 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
     const auto& c = cams->front();
     std::string params;
     for (double v : c.params) params += (params.empty() ? "" : ",") + fmt::format("{:.17g}", v);
-    fe.insert(fe.end(), {"--ImageReader.camera_model", c.model, "--ImageReader.camera_params",
-                         params});
+    fe.insert(fe.end(),
+              {"--ImageReader.camera_model", c.model, "--ImageReader.camera_params", params});
     exact_prior = true;
     r.prior = {{"source", (run_dir / "sparse" / "cameras.txt").string()},
                {"model", c.model},
@@ -271,22 +271,21 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
   }
   std::string matcher = o.matcher;
   if (matcher == "auto") matcher = image_count > 100 ? "sequential" : "exhaustive";
-  std::vector<std::string> match = {o.colmap, matcher + "_matcher", "--database_path",
-                                    db.string()};
+  std::vector<std::string> match = {o.colmap, matcher + "_matcher", "--database_path", db.string()};
   if (!flags->matching_gpu.empty()) {
     match.push_back(flags->matching_gpu);
     match.push_back("0");
   }
-  std::vector<std::string> map = {o.colmap,        "mapper",
+  std::vector<std::string> map = {o.colmap,          "mapper",
                                   "--database_path", db.string(),
                                   "--image_path",    images_dir.string(),
                                   "--output_path",   (work / "sparse").string()};
   if (exact_prior && !o.refine_intrinsics) {
     // A known camera: refining focal length and distortion from two narrow-angle views of a
     // small object is ill-conditioned and can stop the reconstruction at its first pair.
-    map.insert(map.end(), {"--Mapper.ba_refine_focal_length", "0",
-                           "--Mapper.ba_refine_principal_point", "0",
-                           "--Mapper.ba_refine_extra_params", "0"});
+    map.insert(map.end(),
+               {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point", "0",
+                "--Mapper.ba_refine_extra_params", "0"});
   }
   struct Step {
     std::string name;
@@ -414,9 +413,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   // 1. COLMAP.
   ColmapRun colmap =
       run_colmap(o, images_dir, run_dir, out, static_cast<int>(image_names.size()), log);
-  report["colmap"] = {{"steps", colmap.steps},
-                      {"seconds", colmap.seconds},
-                      {"intrinsics_prior", colmap.prior}};
+  report["colmap"] = {
+      {"steps", colmap.steps}, {"seconds", colmap.seconds}, {"intrinsics_prior", colmap.prior}};
   sum.colmap_s = colmap.seconds;
   auto write_report = [&]() {
     std::string why;
@@ -457,8 +455,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     log << fmt::format(
         "rigc eval: COLMAP: {}/{} images registered, {} points, track {:.2f}, reprojection "
         "{:.3f} px ({:.1f} s)\n",
-        model->images.size(), image_names.size(), model->points.size(),
-        model->mean_track_length(), model->mean_reprojection_error(), colmap.seconds);
+        model->images.size(), image_names.size(), model->points.size(), model->mean_track_length(),
+        model->mean_reprojection_error(), colmap.seconds);
   }
   if (model->points.size() < 3) {
     sum.failure = "the reconstruction has fewer than 3 points";
@@ -475,7 +473,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   std::vector<Vec3> rec_points;
   std::map<int, Vec3> rec_centre_by_image;
   for (const auto& p : model->points) rec_points.push_back(p.position);
-  for (const auto& im : model->images) rec_centre_by_image[im.image_id] = camera_centre(im.camera_from_world);
+  for (const auto& im : model->images)
+    rec_centre_by_image[im.image_id] = camera_centre(im.camera_from_world);
 
   // 2. Alignment.
   Similarity align;
@@ -568,9 +567,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
       // camera_from_gt = camera_from_rec * rec_from_gt, made rigid (scale goes into t).
       Mat4 c = Mat4::Identity();
       c.topLeftCorner<3, 3>() = im.camera_from_world.topLeftCorner<3, 3>() * inv.rotation;
-      c.topRightCorner<3, 1>() =
-          im.camera_from_world.topLeftCorner<3, 3>() * inv.translation +
-          im.camera_from_world.topRightCorner<3, 1>();
+      c.topRightCorner<3, 1>() = im.camera_from_world.topLeftCorner<3, 3>() * inv.translation +
+                                 im.camera_from_world.topRightCorner<3, 1>();
       c.topRightCorner<3, 1>() /= inv.scale;
       gt_views.push_back(view_camera(cam, c));
     }
@@ -586,6 +584,13 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     for (const auto& p : aligned) {
       if (crop.contains(p)) inside.push_back(p);
     }
+    // ICP needs no more than 100k points to settle a rigid transform.
+    if (inside.size() > 100000) {
+      const std::size_t stride = (inside.size() + 99999) / 100000;
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < inside.size(); i += stride) inside[k++] = inside[i];
+      inside.resize(k);
+    }
     const std::vector<Vec3>& target = visible_samples.empty() ? samples : visible_samples;
     const std::vector<Vec3>& target_n = visible_samples.empty() ? normals : visible_normals;
     const IcpResult icp = icp_point_to_plane(inside, target, target_n, 0.01 * diag, 50);
@@ -593,8 +598,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
               {"fitness", icp.fitness},
               {"inlier_rmse_mm", icp.inlier_rmse * 1000},
               {"translation_change_mm", icp.transform.topRightCorner<3, 1>().norm() * 1000},
-              {"rotation_change_deg",
-               rotation_angle_deg(icp.transform.topLeftCorner<3, 3>())}};
+              {"rotation_change_deg", rotation_angle_deg(icp.transform.topLeftCorner<3, 3>())}};
     if (icp.fitness >= 0.3) {
       align = Similarity::from_matrix(icp.transform) * align;
       for (auto& p : aligned) p = Similarity::from_matrix(icp.transform).apply(p);
@@ -698,13 +702,11 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     for (const auto& im : model->images) {
       auto it = gt_poses.find(im.name);
       if (it == gt_poses.end()) continue;
-      pos_mm.push_back(1000 *
-                       (align.apply(camera_centre(im.camera_from_world)) -
-                        camera_centre(it->second))
-                           .norm());
+      pos_mm.push_back(
+          1000 *
+          (align.apply(camera_centre(im.camera_from_world)) - camera_centre(it->second)).norm());
       const Eigen::Matrix3d r_rec = im.camera_from_world.topLeftCorner<3, 3>() * inv.rotation;
-      rot_deg.push_back(
-          rotation_angle_deg(it->second.topLeftCorner<3, 3>() * r_rec.transpose()));
+      rot_deg.push_back(rotation_angle_deg(it->second.topLeftCorner<3, 3>() * r_rec.transpose()));
     }
     const DistanceStats ps = distance_stats(pos_mm), rs = distance_stats(rot_deg);
     report["cameras"] = {
@@ -715,8 +717,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const double rigc_metrics_s = seconds_since(t_rigc);
 
   // 5. Files.
-  const double range = o.color_range_mm > 0 ? o.color_range_mm
-                                            : std::max(1e-3, 3 * distance_stats(d_mm).rms);
+  const double range =
+      o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * distance_stats(d_mm).rms);
   json files;
   std::string why;
   if (write_colored_ply(out / "cloud_signed_distance.ply", kept, d_mm, range, &why)) {

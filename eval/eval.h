@@ -18,22 +18,22 @@
 namespace rigc::eval {
 
 struct EvalOptions {
-  std::string run_dir;        // a run folder (images/, sparse/, manifest.json) ...
-  std::string photos_dir;     // ... or a folder of photos (no ground-truth poses)
-  std::string ground_truth;   // mesh file (its own frame); default: the run's scene object
-  std::string scene;          // scene file; default: manifest.json's inputs.source_file
-  std::string output_dir;     // default: RUN_DIR/eval (PHOTOS_DIR/eval)
+  std::string run_dir;       // a run folder (images/, sparse/, manifest.json) ...
+  std::string photos_dir;    // ... or a folder of photos (no ground-truth poses)
+  std::string ground_truth;  // mesh file (its own frame); default: the run's scene object
+  std::string scene;         // scene file; default: manifest.json's inputs.source_file
+  std::string output_dir;    // default: RUN_DIR/eval (PHOTOS_DIR/eval)
   std::string colmap = "colmap";
-  std::string matcher = "auto";  // auto, exhaustive, sequential
-  bool use_masks = true;         // the run's masks/ (what a green screen gives)
+  std::string matcher = "auto";    // auto, exhaustive, sequential
+  bool use_masks = true;           // the run's masks/ (what a green screen gives)
   bool refine_intrinsics = false;  // let COLMAP refine a known (ground-truth) intrinsics prior
-  bool reuse_colmap = false;     // skip COLMAP when the output folder has its model already
+  bool reuse_colmap = false;       // skip COLMAP when the output folder has its model already
   bool icp = true;
   bool poisson = false;  // also mesh the points (Open3D's screened Poisson) and compare the mesh
   int poisson_depth = 9;
-  double tau_mm = 1.0;               // F-score threshold
-  int ground_truth_samples = 200000; // surface samples before the visibility test
-  double color_range_mm = 0;         // heat-map colour range; 0 = 3 x RMS of the distances
+  double tau_mm = 1.0;                // F-score threshold
+  int ground_truth_samples = 200000;  // surface samples before the visibility test
+  double color_range_mm = 0;          // heat-map colour range; 0 = 3 x RMS of the distances
   bool quiet = false;
 };
 

@@ -1,8 +1,8 @@
 // The `rigc eval` and `rigc compare` verbs.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -36,8 +36,9 @@ std::optional<int> parse_options(CLI::App& app, const std::vector<std::string>& 
 
 void add_eval_options(CLI::App& app, EvalOptions& o) {
   app.add_option("--colmap", o.colmap, "COLMAP executable")->capture_default_str();
-  app.add_option("--matcher", o.matcher, "feature matching: exhaustive, sequential, or auto "
-                                         "(sequential above 100 images)")
+  app.add_option("--matcher", o.matcher,
+                 "feature matching: exhaustive, sequential, or auto "
+                 "(sequential above 100 images)")
       ->check(CLI::IsMember({"auto", "exhaustive", "sequential"}))
       ->capture_default_str();
   app.add_flag("!--no-masks", o.use_masks, "ignore the run's masks/ (object masks)");
@@ -129,7 +130,9 @@ int run_compare_command(std::vector<std::string> args) {
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
   app.add_option("--backends", backends_text, "comma-separated renderers")->capture_default_str();
   app.add_option("--photos", photos, "real photos of the same object, evaluated as one more row");
-  app.add_option("--scale", scale, "render scale")->check(CLI::Range(0.01, 4.0))->capture_default_str();
+  app.add_option("--scale", scale, "render scale")
+      ->check(CLI::Range(0.01, 4.0))
+      ->capture_default_str();
   app.add_option("-o,--output", output, "output folder (default: out/<scene>/compare)");
   add_eval_options(app, base);
   if (auto code = parse_options(app, args)) return *code;
@@ -161,7 +164,8 @@ int run_compare_command(std::vector<std::string> args) {
     std::cerr << "rigc compare: error: no backend to compare (--backends preview,...)\n";
     return 1;
   }
-  const fs::path out = output.empty() ? fs::path("out") / scene->name / "compare" : fs::path(output);
+  const fs::path out =
+      output.empty() ? fs::path("out") / scene->name / "compare" : fs::path(output);
   std::error_code ec;
   fs::create_directories(out, ec);
 
@@ -212,26 +216,29 @@ int run_compare_command(std::vector<std::string> args) {
   for (const Row& r : rows) {
     const EvalSummary& s = r.summary;
     if (r.render_status != 0) {
-      table += fmt::format("| {} | render failed (exit {}) | | | | | | |\n", r.name,
-                           r.render_status);
+      table +=
+          fmt::format("| {} | render failed (exit {}) | | | | | | |\n", r.name, r.render_status);
     } else if (!s.reconstructed || s.report.is_null() || !s.report.contains("signed_distance_mm")) {
       table += fmt::format("| {} | {} | {:.1f} | {} | {} | failed: {} | | {:.1f} |\n", r.name,
                            s.images, r.render_s, s.registered, s.points, s.failure, s.colmap_s);
     } else {
-      table += fmt::format("| {} | {} | {:.1f} | {}/{} | {} | {:+.3f} ± {:.3f} | {:.3f} | {:.1f} |\n",
-                           r.name, s.images, r.render_s, s.registered, s.images, s.points,
-                           s.mean_mm, s.std_mm, s.fscore, s.colmap_s);
+      table +=
+          fmt::format("| {} | {} | {:.1f} | {}/{} | {} | {:+.3f} ± {:.3f} | {:.3f} | {:.1f} |\n",
+                      r.name, s.images, r.render_s, s.registered, s.images, s.points, s.mean_mm,
+                      s.std_mm, s.fscore, s.colmap_s);
     }
   }
   std::cout << table;
   std::string md = fmt::format("# {}: reconstruction accuracy by renderer\n\n", scene->name);
-  md += fmt::format("Scene `{}`, render scale {}, COLMAP {} (CPU). Signed distance: reconstructed "
-                    "points to the scene's mesh in the object frame, after a similarity "
-                    "alignment on the camera centres and ICP.\n\n",
-                    scene_path, scale, base.poisson ? "+ Poisson meshing" : "sparse points");
+  md += fmt::format(
+      "Scene `{}`, render scale {}, COLMAP {} (CPU). Signed distance: reconstructed "
+      "points to the scene's mesh in the object frame, after a similarity "
+      "alignment on the camera centres and ICP.\n\n",
+      scene_path, scale, base.poisson ? "+ Poisson meshing" : "sparse points");
   md += table;
-  md += "\nThe paper's Table 1 for reference (Photoscan + CloudCompare, full resolution): real "
-        "DSLR -0.38 ± 2.41 mm, Maya + V-Ray -0.43 ± 2.50 mm, Unity -0.49 ± 3.51 mm.\n\n";
+  md +=
+      "\nThe paper's Table 1 for reference (Photoscan + CloudCompare, full resolution): real "
+      "DSLR -0.38 ± 2.41 mm, Maya + V-Ray -0.43 ± 2.50 mm, Unity -0.49 ± 3.51 mm.\n\n";
   md += "| |";
   for (const Row& r : rows) md += " " + r.name + " |";
   md += "\n|---|";
@@ -251,7 +258,8 @@ int run_compare_command(std::vector<std::string> args) {
   }
   md += "\n| heat map |";
   for (const Row& r : rows) {
-    md += r.summary.heatmap_png.empty() ? " |" : fmt::format(" ![]({}) |", rel(r.summary.heatmap_png));
+    md += r.summary.heatmap_png.empty() ? " |"
+                                        : fmt::format(" ![]({}) |", rel(r.summary.heatmap_png));
   }
   md += "\n| histogram |";
   for (const Row& r : rows) {

@@ -1,5 +1,6 @@
 #include "eval/geometry.h"
 
+#include <embree3/rtcore.h>
 #include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/geometry/TriangleMesh.h>
@@ -10,6 +11,7 @@
 #include <open3d/t/geometry/RaycastingScene.h>
 #include <open3d/utility/Logging.h>
 #include <open3d/utility/Random.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -27,9 +29,8 @@ namespace {
 
 void quiet_open3d() {
   static std::once_flag once;
-  std::call_once(once, [] {
-    o3d::utility::SetVerbosityLevel(o3d::utility::VerbosityLevel::Error);
-  });
+  std::call_once(once,
+                 [] { o3d::utility::SetVerbosityLevel(o3d::utility::VerbosityLevel::Error); });
 }
 
 Tensor points_tensor(const std::vector<Vec3>& points) {
@@ -38,17 +39,6 @@ Tensor points_tensor(const std::vector<Vec3>& points) {
     for (int k = 0; k < 3; ++k) flat[3 * i + k] = static_cast<float>(points[i][k]);
   }
   return Tensor(std::move(flat), {static_cast<int64_t>(points.size()), 3}, o3d::core::Float32);
-}
-
-Tensor rays_tensor(const std::vector<Vec3>& origins, const std::vector<Vec3>& directions) {
-  std::vector<float> flat(origins.size() * 6);
-  for (std::size_t i = 0; i < origins.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      flat[6 * i + k] = static_cast<float>(origins[i][k]);
-      flat[6 * i + 3 + k] = static_cast<float>(directions[i][k]);
-    }
-  }
-  return Tensor(std::move(flat), {static_cast<int64_t>(origins.size()), 6}, o3d::core::Float32);
 }
 
 o3d::geometry::PointCloud to_cloud(const std::vector<Vec3>& points,
@@ -173,9 +163,56 @@ Vec3 ViewCamera::center() const {
 // ---------------------------------------------------------------------------------------------
 // Surface
 
+// Nearest-triangle queries through Open3D's RaycastingScene; rays through Embree directly
+// (Debian's Open3D 0.16 build returns no hits from CastRays/TestOcclusions).
 struct Surface::Impl {
   o3d::t::geometry::RaycastingScene scene;
   std::shared_ptr<o3d::geometry::TriangleMesh> legacy;
+  RTCDevice device = nullptr;
+  RTCScene rays = nullptr;
+
+  ~Impl() {
+    if (rays) rtcReleaseScene(rays);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  void build_rays(const std::vector<Eigen::Vector3f>& positions,
+                  const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+    device = rtcNewDevice(nullptr);
+    rays = rtcNewScene(device);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), positions.size()));
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      for (int k = 0; k < 3; ++k) v[3 * i + k] = positions[i][k];
+    }
+    auto* f = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) f[3 * i + k] = triangles[i][k];
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(rays, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(rays);
+  }
+
+  static RTCRay make_ray(const Vec3& o, const Vec3& d, float tnear, float tfar) {
+    RTCRay r;
+    r.org_x = static_cast<float>(o.x());
+    r.org_y = static_cast<float>(o.y());
+    r.org_z = static_cast<float>(o.z());
+    r.dir_x = static_cast<float>(d.x());
+    r.dir_y = static_cast<float>(d.y());
+    r.dir_z = static_cast<float>(d.z());
+    r.tnear = tnear;
+    r.tfar = tfar;
+    r.time = 0;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    return r;
+  }
 };
 
 Surface::Surface(const std::vector<Eigen::Vector3f>& positions,
@@ -193,6 +230,7 @@ Surface::Surface(const std::vector<Eigen::Vector3f>& positions,
   impl_->scene.AddTriangles(
       Tensor(std::move(v), {static_cast<int64_t>(positions.size()), 3}, o3d::core::Float32),
       Tensor(std::move(f), {static_cast<int64_t>(triangles.size()), 3}, o3d::core::UInt32));
+  impl_->build_rays(positions, triangles);
   impl_->legacy = std::make_shared<o3d::geometry::TriangleMesh>();
   impl_->legacy->vertices_.reserve(positions.size());
   for (const auto& p : positions) impl_->legacy->vertices_.push_back(p.cast<double>());
@@ -205,9 +243,13 @@ Surface::Surface(const std::vector<Eigen::Vector3f>& positions,
 
 Surface::~Surface() = default;
 
-std::size_t Surface::triangle_count() const { return impl_->legacy->triangles_.size(); }
+std::size_t Surface::triangle_count() const {
+  return impl_->legacy->triangles_.size();
+}
 
-double Surface::area() const { return impl_->legacy->GetSurfaceArea(); }
+double Surface::area() const {
+  return impl_->legacy->GetSurfaceArea();
+}
 
 Eigen::AlignedBox3d Surface::bounds() const {
   Eigen::AlignedBox3d box;
@@ -248,8 +290,7 @@ void Surface::sample(int count, std::uint64_t seed, std::vector<Vec3>* points,
   if (normals) normals->assign(cloud->normals_.begin(), cloud->normals_.end());
 }
 
-std::vector<int> Surface::visible(const std::vector<Vec3>& points,
-                                  const std::vector<Vec3>& normals,
+std::vector<int> Surface::visible(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,
                                   const std::vector<ViewCamera>& cameras) const {
   std::vector<char> seen(points.size(), 0);
   const Eigen::AlignedBox3d box = bounds();
@@ -274,12 +315,17 @@ std::vector<int> Surface::visible(const std::vector<Vec3>& points,
       directions.push_back(eye - origin);
     }
     if (candidates.empty()) continue;
-    const Tensor occluded =
-        impl_->scene.TestOcclusions(rays_tensor(origins, directions), 1e-5f, 1.0f).Contiguous();
-    const bool* occ = occluded.GetDataPtr<bool>();
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-      if (!occ[k]) seen[candidates[k]] = 1;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        RTCIntersectContext context;
+                        rtcInitIntersectContext(&context);
+                        for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                          RTCRay ray = Impl::make_ray(origins[k], directions[k], 1e-5f, 1.0f);
+                          rtcOccluded1(impl_->rays, &context, &ray);
+                          // tfar becomes -inf when something is hit.
+                          if (ray.tfar >= 0) seen[candidates[k]] = 1;
+                        }
+                      });
   }
   std::vector<int> out;
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -292,16 +338,25 @@ RayHits Surface::cast_rays(const std::vector<Vec3>& origins,
                            const std::vector<Vec3>& directions) const {
   RayHits hits;
   if (origins.empty()) return hits;
-  auto result = impl_->scene.CastRays(rays_tensor(origins, directions));
-  const Tensor t = result["t_hit"].Contiguous();
-  const Tensor n = result["primitive_normals"].Contiguous();
-  const float* tp = t.GetDataPtr<float>();
-  const float* np = n.GetDataPtr<float>();
-  hits.t.assign(tp, tp + origins.size());
-  hits.normals.resize(origins.size());
-  for (std::size_t i = 0; i < origins.size(); ++i) {
-    hits.normals[i] = Eigen::Vector3f(np[3 * i], np[3 * i + 1], np[3 * i + 2]);
-  }
+  hits.t.assign(origins.size(), std::numeric_limits<float>::infinity());
+  hits.normals.assign(origins.size(), Eigen::Vector3f::Zero());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      RTCIntersectContext context;
+                      rtcInitIntersectContext(&context);
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        RTCRayHit rh;
+                        rh.ray = Impl::make_ray(origins[i], directions[i], 0.0f,
+                                                std::numeric_limits<float>::infinity());
+                        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                        rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+                        rtcIntersect1(impl_->rays, &context, &rh);
+                        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+                        hits.t[i] = rh.ray.tfar;
+                        hits.normals[i] =
+                            Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+                      }
+                    });
   return hits;
 }
 
@@ -315,10 +370,10 @@ IcpResult icp_point_to_plane(const std::vector<Vec3>& source, const std::vector<
   namespace reg = o3d::pipelines::registration;
   const auto src = to_cloud(source);
   const auto tgt = to_cloud(target, &target_normals);
-  const reg::RegistrationResult r = reg::RegistrationICP(
-      src, tgt, max_correspondence_distance, Eigen::Matrix4d::Identity(),
-      reg::TransformationEstimationPointToPlane(),
-      reg::ICPConvergenceCriteria(1e-7, 1e-7, max_iterations));
+  const reg::RegistrationResult r =
+      reg::RegistrationICP(src, tgt, max_correspondence_distance, Eigen::Matrix4d::Identity(),
+                           reg::TransformationEstimationPointToPlane(),
+                           reg::ICPConvergenceCriteria(1e-7, 1e-7, max_iterations));
   IcpResult out;
   out.transform = r.transformation_;
   out.fitness = r.fitness_;
@@ -333,10 +388,10 @@ IcpResult icp_similarity(const std::vector<Vec3>& source, const std::vector<Vec3
   namespace reg = o3d::pipelines::registration;
   const auto src = to_cloud(source);
   const auto tgt = to_cloud(target);
-  const reg::RegistrationResult r = reg::RegistrationICP(
-      src, tgt, max_correspondence_distance, Eigen::Matrix4d::Identity(),
-      reg::TransformationEstimationPointToPoint(true),
-      reg::ICPConvergenceCriteria(1e-7, 1e-7, max_iterations));
+  const reg::RegistrationResult r =
+      reg::RegistrationICP(src, tgt, max_correspondence_distance, Eigen::Matrix4d::Identity(),
+                           reg::TransformationEstimationPointToPoint(true),
+                           reg::ICPConvergenceCriteria(1e-7, 1e-7, max_iterations));
   IcpResult out;
   out.transform = r.transformation_;
   out.fitness = r.fitness_;

@@ -33,7 +33,8 @@ struct Similarity {
 };
 
 // Least-squares similarity dst ≈ S(src) (Umeyama, through Eigen::umeyama); needs 3+ points.
-std::optional<Similarity> fit_similarity(const std::vector<Vec3>& src, const std::vector<Vec3>& dst);
+std::optional<Similarity> fit_similarity(const std::vector<Vec3>& src,
+                                         const std::vector<Vec3>& dst);
 
 struct RobustSimilarity {
   Similarity transform;

@@ -64,9 +64,9 @@ bool write_canvas(const fs::path& path, const Canvas& canvas, const std::vector<
     OIIO::ImageBufAlgo::render_text(copy, l.x, l.y, l.text, l.size, "DejaVuSans", colour, l.align);
   }
   static std::atomic<unsigned> counter{0};
-  const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp" +
-                                                   std::to_string(::getpid()) + "_" +
-                                                   std::to_string(counter++) + ".png");
+  const fs::path temporary =
+      path.parent_path() / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
+                            "_" + std::to_string(counter++) + ".png");
   if (!copy.write(temporary.string(), OIIO::TypeDesc::UINT8, "png")) {
     *error = fmt::format("cannot write {}: {}", path.string(), copy.geterror());
     std::error_code ec;
@@ -130,9 +130,7 @@ FScore f_score(const std::vector<double>& reconstruction_to_truth,
   f.tau = tau;
   f.precision = share(reconstruction_to_truth);
   f.recall = share(truth_to_reconstruction);
-  f.fscore = f.precision + f.recall > 0
-                 ? 2 * f.precision * f.recall / (f.precision + f.recall)
-                 : 0;
+  f.fscore = f.precision + f.recall > 0 ? 2 * f.precision * f.recall / (f.precision + f.recall) : 0;
   return f;
 }
 
@@ -198,7 +196,8 @@ bool write_histogram_png(const fs::path& path, const std::vector<double>& d_mm, 
     int b = static_cast<int>(std::floor((d - lo) / (hi - lo) * bins));
     counts[std::clamp(b, 0, bins - 1)]++;  // outside the range: in the end bins
   }
-  const std::size_t peak = std::max<std::size_t>(1, *std::max_element(counts.begin(), counts.end()));
+  const std::size_t peak =
+      std::max<std::size_t>(1, *std::max_element(counts.begin(), counts.end()));
   Canvas canvas(width, height, {255, 255, 255});
   canvas.rect(left, top + plot_h, left + plot_w, top + plot_h + 1, {0, 0, 0});
   canvas.rect(left - 1, top, left, top + plot_h, {0, 0, 0});
@@ -230,12 +229,12 @@ bool write_histogram_png(const fs::path& path, const std::vector<double>& d_mm, 
   }
   labels.push_back({width / 2, height - 12, "signed distance to the ground truth (mm)", 15,
                     OIIO::ImageBufAlgo::TextAlignX::Center});
-  labels.push_back({left, 26,
-                    fmt::format("{} points   mean {:.3f} mm   std {:.3f} mm   median {:.3f} mm   "
-                                "p90|d| {:.3f} mm   (peak {} points per bin)",
-                                stats.count, stats.mean, stats.stddev, stats.median,
-                                stats.p90_abs, peak),
-                    14});
+  labels.push_back(
+      {left, 26,
+       fmt::format("{} points   mean {:.3f} mm   std {:.3f} mm   median {:.3f} mm   "
+                   "p90|d| {:.3f} mm   (peak {} points per bin)",
+                   stats.count, stats.mean, stats.stddev, stats.median, stats.p90_abs, peak),
+       14});
   return write_canvas(path, canvas, labels, 0.1f, error);
 }
 
@@ -295,10 +294,9 @@ bool write_heatmap_png(const fs::path& path, const Surface& surface, const ViewC
     const double v = range_mm * (2.0 * x / (bar_w - 1) - 1);
     canvas.rect(bx + x, by, bx + x + 1, by + bar_h, signed_distance_color(v, range_mm));
   }
-  std::vector<Label> labels = {
-      {bx, by - 6, fmt::format("-{:.2f} mm", range_mm), 13},
-      {bx + bar_w, by - 6, fmt::format("+{:.2f} mm", range_mm), 13,
-       OIIO::ImageBufAlgo::TextAlignX::Right}};
+  std::vector<Label> labels = {{bx, by - 6, fmt::format("-{:.2f} mm", range_mm), 13},
+                               {bx + bar_w, by - 6, fmt::format("+{:.2f} mm", range_mm), 13,
+                                OIIO::ImageBufAlgo::TextAlignX::Right}};
   return write_canvas(path, canvas, labels, 0.95f, error);
 }
 

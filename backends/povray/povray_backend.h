@@ -25,8 +25,8 @@ namespace rigc::povray {
 using reference::ReferenceOptions;
 using reference::ShotTiming;
 
-// POV-Ray's focal blur `aperture` per metre of pupil diameter f/N (measured with a render by
-// PovrayDepthOfField: see povray_test.cpp).
+// POV-Ray's focal blur `aperture` per metre of pupil diameter f/N (2: checked with a render by
+// ReferenceAgreement.DefocusBlurWidth).
 extern const double kApertureMetersPerPupilDiameter;
 
 // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if

@@ -40,6 +40,21 @@ struct ScreenTriangle {
   std::array<Vector3f, 3> source_bary;
   float inv_area = 0;                 // 1 / (twice the signed screen area)
   std::int32_t source = 0;            // triangle index; object triangles first, then studio
+  // Planes in pixel coordinates, value = a·x + b·y + c: the barycentrics w0, w1 and 1/z.
+  std::array<float, 3> w0_plane, w1_plane, inv_z_plane;
+
+  void compute_planes() {
+    auto edge_plane = [&](const Vector2f& a, const Vector2f& b) {
+      return std::array<float, 3>{-(b.y() - a.y()) * inv_area, (b.x() - a.x()) * inv_area,
+                                  ((b.y() - a.y()) * a.x() - (b.x() - a.x()) * a.y()) * inv_area};
+    };
+    w0_plane = edge_plane(screen[1], screen[2]);
+    w1_plane = edge_plane(screen[2], screen[0]);
+    // w2 = 1 - w0 - w1, so 1/z = iz2 + w0·(iz0 - iz2) + w1·(iz1 - iz2).
+    const float d0 = inv_z[0] - inv_z[2], d1 = inv_z[1] - inv_z[2];
+    for (int i = 0; i < 3; ++i) inv_z_plane[i] = w0_plane[i] * d0 + w1_plane[i] * d1;
+    inv_z_plane[2] += inv_z[2];
+  }
 };
 
 struct FrameGeometry {
@@ -162,6 +177,12 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
     float blockers = 0, blocker_sum = 0;
     const float search = std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f,
                                     2.0f, 24.0f);
+    // Most points are plainly lit: five taps over the search area settle them cheaply.
+    if (lookup(u, v) >= receiver && lookup(u - search, v - search) >= receiver &&
+        lookup(u + search, v - search) >= receiver && lookup(u - search, v + search) >= receiver &&
+        lookup(u + search, v + search) >= receiver) {
+      return 1;
+    }
     for (const auto& d : kDisc) {
       const float z = lookup(u + d[0] * search, v + d[1] * search);
       if (z < receiver) {
@@ -365,6 +386,7 @@ ScreenSetup setup_screen(int total_tris, const WorldVertex& world_vertex, const 
       if (std::abs(area) < 1e-10f) return;
       s.inv_area = 1 / area;
       s.source = t;
+      s.compute_planes();
       screen_tris.push_back(s);
     });
   }
@@ -426,11 +448,11 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                 for (int k = 0; k < Samples; ++k) {
                   const float sx = px + (Samples == 1 ? 0.5f : kSampleX[k]);
                   const float sy = py + (Samples == 1 ? 0.5f : kSampleY[k]);
-                  const float w0 = edge(s.screen[1], s.screen[2], sx, sy) * s.inv_area;
-                  const float w1 = edge(s.screen[2], s.screen[0], sx, sy) * s.inv_area;
-                  const float w2 = 1 - w0 - w1;
-                  if (w0 < 0 || w1 < 0 || w2 < 0) continue;
-                  const float inv_z = w0 * s.inv_z[0] + w1 * s.inv_z[1] + w2 * s.inv_z[2];
+                  const float w0 = s.w0_plane[0] * sx + s.w0_plane[1] * sy + s.w0_plane[2];
+                  const float w1 = s.w1_plane[0] * sx + s.w1_plane[1] * sy + s.w1_plane[2];
+                  if (w0 < 0 || w1 < 0 || w0 + w1 > 1) continue;
+                  const float inv_z =
+                      s.inv_z_plane[0] * sx + s.inv_z_plane[1] * sy + s.inv_z_plane[2];
                   if (inv_z > sample_inv_z[base + k]) {
                     sample_inv_z[base + k] = inv_z;
                     sample_tri[base + k] = id;

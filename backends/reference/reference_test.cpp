@@ -34,7 +34,7 @@ TEST(ReferenceScriptText, PovLiteralAndComments) {
   EXPECT_EQ(*pov_string_literal("a\"b\\c"), "\"a\\\"b\\\\c\"");
   EXPECT_FALSE(pov_string_literal("a\nb"));
   EXPECT_FALSE(pov_string_literal("caf\xC3\xA9"));
-  EXPECT_EQ(comment_text("x\n#include \"evil\"\r\xC3\xA9"), "x?#include \"evil\"???");
+  EXPECT_EQ(comment_text("x\n#include \"evil\\\"\r\xC3\xA9"), "x?#include ?evil?????");
   EXPECT_EQ(number_text(0.5), "0.5");
   EXPECT_EQ(number_text(-0.0), "0");
   EXPECT_EQ(number_text(std::nan("")), "0");

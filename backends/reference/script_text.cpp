@@ -94,7 +94,7 @@ std::string comment_text(std::string_view text) {
   std::string out;
   for (const char ch : text) {
     const auto c = static_cast<unsigned char>(ch);
-    out += (c >= 0x20 && c < 0x7F) ? ch : '?';
+    out += (c >= 0x20 && c < 0x7F && c != '"' && c != '\\') ? ch : '?';
   }
   return out;
 }

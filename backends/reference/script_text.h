@@ -18,8 +18,8 @@ std::string python_string_literal(std::string_view utf8);
 // names, which are always plain.
 std::optional<std::string> pov_string_literal(std::string_view text);
 
-// Text for a one-line comment in any of the generated files: printable ASCII only (anything else
-// becomes '?'), so a newline cannot end the comment and start code.
+// Text for a one-line comment in any of the generated files: printable ASCII only, no quotes or
+// backslashes (anything else becomes '?'), so a newline cannot end the comment and start code.
 std::string comment_text(std::string_view text);
 
 // True for names safe as generated file names and as program arguments: 1..64 characters of

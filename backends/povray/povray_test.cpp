@@ -1,0 +1,118 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "backends/povray/povray_backend.h"
+#include "backends/reference/process.h"
+#include "compiler/frontend.h"
+#include "tests/test_support.h"
+
+namespace rigc::povray {
+namespace {
+
+namespace fs = std::filesystem;
+using rigc::testing::read_text;
+using rigc::testing::TempDir;
+
+ir::Scene paper_scene() {
+  DiagnosticEngine diag;
+  auto scene = compile_scene_file(rigc::testing::source_path("scenes/paper-turntable.yaml"), diag);
+  EXPECT_TRUE(scene);
+  return scene ? *scene : ir::Scene{};
+}
+
+// Sets an environment variable for the lifetime of the object.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) setenv(name_, old_->c_str(), 1);
+    else unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
+  const ir::Scene scene = paper_scene();
+  TempDir dir;
+  std::string error;
+  ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
+  const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
+  EXPECT_NE(inc.find("#declare RigcObject = mesh2 {"), std::string::npos);
+  EXPECT_NE(inc.find("uv_vectors"), std::string::npos);
+  EXPECT_NE(inc.find("area_light"), std::string::npos);
+  EXPECT_NE(inc.find("bozo"), std::string::npos);  // the speckle pattern
+  for (const auto& shot : scene.shots) {
+    EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + ".pov")));
+    EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + "_mask.ini")));
+    const std::string ini = read_text((dir.path() / "pov" / (shot.name + ".ini")).string());
+    EXPECT_NE(ini.find("Output_File_Type=E"), std::string::npos);
+  }
+  const std::string pov = read_text((dir.path() / "pov" / "shot_000.pov").string());
+  EXPECT_NE(pov.find("aperture"), std::string::npos);  // f-number mapped to focal blur
+  EXPECT_NE(pov.find("focal_point"), std::string::npos);
+}
+
+TEST(PovrayRun, MissingExecutableNamesThePackage) {
+  const ir::Scene scene = paper_scene();
+  TempDir dir;
+  ScopedEnv path("PATH", (dir.path() / "empty").string());
+  ReferenceOptions options;
+  options.output_dir = (dir.path() / "out").string();
+  options.scale = 0.01;
+  std::ostringstream log;
+  EXPECT_EQ(run(scene, options, log), 2);
+  EXPECT_NE(log.str().find("apt-get install povray"), std::string::npos) << log.str();
+}
+
+// A povray that fails for shot_001 (a wrapper in front of the real one): the run names the shot
+// and its log, finishes the others and exits 2; the rerun renders only the failed shot.
+TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
+  const auto real = reference::find_executable("povray");
+  if (!real) GTEST_SKIP() << "povray is not installed";
+  ir::Scene scene = paper_scene();
+  scene.camera.effects.depth_of_field = false;
+  TempDir dir;
+  fs::create_directories(dir.path() / "bin");
+  const fs::path wrapper = dir.path() / "bin" / "povray";
+  rigc::testing::write_text(wrapper.string(),
+                            "#!/bin/sh\ncase \"$1\" in shot_001*) echo broken >&2; exit 7;; esac\n"
+                            "exec " + real->string() + " \"$@\"\n");
+  fs::permissions(wrapper, fs::perms::owner_all);
+  ReferenceOptions options;
+  options.output_dir = (dir.path() / "out").string();
+  options.scale = 0.012;
+  options.samples = 1;
+  options.shots = {0, 1};
+  {
+    ScopedEnv path("PATH", (dir.path() / "bin").string() + ":" + std::getenv("PATH"));
+    std::ostringstream log;
+    EXPECT_EQ(run(scene, options, log), 2);
+    EXPECT_NE(log.str().find("shot_001: povray shot_001.ini failed with exit code 7"),
+              std::string::npos) << log.str();
+    EXPECT_NE(log.str().find("render/shot_001.log"), std::string::npos) << log.str();
+    EXPECT_TRUE(fs::exists(dir.path() / "out" / "images" / "shot_000.jpg"));
+    EXPECT_FALSE(fs::exists(dir.path() / "out" / "images" / "shot_001.jpg"));
+  }
+  std::ostringstream log;
+  std::vector<ShotTiming> timings;
+  EXPECT_EQ(run(scene, options, log, &timings), 0) << log.str();
+  ASSERT_EQ(timings.size(), 2u);
+  EXPECT_TRUE(timings[0].skipped);
+  EXPECT_FALSE(timings[1].skipped);
+  for (const char* file : {"images/shot_001.jpg", "masks/shot_001.png", "sparse/images.txt",
+                           "transforms.json", "manifest.json"}) {
+    EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
+  }
+}
+
+}  // namespace
+}  // namespace rigc::povray
