@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <limits>
 
 #include "dslr/lens.h"
 
@@ -24,7 +25,8 @@ std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& ra
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, radiance.size(), 1 << 16),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                        signal[i] = radiance[i] * scale;
+                        const float v = radiance[i] * scale;
+                        signal[i] = v > 0 && v < std::numeric_limits<float>::infinity() ? v : 0;
                       }
                     });
   return signal;

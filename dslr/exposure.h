@@ -17,7 +17,8 @@ double ev100(double f_number, double shutter_s, double iso);
 // (1.0 saturates the sensor at this ISO).
 double exposure_scale(const ir::Camera& camera);
 
-// Radiance (cd/m²) times exposure_scale. No clipping here: the sensor clips.
+// Radiance (cd/m²) times exposure_scale. No clipping here (the sensor clips), but negative and
+// non-finite radiance (a renderer's stray NaN) becomes 0 so it cannot spread through the blurs.
 std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance);
 
 // Length in pixels of the motion blur of a point at R⊥ metres from the turntable axis (the

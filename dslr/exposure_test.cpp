@@ -60,6 +60,15 @@ TEST(DslrExposure, SaturatedSignalClipsAtOne) {
   EXPECT_FLOAT_EQ(mean_signal(camera, 1e6), 1.0f);
 }
 
+TEST(DslrExposure, StrayNanOrNegativeRadianceBecomesBlack) {
+  const ir::Camera camera = canon_6d();
+  const std::vector<float> signal = expose(camera, {NAN, -5, INFINITY, 100});
+  EXPECT_EQ(signal[0], 0);
+  EXPECT_EQ(signal[1], 0);
+  EXPECT_EQ(signal[2], 0);
+  EXPECT_FLOAT_EQ(signal[3], 100 * exposure_scale(camera));
+}
+
 TEST(DslrMotionBlur, LengthIsAngularSpeedTimesLeverArmInPixels) {
   const double omega = 2 * M_PI / 10;  // one turn in 10 s
   EXPECT_NEAR(motion_blur_length_px(omega, 1.0 / 125, 0.1, 0.8, 7642),

@@ -185,11 +185,12 @@ bool same_grid(const Intrinsics& a, const Intrinsics& b) {
 
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
-                           const std::vector<float>& depth_m,
-                           const std::vector<std::uint8_t>& mask) {
+                           const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask,
+                           std::vector<float> storage) {
   SensorImage out;
   out.intrinsics = sensor;
   const std::size_t n = static_cast<std::size_t>(sensor.width) * sensor.height;
+  out.rgb = std::move(storage);
   out.rgb.resize(3 * n);
   const bool has_depth = !depth_m.empty(), has_mask = !mask.empty();
   if (has_depth) out.depth_m.resize(n);

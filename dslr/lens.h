@@ -46,9 +46,10 @@ struct SensorImage {
 // Resamples the canvas onto the sensor grid: for each sensor pixel, undistort its normalised
 // coordinates and sample the canvas (bilinear for colour, nearest for depth and mask), then apply
 // vignetting. camera.effects.distortion / .vignetting switch the two effects.
+// `storage`, if given, is a spare buffer reused for the output colour (no fresh pages to fault in).
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
-                           const std::vector<float>& depth_m,
-                           const std::vector<std::uint8_t>& mask);
+                           const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask,
+                           std::vector<float> storage = {});
 
 }  // namespace rigc::dslr

@@ -32,10 +32,11 @@ double diffraction_sigma_m(double f_number, double wavelength_m = 550e-9);
 //  - at p's depth (±2 %): the same, normalised (a uniform region gets the plain disc average);
 //  - behind p: only within p's own disc, so a sharp foreground never picks up the background
 //    behind it and keeps its exact values (no halos).
-// Taps: every pixel within 6.5 px, then rings 25 % apart with as many taps as keep the spacing
-// isotropic, each weighted by the area it stands for; taps are rounded to whole pixels (large
-// discs of small bright highlights show ring structure). Each 16x16 tile only visits the taps
-// that the largest disc reaching it needs, so sharp regions cost a copy.
+// Approximations: taps are every pixel within 4.5 px, then rings 30 % apart with as many taps
+// as keep the spacing isotropic, each weighted by the area it stands for and rounded to whole
+// pixels (large discs of small bright highlights show ring structure); discs are capped at
+// kMaxCocRadiusPx. Each 16x16 tile only visits the taps that the largest disc reaching it needs,
+// so sharp regions cost a copy and the cost grows with the blur (see the timings in the report).
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
                           const std::vector<float>& depth_m, std::vector<float>& out);

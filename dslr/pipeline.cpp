@@ -74,10 +74,10 @@ DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
   result.timings.depth_of_field_ms = clock.lap_ms();
 
   if (camera.effects.diffraction) apply_diffraction(camera, canvas, work, scratch);
-  scratch = {};
   result.timings.diffraction_ms = clock.lap_ms();
 
-  SensorImage image = warp_to_sensor(camera, sensor, canvas, work, frame.depth_m, frame.mask);
+  SensorImage image =
+      warp_to_sensor(camera, sensor, canvas, work, frame.depth_m, frame.mask, std::move(scratch));
   work = {};
   result.timings.distortion_ms = clock.lap_ms();
 

@@ -35,7 +35,9 @@ json matrix_rows(const ir::Mat4& m) {
   return rows;
 }
 
-json vec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+json vec3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 // Blender lights shine along their local -Z.
 ir::Mat4 light_matrix(const ir::Light& light) {
@@ -81,7 +83,9 @@ json light_json(const ir::Light& light, int index) {
   return spec;
 }
 
-std::string texture_file_name(int texture) { return fmt::format("texture_{}.png", texture); }
+std::string texture_file_name(int texture) {
+  return fmt::format("texture_{}.png", texture);
+}
 
 json material_json(const ir::Scene& scene, const preview::ShadedMaterial& material, int index,
                    bool is_object) {
@@ -92,8 +96,8 @@ json material_json(const ir::Scene& scene, const preview::ShadedMaterial& materi
                {"base_color", vec3(material.base_color.cast<double>())},
                {"roughness", material.roughness},
                {"metallic", material.metallic},
-               {"texture", material.texture >= 0 ? json(texture_file_name(material.texture))
-                                                 : json(nullptr)},
+               {"texture",
+                material.texture >= 0 ? json(texture_file_name(material.texture)) : json(nullptr)},
                {"pattern", nullptr}};
   const ir::SurfacePattern& pattern = material.pattern;
   if (is_object && pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0) {
@@ -146,8 +150,8 @@ json append_geometry(std::string& bytes, const preview::Geometry& g, int materia
 }
 
 std::string script_text(const json& data) {
-  const std::string literal = reference::python_string_literal(
-      data.dump(-1, ' ', true, json::error_handler_t::replace));
+  const std::string literal =
+      reference::python_string_literal(data.dump(-1, ' ', true, json::error_handler_t::replace));
   std::string script = kScriptTemplate;
   const std::string placeholder = "@DATA@";
   script.replace(script.find(placeholder), placeholder.size(), literal);
@@ -191,8 +195,8 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   }
   for (const auto& shot : scene.shots) {
     if (!reference::is_plain_file_stem(shot.name)) {
-      *error = fmt::format("shot name '{}' cannot be a file name",
-                           reference::comment_text(shot.name));
+      *error =
+          fmt::format("shot name '{}' cannot be a file name", reference::comment_text(shot.name));
       return false;
     }
   }
@@ -236,8 +240,8 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   std::string bytes;
   data["geometry_file"] = "geometry.bin";
   data["geometry"]["object"] = append_geometry(bytes, studio.object, 0, object_materials);
-  data["geometry"]["studio"] = append_geometry(bytes, studio.studio, object_materials,
-                                               total_materials - object_materials);
+  data["geometry"]["studio"] =
+      append_geometry(bytes, studio.studio, object_materials, total_materials - object_materials);
   if (!backends::write_file_atomically(dir / "geometry.bin", bytes, error)) return false;
 
   json lights = json::array();
@@ -266,17 +270,25 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
 }
 
 bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
-                            double scale, int samples, const fs::path& log_path,
-                            RenderedShot* out, std::string* error) {
+                            double scale, int samples, const fs::path& log_path, RenderedShot* out,
+                            std::string* error) {
   const std::string stem = shot.name;
   std::error_code ec;
   fs::remove(dir / (stem + ".exr"), ec);
   fs::remove(dir / (stem + "_mask.exr"), ec);
   // An absolute script path: Blender resolves relative ones against $PWD, not the working folder.
   const std::string script = fs::absolute(dir / "scene.py").string();
-  std::vector<std::string> argv = {"blender",  "-b",     "--factory-startup", "-noaudio",
-                                   "--python-exit-code", "2", "--python", script,
-                                   "--",       "--shot", std::to_string(shot.index)};
+  std::vector<std::string> argv = {"blender",
+                                   "-b",
+                                   "--factory-startup",
+                                   "-noaudio",
+                                   "--python-exit-code",
+                                   "2",
+                                   "--python",
+                                   script,
+                                   "--",
+                                   "--shot",
+                                   std::to_string(shot.index)};
   if (samples > 0) {
     argv.push_back("--samples");
     argv.push_back(std::to_string(samples));
@@ -296,8 +308,8 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
       !reference::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) {
     return false;
   }
-  if (image.width != canvas.width || image.height != canvas.height ||
-      mask.width != canvas.width || mask.height != canvas.height || mask.alpha.empty()) {
+  if (image.width != canvas.width || image.height != canvas.height || mask.width != canvas.width ||
+      mask.height != canvas.height || mask.alpha.empty()) {
     *error = fmt::format("Blender wrote {} x {} images, expected {} x {} with alpha", image.width,
                          image.height, canvas.width, canvas.height);
     return false;
@@ -320,7 +332,9 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
 
 }  // namespace
 
-std::unique_ptr<reference::Renderer> make_renderer() { return std::make_unique<CyclesRenderer>(); }
+std::unique_ptr<reference::Renderer> make_renderer() {
+  return std::make_unique<CyclesRenderer>();
+}
 
 bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
           int samples) {

@@ -44,8 +44,8 @@ shots:
   DiagnosticEngine diag;
   std::string messages;
   diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
-  auto scene = compile_scene_text(text, (dir.path() / "scene.yaml").string(),
-                                  dir.path().string(), diag);
+  auto scene =
+      compile_scene_text(text, (dir.path() / "scene.yaml").string(), dir.path().string(), diag);
   EXPECT_TRUE(scene) << messages;
   if (scene) {
     EXPECT_NE(scene->object.source.find("os.system"), std::string::npos);

@@ -37,7 +37,9 @@ constexpr int kMaxSubframes = 16;
 std::string vec(const Eigen::Vector3d& v) {
   return fmt::format("<{}, {}, {}>", number_text(v.x()), number_text(v.y()), number_text(v.z()));
 }
-std::string vec(const Eigen::Vector3f& v) { return vec(Eigen::Vector3d(v.cast<double>())); }
+std::string vec(const Eigen::Vector3f& v) {
+  return vec(Eigen::Vector3d(v.cast<double>()));
+}
 
 // POV's `matrix` keyword for a column-vector affine transform: its rows are our columns.
 std::string pov_matrix(const ir::Mat4& m) {
@@ -48,8 +50,12 @@ std::string pov_matrix(const ir::Mat4& m) {
                      number_text(m(0, 3)), number_text(m(1, 3)), number_text(m(2, 3)));
 }
 
-std::string material_identifier(int index) { return fmt::format("RigcMaterial{}", index); }
-std::string texture_file_name(int material) { return fmt::format("material_{}.png", material); }
+std::string material_identifier(int index) {
+  return fmt::format("RigcMaterial{}", index);
+}
+std::string texture_file_name(int material) {
+  return fmt::format("material_{}.png", material);
+}
 
 // The texture times the base colour, in linear light, as a 16-bit PNG read with gamma 1:
 // POV-Ray has no way to multiply an image_map by a colour.
@@ -105,7 +111,8 @@ std::string pigment_text(const preview::ShadedMaterial& material, int index, boo
                          vec(dark), scale);
     case ir::PatternKind::kChecker:
       return fmt::format("checker rgb {}, rgb {} scale {}", vec(base), vec(dark), scale);
-    case ir::PatternKind::kNone: break;
+    case ir::PatternKind::kNone:
+      break;
   }
   return "rgb " + vec(base);
 }
@@ -119,10 +126,10 @@ std::string finish_text(const preview::ShadedMaterial& material) {
   const double alpha = std::max(static_cast<double>(material.roughness) * material.roughness, 0.05);
   const double exponent = std::max(2 / (alpha * alpha) - 2, 1.0);
   const double specular = f0 * (exponent + 8) / 8;
-  return fmt::format(
-      "finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
-      number_text(1 - metallic), number_text((1 - f0) * (1 - metallic)), number_text(specular),
-      number_text(1 / exponent), metallic > 0.5 ? " metallic" : "");
+  return fmt::format("finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
+                     number_text(1 - metallic), number_text((1 - f0) * (1 - metallic)),
+                     number_text(specular), number_text(1 / exponent),
+                     metallic > 0.5 ? " metallic" : "");
 }
 
 void append_mesh2(fmt::memory_buffer& out, const std::string& name, const preview::Geometry& g,
@@ -194,8 +201,8 @@ std::string light_text(const ir::Light& light) {
       return fmt::format(
           "light_source {{ {}, rgb {} {} spotlight point_at {} radius 90 falloff 90 tightness 1\n"
           "  area_light {}, {}, {}, {} adaptive 1 }}\n",
-          vec(light.position), vec(Eigen::Vector3d(color * light.power_w / kPi * to_colour)),
-          fade, vec(Eigen::Vector3d(light.position + dir)),
+          vec(light.position), vec(Eigen::Vector3d(color * light.power_w / kPi * to_colour)), fade,
+          vec(Eigen::Vector3d(light.position + dir)),
           vec(Eigen::Vector3d(across * std::max(light.size_m.x(), 1e-4))),
           vec(Eigen::Vector3d(along * std::max(light.size_m.y(), 1e-4))), cells, cells);
     }
@@ -230,8 +237,8 @@ std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::I
       "// Horizontal field of view {:.4f} deg, {} x {} px.\n"
       "camera {{\n  perspective\n  location {}\n  direction {}\n  right {}\n  up {}\n",
       reference::comment_text(shot.name), reference::comment_text(scene.name),
-      reference::comment_text(shot.name), horizontal_fov_deg, canvas.width, canvas.height,
-      vec(eye), vec(direction), vec(Eigen::Vector3d(right * (canvas.width / canvas.fx))),
+      reference::comment_text(shot.name), horizontal_fov_deg, canvas.width, canvas.height, vec(eye),
+      vec(direction), vec(Eigen::Vector3d(right * (canvas.width / canvas.fx))),
       vec(Eigen::Vector3d(-down * (canvas.height / canvas.fy))));
   if (camera.effects.depth_of_field) {
     const double pupil = camera.focal_length_m / camera.aperture_f_number;
@@ -328,8 +335,8 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   }
   for (const auto& shot : scene.shots) {
     if (!reference::is_plain_file_stem(shot.name)) {
-      *error = fmt::format("shot name '{}' cannot be a file name",
-                           reference::comment_text(shot.name));
+      *error =
+          fmt::format("shot name '{}' cannot be a file name", reference::comment_text(shot.name));
       return false;
     }
   }
@@ -367,8 +374,8 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
                    "#declare {} =\n#if (RIGC_MASK)\n"
                    "  texture {{ pigment {{ rgb {} }} finish {{ ambient 1 diffuse 0 }} }}\n"
                    "#else\n  texture {{\n    pigment {{ {} }}\n    {}\n  }}\n#end\n",
-                   material_identifier(m), is_object ? 1 : 0,
-                   pigment_text(material, m, is_object), finish_text(material));
+                   material_identifier(m), is_object ? 1 : 0, pigment_text(material, m, is_object),
+                   finish_text(material));
   }
   inc.push_back('\n');
   std::vector<int> object_triangles(studio.object.triangles.size());
@@ -389,8 +396,8 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   for (const auto& shot : scene.shots) {
     const int count = subframes_for(scene, studio, shot, scale);
     (*subframes)[shot.index] = count;
-    if (!write_text_file(dir / (shot.name + ".pov"),
-                         shot_pov(scene, shot, canvas, count, samples), error) ||
+    if (!write_text_file(dir / (shot.name + ".pov"), shot_pov(scene, shot, canvas, count, samples),
+                         error) ||
         !write_text_file(dir / (shot.name + ".ini"),
                          shot_ini(shot, canvas, count, samples, false, focal_blur), error) ||
         !write_text_file(dir / (shot.name + "_mask.ini"),
@@ -464,8 +471,8 @@ bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
     reference::LinearImage image;
     if (!reference::read_linear_image(path, &image, error)) return false;
     if (image.width != canvas.width || image.height != canvas.height) {
-      *error = fmt::format("{} is {} x {}, expected {} x {}", path.filename().string(),
-                           image.width, image.height, canvas.width, canvas.height);
+      *error = fmt::format("{} is {} x {}, expected {} x {}", path.filename().string(), image.width,
+                           image.height, canvas.width, canvas.height);
       return false;
     }
     const float weight = static_cast<float>(reference::kCandelaPerBlenderUnit / frames.size());
@@ -487,7 +494,9 @@ bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
 
 }  // namespace
 
-std::unique_ptr<reference::Renderer> make_renderer() { return std::make_unique<PovrayRenderer>(); }
+std::unique_ptr<reference::Renderer> make_renderer() {
+  return std::make_unique<PovrayRenderer>();
+}
 
 bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
           int samples) {

@@ -31,8 +31,10 @@ class ScopedEnv {
     setenv(name, value.c_str(), 1);
   }
   ~ScopedEnv() {
-    if (old_) setenv(name_, old_->c_str(), 1);
-    else unsetenv(name_);
+    if (old_)
+      setenv(name_, old_->c_str(), 1);
+    else
+      unsetenv(name_);
   }
 
  private:
@@ -61,6 +63,31 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   EXPECT_NE(pov.find("focal_point"), std::string::npos);
 }
 
+TEST(PovrayEmit, TurningTableGetsMotionBlurSubframes) {
+  DiagnosticEngine diag;
+  auto scene = compile_scene_text(R"(rigc: 1
+object:
+  primitive: sphere
+  fit: {size: 20cm}
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm}
+  exposure: {aperture: f/8, shutter: 1/15, iso: 400}
+shots:
+  - turntable: {steps: 2, step: 90deg, speed: 30deg/s, camera: {distance: 60cm, height: 10cm}}
+)",
+                                  "test.yaml", ".", diag);
+  ASSERT_TRUE(scene);
+  TempDir dir;
+  std::string error;
+  ASSERT_TRUE(emit(*scene, dir.path(), 0.1, &error)) << error;
+  const std::string ini = read_text((dir.path() / "shot_000.ini").string());
+  EXPECT_NE(ini.find("Initial_Frame=1"), std::string::npos) << ini;
+  EXPECT_NE(ini.find("Final_Frame="), std::string::npos);
+  const std::string pov = read_text((dir.path() / "shot_000.pov").string());
+  EXPECT_NE(pov.find("RigcDelta = 0.0349"), std::string::npos) << pov;  // 30 deg/s over 1/15 s
+}
+
 TEST(PovrayRun, MissingExecutableNamesThePackage) {
   const ir::Scene scene = paper_scene();
   TempDir dir;
@@ -85,7 +112,8 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
   const fs::path wrapper = dir.path() / "bin" / "povray";
   rigc::testing::write_text(wrapper.string(),
                             "#!/bin/sh\ncase \"$1\" in shot_001*) echo broken >&2; exit 7;; esac\n"
-                            "exec " + real->string() + " \"$@\"\n");
+                            "exec " +
+                                real->string() + " \"$@\"\n");
   fs::permissions(wrapper, fs::perms::owner_all);
   ReferenceOptions options;
   options.output_dir = (dir.path() / "out").string();
@@ -97,7 +125,8 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
     std::ostringstream log;
     EXPECT_EQ(run(scene, options, log), 2);
     EXPECT_NE(log.str().find("shot_001: povray shot_001.ini failed with exit code 7"),
-              std::string::npos) << log.str();
+              std::string::npos)
+        << log.str();
     EXPECT_NE(log.str().find("render/shot_001.log"), std::string::npos) << log.str();
     EXPECT_TRUE(fs::exists(dir.path() / "out" / "images" / "shot_000.jpg"));
     EXPECT_FALSE(fs::exists(dir.path() / "out" / "images" / "shot_001.jpg"));

@@ -95,7 +95,8 @@ double mask_iou(const dslr::LinearFrame& a, const dslr::LinearFrame& b) {
 }
 
 // Mean luminance (cd/m²) of the pixels every backend calls object, away from the silhouette.
-double mean_object_luminance(const dslr::LinearFrame& frame, const std::vector<std::uint8_t>& mask) {
+double mean_object_luminance(const dslr::LinearFrame& frame,
+                             const std::vector<std::uint8_t>& mask) {
   double sum = 0, count = 0;
   for (size_t i = 0; i < mask.size(); ++i) {
     if (!mask[i]) continue;
@@ -168,10 +169,11 @@ void expect_agreement(ir::Scene scene, int shot_index, double scale) {
     const double iou = mask_iou(all[0].frame, all[i].frame);
     const double mean = mean_object_luminance(all[i].frame, common);
     const double stops = std::log2(mean / preview_mean);
-    std::printf("%s vs preview: IoU %.4f, centroid (%+.3f, %+.3f) px, object %.1f vs %.1f cd/m2 "
-                "(%+.3f stop)\n",
-                all[i].backend.c_str(), iou, stats.x - reference.x, stats.y - reference.y, mean,
-                preview_mean, stops);
+    std::printf(
+        "%s vs preview: IoU %.4f, centroid (%+.3f, %+.3f) px, object %.1f vs %.1f cd/m2 "
+        "(%+.3f stop)\n",
+        all[i].backend.c_str(), iou, stats.x - reference.x, stats.y - reference.y, mean,
+        preview_mean, stops);
     EXPECT_GE(iou, 0.97) << all[i].backend;
     EXPECT_NEAR(stats.x, reference.x, 1.0) << all[i].backend;
     EXPECT_NEAR(stats.y, reference.y, 1.0) << all[i].backend;
@@ -211,7 +213,8 @@ double edge_width_px(const dslr::DevelopResult& result) {
   const int w = result.width, h = result.height;
   std::vector<double> profile(w, 0.0);
   for (int y = h / 2 - 4; y <= h / 2 + 4; ++y) {
-    for (int x = 0; x < w; ++x) profile[x] += result.linear[(static_cast<size_t>(y) * w + x) * 3 + 1];
+    for (int x = 0; x < w; ++x)
+      profile[x] += result.linear[(static_cast<size_t>(y) * w + x) * 3 + 1];
   }
   // The plateau: the box's middle column; the left edge: search from the middle leftwards.
   const int middle = w / 2;

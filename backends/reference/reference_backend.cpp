@@ -35,7 +35,9 @@ std::string progress_line(int done, int total, const std::string& name, double s
 
 }  // namespace
 
-fs::path render_folder(const fs::path& run_dir) { return run_dir / "render"; }
+fs::path render_folder(const fs::path& run_dir) {
+  return run_dir / "render";
+}
 
 bool read_linear_image(const fs::path& path, LinearImage* image, std::string* error) {
   auto input = OIIO::ImageInput::open(path.string());
@@ -86,7 +88,8 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
   const fs::path run_dir = options.output_dir;
   const fs::path work_dir = render_folder(run_dir);
   std::error_code ec;
-  for (const fs::path& dir : {run_dir / "images", run_dir / "masks", run_dir / "sparse", work_dir}) {
+  for (const fs::path& dir :
+       {run_dir / "images", run_dir / "masks", run_dir / "sparse", work_dir}) {
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir)) {
       log << fmt::format("rigc: error: cannot create the output folder '{}': {}\n", dir.string(),
@@ -205,9 +208,8 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
     record.name = shot.name;
     record.key = key;
     record.render_ms = timing.total_ms;
-    record.stage_ms = {{"render", timing.render_ms},
-                       {"develop", timing.develop_ms},
-                       {"write", timing.write_ms}};
+    record.stage_ms = {
+        {"render", timing.render_ms}, {"develop", timing.develop_ms}, {"write", timing.write_ms}};
     record.files = {image, mask};
     manifest.record(record);
     // Saved after every shot, so an interrupted run resumes where it stopped.
@@ -218,8 +220,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
-      log << progress_line(done, static_cast<int>(shots.size()), shot.name,
-                           timing.total_ms / 1000)
+      log << progress_line(done, static_cast<int>(shots.size()), shot.name, timing.total_ms / 1000)
           << std::flush;
     } else {
       log << fmt::format("{}: rendered with {} in {:.2f} s\n", shot.name, renderer.name(),

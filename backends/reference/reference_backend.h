@@ -30,8 +30,8 @@ struct ShotTiming {
   double develop_ms = 0;  // the DSLR model
   double write_ms = 0;
   double total_ms = 0;
-  int subframes = 1;      // motion-blur sub-frames the renderer averaged (1: none, or native)
-  bool skipped = false;   // already in the manifest with the same inputs
+  int subframes = 1;     // motion-blur sub-frames the renderer averaged (1: none, or native)
+  bool skipped = false;  // already in the manifest with the same inputs
   bool failed = false;
 };
 

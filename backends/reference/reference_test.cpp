@@ -53,7 +53,8 @@ TEST(ReferenceProcess, RunsAnArgumentVectorWithoutAShell) {
       run_program({"echo", "$(touch pwned); touch pwned2", "`touch pwned3`"}, dir.path(), log);
   ASSERT_TRUE(result.started) << result.error;
   EXPECT_EQ(result.exit_code, 0);
-  EXPECT_EQ(rigc::testing::read_text(log.string()), "$(touch pwned); touch pwned2 `touch pwned3`\n");
+  EXPECT_EQ(rigc::testing::read_text(log.string()),
+            "$(touch pwned); touch pwned2 `touch pwned3`\n");
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "pwned"));
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "pwned2"));
 
