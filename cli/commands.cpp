@@ -15,6 +15,7 @@
 #include "backends/common/shots.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
+#include "eval/eval.h"
 #include "compiler/ir_json.h"
 #include "compiler/units.h"
 
@@ -238,6 +239,10 @@ const std::vector<Command>& commands() {
       {"compile", "compile a scene to a target (ir)", run_compile},
       {"render", "render every shot with a backend (preview)", run_render},
       {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
+      {"eval", "reconstruct a run with COLMAP and measure it against the ground truth",
+       eval::run_eval_command},
+      {"compare", "render with several backends and compare reconstruction accuracy",
+       eval::run_compare_command},
       {"version", "print the version", run_version},
   };
   return table;

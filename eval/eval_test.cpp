@@ -323,19 +323,5 @@ shots:
   EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");
 }
 
-// Manual runs while the CLI is not wired: RIGC_EVAL_ARGS="RUN -o DIR" and
-// --gtest_also_run_disabled_tests --gtest_filter=EvalManual.*
-TEST(EvalManual, DISABLED_Run) {
-  const char* env = std::getenv("RIGC_EVAL_ARGS");
-  if (!env) GTEST_SKIP();
-  std::vector<std::string> args = {"rigc eval"};
-  std::istringstream s(env);
-  std::string a;
-  while (s >> a) args.push_back(a);
-  const bool compare = args.size() > 1 && args[1] == "compare";
-  if (compare) args.erase(args.begin() + 1);
-  EXPECT_EQ(compare ? run_compare_command(args) : run_eval_command(args), 0);
-}
-
 }  // namespace
 }  // namespace rigc::eval
