@@ -13,6 +13,8 @@
 #include "analysis/coverage.h"
 #include "analysis/coverage_output.h"
 #include "backends/common/shots.h"
+#include "backends/cycles/cycles_backend.h"
+#include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "eval/eval.h"
@@ -130,16 +132,36 @@ int run_compile(std::vector<std::string> args) {
   std::string scene_path, target = "ir", output;
   bool no_geometry = false;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
-  app.add_option("--target,--emit", target, "what to emit")
-      ->check(CLI::IsMember({"ir"}))
+  int samples = 0;
+  double scale = 1.0;
+  app.add_option("--target,--emit", target, "what to emit: the IR as JSON, or scripts")
+      ->check(CLI::IsMember({"ir", "povray", "cycles"}))
       ->capture_default_str();
-  app.add_option("-o,--output", output, "output file (default: standard output)");
+  app.add_option("-o,--output", output,
+                 "output file for ir (default: standard output); folder for povray and cycles "
+                 "(default: out/<scene>/<target>/render)");
+  app.add_option("--scale", scale, "multiplies the sensor resolution")
+      ->check(CLI::Range(0.01, 4.0))
+      ->capture_default_str();
+  app.add_option("--samples", samples, "renderer samples per pixel (0: the backend's default)");
   app.add_flag("--no-geometry", no_geometry, "leave vertex and triangle arrays out of the IR");
   if (auto code = parse_options(app, args)) return *code;
 
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
+  if (target == "povray" || target == "cycles") {
+    if (output.empty()) output = (fs::path("out") / scene->name / target / "render").string();
+    std::string error;
+    const bool ok = target == "povray" ? povray::emit(*scene, output, scale, &error, samples)
+                                       : cycles::emit(*scene, output, scale, &error, samples);
+    if (!ok) {
+      std::cerr << "rigc: error: " << error << '\n';
+      return kExitUserError;
+    }
+    std::cout << fmt::format("{} files for '{}' in {}\n", target, scene->name, output);
+    return kExitOk;
+  }
   const std::string text = ir_to_json(*scene, !no_geometry).dump(1) + "\n";
   if (output.empty()) {
     std::cout << text;
@@ -159,9 +181,12 @@ int run_render(std::vector<std::string> args) {
   double scale = 1.0;
   std::uint64_t seed = 1;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
+  int samples = 0;
   app.add_option("--backend", backend, "renderer")
-      ->check(CLI::IsMember({"preview"}))
+      ->check(CLI::IsMember({"preview", "povray", "cycles"}))
       ->capture_default_str();
+  app.add_option("--samples", samples,
+                 "samples per pixel for povray and cycles (0: the backend's default)");
   app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
   app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 (default: all)");
   app.add_option("--scale", scale, "multiplies the sensor resolution, for quick looks")
@@ -181,6 +206,17 @@ int run_render(std::vector<std::string> args) {
     return kExitUserError;
   }
   if (output.empty()) output = (fs::path("out") / scene->name / backend).string();
+  if (backend != "preview") {
+    reference::ReferenceOptions options;
+    options.output_dir = output;
+    options.shots = *shots;
+    options.scale = scale;
+    options.seed = seed;
+    options.samples = samples;
+    options.progress_bar = isatty(STDERR_FILENO);
+    return backend == "povray" ? povray::run(*scene, options, std::cerr)
+                               : cycles::run(*scene, options, std::cerr);
+  }
   preview::RenderOptions options;
   options.output_dir = output;
   options.shots = *shots;
@@ -236,8 +272,8 @@ int run_version(std::vector<std::string> args) {
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"check", "check a scene and report errors and capture warnings", run_check},
-      {"compile", "compile a scene to a target (ir)", run_compile},
-      {"render", "render every shot with a backend (preview)", run_render},
+      {"compile", "compile a scene to a target (ir, povray, cycles)", run_compile},
+      {"render", "render every shot with a backend (preview, povray, cycles)", run_render},
       {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
       {"eval", "reconstruct a run with COLMAP and measure it against the ground truth",
        eval::run_eval_command},

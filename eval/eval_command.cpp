@@ -12,6 +12,8 @@
 #include "backends/common/files.h"
 #include "backends/common/manifest.h"
 #include "backends/common/shots.h"
+#include "backends/cycles/cycles_backend.h"
+#include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "eval/eval.h"
@@ -80,6 +82,20 @@ const std::vector<RenderBackend>& render_backends() {
          options.output_dir = run_dir;
          options.scale = scale;
          return preview::run_preview(scene, options, log);
+       }},
+      {"povray",
+       [](const ir::Scene& scene, const std::string& run_dir, double scale, std::ostream& log) {
+         reference::ReferenceOptions options;
+         options.output_dir = run_dir;
+         options.scale = scale;
+         return povray::run(scene, options, log);
+       }},
+      {"cycles",
+       [](const ir::Scene& scene, const std::string& run_dir, double scale, std::ostream& log) {
+         reference::ReferenceOptions options;
+         options.output_dir = run_dir;
+         options.scale = scale;
+         return cycles::run(scene, options, log);
        }},
   };
   return table;
