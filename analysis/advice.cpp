@@ -1,8 +1,9 @@
 #include "analysis/advice.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "dslr/exposure.h"
 
@@ -72,11 +73,11 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
   }
   // Exposure.
   if (clipped / visible > kWarnShare) {
-    diag.warning(shutter_loc,
-                 fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
-                             "(EV100 {:.1f}); shorten the shutter or stop down by one stop",
-                             100 * clipped / visible,
-                             dslr::ev100(n, camera.shutter_s, camera.iso)));
+    diag.warning(
+        shutter_loc,
+        fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
+                    "(EV100 {:.1f}); shorten the shutter or stop down by one stop",
+                    100 * clipped / visible, dslr::ev100(n, camera.shutter_s, camera.iso)));
   }
   if (dark / visible > kWarnShare) {
     diag.warning(shutter_loc,
@@ -95,11 +96,11 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
         camera, 1.0, std::abs(shot.turntable_velocity_rad_s), radius, depth);
     if (blur_px > 1) {
       last_line = shot.loc.line;
-      diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} px "
-                                         "during the {:g} s exposure; stop the table for each "
-                                         "shot or use 1/{:.0f} s or shorter",
-                                         blur_px, camera.shutter_s,
-                                         std::ceil(blur_px / camera.shutter_s)));
+      diag.warning(shot.loc,
+                   fmt::format("the turning table smears the object by up to {:.1f} px "
+                               "during the {:g} s exposure; stop the table for each "
+                               "shot or use 1/{:.0f} s or shorter",
+                               blur_px, camera.shutter_s, std::ceil(blur_px / camera.shutter_s)));
     }
   }
   // Faces never seen (the base resting on the table cannot be, so it does not count).
@@ -115,17 +116,21 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
     unseen += coverage.face_area_m2[f];
     const auto& t = mesh.triangles[f];
     const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>();
-    unseen_normal += (mesh.positions[t[1]].cast<double>() - a)
-                         .cross(mesh.positions[t[2]].cast<double>() - a) / 2;
+    unseen_normal +=
+        (mesh.positions[t[1]].cast<double>() - a).cross(mesh.positions[t[2]].cast<double>() - a) /
+        2;
   }
   const double visible_total = std::max(coverage.total_area_m2 - resting, 1e-30);
   if (!scene.shots.empty() && unseen / visible_total > kWarnShare) {
     std::string fix = "add shots from the directions the red faces face";
     if (unseen_normal.norm() > 0.3 * unseen) {
       const double elevation = std::asin(std::clamp(unseen_normal.normalized().z(), -1.0, 1.0));
-      if (elevation > 0.35) fix = "add a ring at a higher elevation, e.g. 60deg";
-      else if (elevation < -0.35) fix = "add a ring from below (elevation -30deg) or turn the "
-                                        "object over for a second pass";
+      if (elevation > 0.35)
+        fix = "add a ring at a higher elevation, e.g. 60deg";
+      else if (elevation < -0.35)
+        fix =
+            "add a ring from below (elevation -30deg) or turn the "
+            "object over for a second pass";
     }
     diag.warning(scene.shots.front().loc,
                  fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",

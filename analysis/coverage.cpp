@@ -20,12 +20,12 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 
-constexpr int kBlurBins = 1000;        // histogram of blur / max_blur, 0..10
+constexpr int kBlurBins = 1000;  // histogram of blur / max_blur, 0..10
 constexpr double kBlurBinWidth = 0.01;
 
 struct ShotSums {
-  double visible = 0, fresh = 0, overlap = 0, out_of_focus = 0, clipped = 0, dark = 0,
-         oblique = 0, coarse = 0;
+  double visible = 0, fresh = 0, overlap = 0, out_of_focus = 0, clipped = 0, dark = 0, oblique = 0,
+         coarse = 0;
   double nearest = 1e30;
   std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
 };
@@ -41,10 +41,9 @@ std::vector<float> face_albedo(const ir::Scene& scene, const preview::StudioScen
       color = color.cwiseProduct(studio.textures[material.texture].levels.back().texels[0]);
     }
     // A footprint far larger than the pattern gives the pattern's mean.
-    const float pattern_mean =
-        preview::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
-    material_albedo.push_back(
-        static_cast<float>(luminance(color.cast<double>()) * pattern_mean * (1 - material.metallic)));
+    const float pattern_mean = preview::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
+    material_albedo.push_back(static_cast<float>(luminance(color.cast<double>()) * pattern_mean *
+                                                 (1 - material.metallic)));
   }
   std::vector<float> albedo(studio.object.triangles.size(), 0.5f);
   for (size_t f = 0; f < albedo.size(); ++f) {
@@ -119,86 +118,89 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
     usable_by_shot[s].assign(face_count, 0);
 
     tbb::enumerable_thread_specific<ShotSums> sums;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, face_count, 2048),
-                      [&](const tbb::blocked_range<size_t>& range) {
-      ShotSums& sum = sums.local();
-      for (size_t f = range.begin(); f != range.end(); ++f) {
-        seen_now[f] = 0;
-        const Vector3d to_eye = eye_object[s] - center[f];
-        if (normal[f].dot(to_eye) <= 0) continue;
-        const Vector3d p = rotation * center[f] + translation;
-        if (p.z() <= 0.01) continue;
-        const double u = canvas.fx * p.x() / p.z() + canvas.cx;
-        const double v = canvas.fy * p.y() / p.z() + canvas.cy;
-        if (u < 0 || v < 0 || u >= canvas.width || v >= canvas.height) continue;
-        const size_t pixel = static_cast<size_t>(v) * canvas.width + static_cast<size_t>(u);
-        // The face's own triangle at its centre pixel, or a surface at the same depth there
-        // (faces smaller than a pixel of the buffer).
-        const bool visible = buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
-                             p.z() <= buffer.depth_m[pixel] * 1.004 + 0.0015;
-        if (!visible) continue;
-        seen_now[f] = 1;
-        const double area = result.face_area_m2[f];
-        sum.visible += area;
-        if (result.views[f] == 0) sum.fresh += area;
-        if (seen_previous[f]) sum.overlap += area;
-        if (result.views[f] == 0) result.first_seen[f] = static_cast<std::uint16_t>(s);
-        if (result.views[f] == 1) result.second_seen[f] = static_cast<std::uint16_t>(s);
-        sum.nearest = std::min(sum.nearest, p.z());
-        ++result.views[f];
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, face_count, 2048),
+        [&](const tbb::blocked_range<size_t>& range) {
+          ShotSums& sum = sums.local();
+          for (size_t f = range.begin(); f != range.end(); ++f) {
+            seen_now[f] = 0;
+            const Vector3d to_eye = eye_object[s] - center[f];
+            if (normal[f].dot(to_eye) <= 0) continue;
+            const Vector3d p = rotation * center[f] + translation;
+            if (p.z() <= 0.01) continue;
+            const double u = canvas.fx * p.x() / p.z() + canvas.cx;
+            const double v = canvas.fy * p.y() / p.z() + canvas.cy;
+            if (u < 0 || v < 0 || u >= canvas.width || v >= canvas.height) continue;
+            const size_t pixel = static_cast<size_t>(v) * canvas.width + static_cast<size_t>(u);
+            // The face's own triangle at its centre pixel, or a surface at the same depth there
+            // (faces smaller than a pixel of the buffer).
+            const bool visible = buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
+                                 p.z() <= buffer.depth_m[pixel] * 1.004 + 0.0015;
+            if (!visible) continue;
+            seen_now[f] = 1;
+            const double area = result.face_area_m2[f];
+            sum.visible += area;
+            if (result.views[f] == 0) sum.fresh += area;
+            if (seen_previous[f]) sum.overlap += area;
+            if (result.views[f] == 0) result.first_seen[f] = static_cast<std::uint16_t>(s);
+            if (result.views[f] == 1) result.second_seen[f] = static_cast<std::uint16_t>(s);
+            sum.nearest = std::min(sum.nearest, p.z());
+            ++result.views[f];
 
-        // Footprint at full resolution.
-        const auto& t = mesh.triangles[f];
-        std::array<Eigen::Vector2d, 3> corner;
-        for (int k = 0; k < 3; ++k) {
-          const Vector3d q = rotation * mesh.positions[t[k]].cast<double>() + translation;
-          corner[k] = {camera.fx * q.x() / q.z(), camera.fy * q.y() / q.z()};
-        }
-        const Eigen::Vector2d e1 = corner[1] - corner[0], e2 = corner[2] - corner[0];
-        const double footprint_px = std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 2;
-        const double pixels_per_mm2 = footprint_px / std::max(area * 1e6, 1e-12);
-        const double cos_view = normal[f].dot(to_eye.normalized());
-        const double blur_px =
-            dslr::coc_diameter_m(camera.focal_length_m, camera.aperture_f_number,
-                                 shot.focus_distance_m, p.z()) /
-            pixel_pitch_m;
-        const int bin = std::min(kBlurBins, static_cast<int>(blur_px / settings.max_blur_px /
-                                                             kBlurBinWidth));
-        sum.blur_histogram[bin] += area;
-        const Vector3f world_center = (world_rotation * center[f] + world_translation).cast<float>();
-        const Vector3f world_normal = (world_rotation * normal[f]).cast<float>();
-        double illuminance = scene.studio.ambient_lx;
-        for (const auto& light : scene.studio.lights) {
-          illuminance += luminance(
-              preview::light_illuminance(light, world_center, world_normal).cast<double>());
-        }
-        const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
+            // Footprint at full resolution.
+            const auto& t = mesh.triangles[f];
+            std::array<Eigen::Vector2d, 3> corner;
+            for (int k = 0; k < 3; ++k) {
+              const Vector3d q = rotation * mesh.positions[t[k]].cast<double>() + translation;
+              corner[k] = {camera.fx * q.x() / q.z(), camera.fy * q.y() / q.z()};
+            }
+            const Eigen::Vector2d e1 = corner[1] - corner[0], e2 = corner[2] - corner[0];
+            const double footprint_px = std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 2;
+            const double pixels_per_mm2 = footprint_px / std::max(area * 1e6, 1e-12);
+            const double cos_view = normal[f].dot(to_eye.normalized());
+            const double blur_px =
+                dslr::coc_diameter_m(camera.focal_length_m, camera.aperture_f_number,
+                                     shot.focus_distance_m, p.z()) /
+                pixel_pitch_m;
+            const int bin = std::min(
+                kBlurBins, static_cast<int>(blur_px / settings.max_blur_px / kBlurBinWidth));
+            sum.blur_histogram[bin] += area;
+            const Vector3f world_center =
+                (world_rotation * center[f] + world_translation).cast<float>();
+            const Vector3f world_normal = (world_rotation * normal[f]).cast<float>();
+            double illuminance = scene.studio.ambient_lx;
+            for (const auto& light : scene.studio.lights) {
+              illuminance += luminance(
+                  preview::light_illuminance(light, world_center, world_normal).cast<double>());
+            }
+            const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
 
-        const bool in_focus = blur_px <= settings.max_blur_px;
-        const bool clipped = signal > settings.max_signal;
-        const bool dark = signal < settings.min_signal;
-        const bool oblique = cos_view < cos_max_angle;
-        const bool coarse = pixels_per_mm2 < settings.min_pixels_per_mm2;
-        if (!in_focus) sum.out_of_focus += area;
-        if (clipped) sum.clipped += area;
-        if (dark) sum.dark += area;
-        if (oblique) sum.oblique += area;
-        if (coarse) sum.coarse += area;
-        if (!in_focus || clipped || dark || oblique || coarse) continue;
+            const bool in_focus = blur_px <= settings.max_blur_px;
+            const bool clipped = signal > settings.max_signal;
+            const bool dark = signal < settings.min_signal;
+            const bool oblique = cos_view < cos_max_angle;
+            const bool coarse = pixels_per_mm2 < settings.min_pixels_per_mm2;
+            if (!in_focus) sum.out_of_focus += area;
+            if (clipped) sum.clipped += area;
+            if (dark) sum.dark += area;
+            if (oblique) sum.oblique += area;
+            if (coarse) sum.coarse += area;
+            if (!in_focus || clipped || dark || oblique || coarse) continue;
 
-        usable_by_shot[s][f] = 1;
-        ++result.usable_views[f];
-        if (result.reconstructable[f]) continue;
-        const Vector3d ray = to_eye.normalized();
-        for (int earlier = 0; earlier < s; ++earlier) {
-          if (!usable_by_shot[earlier][f]) continue;
-          if (ray.dot((eye_object[earlier] - center[f]).normalized()) <= cos_min_triangulation) {
-            result.reconstructable[f] = 1;
-            break;
+            usable_by_shot[s][f] = 1;
+            ++result.usable_views[f];
+            if (result.reconstructable[f]) continue;
+            const Vector3d ray = to_eye.normalized();
+            for (int earlier = 0; earlier < s; ++earlier) {
+              if (!usable_by_shot[earlier][f]) continue;
+              if (ray.dot((eye_object[earlier] - center[f]).normalized()) <=
+                  cos_min_triangulation) {
+                result.reconstructable[f] = 1;
+                break;
+              }
+            }
           }
-        }
-      }
-    });
+        });
 
     ShotSums total;
     for (const ShotSums& part : sums) {

@@ -14,8 +14,8 @@ namespace rigc::analysis {
 struct ShotCoverage {
   int shot = 0;
   double visible_area_m2 = 0;
-  double new_area_m2 = 0;             // first seen in this shot
-  double overlap_with_previous = 0;   // share of this shot's visible area the previous shot saw
+  double new_area_m2 = 0;            // first seen in this shot
+  double overlap_with_previous = 0;  // share of this shot's visible area the previous shot saw
   // Cumulative shares of the surface area after this shot.
   double seen_1 = 0, seen_2 = 0, seen_3 = 0, reconstructable = 0;
   // Shares of this shot's visible area.
@@ -25,11 +25,11 @@ struct ShotCoverage {
 };
 
 struct CoverageResult {
-  std::vector<double> face_area_m2;        // object frame
-  std::vector<std::uint16_t> views;        // shots that see each face
+  std::vector<double> face_area_m2;         // object frame
+  std::vector<std::uint16_t> views;         // shots that see each face
   std::vector<std::uint16_t> usable_views;  // of those, views SfM can use
   std::vector<std::uint8_t> reconstructable;
-  std::vector<std::uint8_t> resting;       // faces lying on the turntable: no camera can see them
+  std::vector<std::uint8_t> resting;  // faces lying on the turntable: no camera can see them
   // The shots in which each face was seen the first and second time (kNever if not).
   static constexpr std::uint16_t kNever = 0xFFFF;
   std::vector<std::uint16_t> first_seen, second_seen;

@@ -1,11 +1,11 @@
 #include "analysis/coverage_output.h"
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include <cmath>
 #include <cstring>
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -169,14 +169,14 @@ bool write_png(const fs::path& path, const std::vector<float>& rgb, int width, i
 }
 
 // A camera orbiting the object at `azimuth`/`elevation` (radians), framing it whole.
-ir::Mat4 picture_camera(const ir::Scene& scene, const preview::StudioScene& studio,
-                        double azimuth, double elevation, double horizontal_fov) {
+ir::Mat4 picture_camera(const ir::Scene& scene, const preview::StudioScene& studio, double azimuth,
+                        double elevation, double horizontal_fov) {
   const ir::Vec3 center =
       (ir::world_from_object(scene, 0) * studio.object_center.homogeneous()).head<3>();
   const double distance = studio.object_radius / std::sin(horizontal_fov / 2 * 0.6);
-  const ir::Vec3 eye = center + distance * ir::Vec3(std::cos(elevation) * std::cos(azimuth),
-                                                    std::cos(elevation) * std::sin(azimuth),
-                                                    std::sin(elevation));
+  const ir::Vec3 eye =
+      center + distance * ir::Vec3(std::cos(elevation) * std::cos(azimuth),
+                                   std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
   const ir::Vec3 forward = (center - eye).normalized();
   const ir::Vec3 right = forward.cross(ir::Vec3::UnitZ()).normalized();
   ir::Mat4 m = ir::Mat4::Identity();
@@ -199,16 +199,16 @@ Vector3f heat_color(int views, int max_views) {
   if (views <= 0) return {1, 1, 1};
   const float t = std::clamp((views - 1.0f) / std::max(1, max_views - 1), 0.0f, 1.0f);
   // Blue -> cyan -> yellow -> red.
-  const Vector3f stops[4] = {{0.05f, 0.1f, 0.8f}, {0.05f, 0.7f, 0.8f}, {0.95f, 0.85f, 0.1f},
-                             {0.85f, 0.05f, 0.05f}};
+  const Vector3f stops[4] = {
+      {0.05f, 0.1f, 0.8f}, {0.05f, 0.7f, 0.8f}, {0.95f, 0.85f, 0.1f}, {0.85f, 0.05f, 0.05f}};
   const float x = t * 3;
   const int i = std::min(2, static_cast<int>(x));
   return stops[i] + (stops[i + 1] - stops[i]) * (x - i);
 }
 
 bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& studio,
-                            const CoverageResult& coverage, const fs::path& dir,
-                            int picture_width, std::string* error) {
+                            const CoverageResult& coverage, const fs::path& dir, int picture_width,
+                            std::string* error) {
   std::error_code ec;
   fs::create_directories(dir / "pictures", ec);
   if (ec) {
@@ -235,8 +235,9 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
   const double fov = 2 * std::atan(0.5 * scene.camera.sensor_width_m / scene.camera.focal_length_m);
   const int width = picture_width;
   const int height = picture_width * 2 / 3;
-  request.canvas = {width, height, width / (2 * std::tan(fov / 2)),
-                    width / (2 * std::tan(fov / 2)), width / 2.0, height / 2.0};
+  request.canvas = {
+      width,       height,      width / (2 * std::tan(fov / 2)), width / (2 * std::tan(fov / 2)),
+      width / 2.0, height / 2.0};
   struct View {
     const char* name;
     double azimuth_deg, elevation_deg;
@@ -261,8 +262,8 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
       colors[f] = paper_color(views_so_far);
     }
     const auto rgb = preview::render_face_colors(scene, studio, request, colors);
-    if (!write_png(dir / "pictures" / fmt::format("after_{}.png", scene.shots[s].name), rgb,
-                   width, height, error)) {
+    if (!write_png(dir / "pictures" / fmt::format("after_{}.png", scene.shots[s].name), rgb, width,
+                   height, error)) {
       return false;
     }
   }
@@ -283,13 +284,13 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
                      {"reconstructable", reconstructable_area / coverage.total_area_m2},
                      {"resting_on_turntable", resting_area / coverage.total_area_m2},
                      {"blur_ratio_95", coverage.blur_ratio_95}};
-  json["thresholds"] = {{"min_pixels_per_mm2", scene.coverage.min_pixels_per_mm2},
-                        {"max_view_angle_deg", scene.coverage.max_view_angle_rad * 180 / M_PI},
-                        {"max_blur_px", scene.coverage.max_blur_px},
-                        {"min_triangulation_angle_deg",
-                         scene.coverage.min_triangulation_angle_rad * 180 / M_PI},
-                        {"min_signal", scene.coverage.min_signal},
-                        {"max_signal", scene.coverage.max_signal}};
+  json["thresholds"] = {
+      {"min_pixels_per_mm2", scene.coverage.min_pixels_per_mm2},
+      {"max_view_angle_deg", scene.coverage.max_view_angle_rad * 180 / M_PI},
+      {"max_blur_px", scene.coverage.max_blur_px},
+      {"min_triangulation_angle_deg", scene.coverage.min_triangulation_angle_rad * 180 / M_PI},
+      {"min_signal", scene.coverage.min_signal},
+      {"max_signal", scene.coverage.max_signal}};
   nlohmann::json shots = nlohmann::json::array();
   for (const auto& shot : coverage.shots) {
     shots.push_back({{"shot", scene.shots[shot.shot].name},

@@ -55,7 +55,8 @@ studio:
 camera:
   body: canon-6d
   lens: {focal_length: 50mm}
-  exposure: )" + exposure + "\n" + extra_camera + "shots:\n" + shots;
+  exposure: )" +
+         exposure + "\n" + extra_camera + "shots:\n" + shots;
 }
 
 const std::string kStatue = "  primitive: {shape: statue, detail: 5}\n  fit: {height: 30cm}";
@@ -73,10 +74,10 @@ TEST(Coverage, SphereSeenFromOneCameraMatchesTheCapArea) {
   const double expected = (1 - 0.05 / 0.45) / 2;
   EXPECT_NEAR(a.coverage.shots[0].seen_1, expected, 0.01);
   // Two opposite cameras see two such caps, and no face twice.
-  Analysed b = analyse(scene_text(
-      sphere, kGoodExposure,
-      "  - pose: {position: [0, -0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"
-      "  - pose: {position: [0, 0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"));
+  Analysed b =
+      analyse(scene_text(sphere, kGoodExposure,
+                         "  - pose: {position: [0, -0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"
+                         "  - pose: {position: [0, 0.45m, 0.8m], look_at: [0, 0, 0.8m]}\n"));
   EXPECT_NEAR(b.coverage.shots[1].seen_1, 2 * expected, 0.02);
   EXPECT_NEAR(b.coverage.shots[1].seen_2, 0.0, 1e-9);
   EXPECT_NEAR(b.coverage.shots[1].overlap_with_previous, 0.0, 1e-9);
@@ -159,8 +160,7 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
   };
   for (const auto& c : cases) {
     Analysed a = analyse(scene_text(kStatue, c.exposure, c.shots, c.extra_camera));
-    EXPECT_NE(a.warnings.find(c.expected), std::string::npos)
-        << c.name << ":\n" << a.warnings;
+    EXPECT_NE(a.warnings.find(c.expected), std::string::npos) << c.name << ":\n" << a.warnings;
   }
 }
 
@@ -171,11 +171,10 @@ TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
       "  - turntable: {steps: 4, step: 90deg, camera: {distance: 60cm, height: 20cm}}\n"));
   const preview::StudioScene studio = preview::prepare_studio_scene(a.scene);
   std::string error;
-  ASSERT_TRUE(write_coverage_outputs(a.scene, studio, a.coverage, dir.path(), 96, &error))
-      << error;
-  for (const char* file : {"coverage.ply", "coverage.glb", "views.ply", "views.glb",
-                           "coverage.json", "pictures/view_front.png",
-                           "pictures/after_shot_003.png"}) {
+  ASSERT_TRUE(write_coverage_outputs(a.scene, studio, a.coverage, dir.path(), 96, &error)) << error;
+  for (const char* file :
+       {"coverage.ply", "coverage.glb", "views.ply", "views.glb", "coverage.json",
+        "pictures/view_front.png", "pictures/after_shot_003.png"}) {
     EXPECT_TRUE(fs::exists(dir.path() / file)) << file;
   }
   // The GLB and PLY load back with one face per box triangle.

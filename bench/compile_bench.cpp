@@ -2,10 +2,10 @@
 // million triangles compiles in under 1 s on the 2-core reference machine.
 // Run: ./build/bench/compile_bench  (prints time per compile and the process's peak memory)
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 #include <sys/resource.h>
 
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 
 #include "compiler/frontend.h"

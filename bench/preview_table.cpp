@@ -3,14 +3,14 @@
 //   the same at 1280 x 853: <= 0.1 s per shot; growth with a 1M-triangle mesh; peak memory < 2 GB.
 // Usage: preview_table [SCENE] [--full] [--shots N]
 //   without --full only the 1280 px rows run (the full-resolution row takes minutes on 2 cores).
+#include <fmt/format.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
-#include <fmt/format.h>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -95,9 +95,12 @@ int main(int argc, char** argv) {
   bool full = false;
   int shots = 18;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--full")) full = true;
-    else if (!std::strcmp(argv[i], "--shots") && i + 1 < argc) shots = std::atoi(argv[++i]);
-    else scene_path = argv[i];
+    if (!std::strcmp(argv[i], "--full"))
+      full = true;
+    else if (!std::strcmp(argv[i], "--shots") && i + 1 < argc)
+      shots = std::atoi(argv[++i]);
+    else
+      scene_path = argv[i];
   }
   std::vector<Row> rows;
   const rigc::ir::Scene scene = load(scene_path, 0);
@@ -109,8 +112,8 @@ int main(int argc, char** argv) {
   rows.push_back(run(fmt::format("1280 px, {} tris", big.object.mesh.triangles.size()), big,
                      scale_1280, shots));
   if (full) {
-    rows.push_back(run(fmt::format("full res, {} tris", scene.object.mesh.triangles.size()),
-                       scene, 1.0, shots));
+    rows.push_back(run(fmt::format("full res, {} tris", scene.object.mesh.triangles.size()), scene,
+                       1.0, shots));
   }
   std::cout << fmt::format("{:<24} {:>5} {:>9} {:>9}", "run", "shots", "total s", "s/shot");
   for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);

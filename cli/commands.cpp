@@ -1,13 +1,13 @@
 #include "cli/commands.h"
 
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-
-#include <unistd.h>
 
 #include "analysis/advice.h"
 #include "analysis/coverage.h"
@@ -17,9 +17,9 @@
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
-#include "eval/eval.h"
 #include "compiler/ir_json.h"
 #include "compiler/units.h"
+#include "eval/eval.h"
 
 namespace rigc::cli {
 namespace {
@@ -121,7 +121,8 @@ int run_check(std::vector<std::string> args) {
       100 * (scene->object.bounds_max_object.x() - scene->object.bounds_min_object.x()),
       100 * (scene->object.bounds_max_object.y() - scene->object.bounds_min_object.y()),
       100 * (scene->object.bounds_max_object.z() - scene->object.bounds_min_object.z()),
-      c.model.rfind(c.make, 0) == 0 ? c.model : c.make + " " + c.model, c.focal_length_m * 1000, format_quantity(c.aperture_f_number, QuantityKind::kFNumber),
+      c.model.rfind(c.make, 0) == 0 ? c.model : c.make + " " + c.model, c.focal_length_m * 1000,
+      format_quantity(c.aperture_f_number, QuantityKind::kFNumber),
       format_quantity(c.shutter_s, QuantityKind::kTime), c.iso, scene->studio.lights.size(),
       diag.warning_count(), diag.warning_count() == 1 ? "" : "s");
   return kExitOk;
@@ -199,8 +200,8 @@ int run_render(std::vector<std::string> args) {
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
   std::string error;
-  auto shots = backends::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()),
-                                              &error);
+  auto shots =
+      backends::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()), &error);
   if (!shots) {
     std::cerr << "rigc: error: --shots: " << error << '\n';
     return kExitUserError;
@@ -315,9 +316,9 @@ int run_main(std::vector<std::string> args) {
   std::vector<std::string> names;
   for (const auto& c : commands()) names.push_back(c.name);
   std::string suggestion = closest_match(verb, names);
-  std::cerr << fmt::format("rigc: error: unknown command '{}'{}\n\n{}", verb,
-                           suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion),
-                           usage());
+  std::cerr << fmt::format(
+      "rigc: error: unknown command '{}'{}\n\n{}", verb,
+      suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion), usage());
   return kExitUserError;
 }
 

@@ -1,8 +1,9 @@
 #include "compiler/check.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
-#include <fmt/format.h>
 #include <numbers>
 #include <set>
 
@@ -101,9 +102,9 @@ class Checker {
     if (range) {
       bool below = range->min_exclusive ? value <= range->min : value < range->min;
       if (below || value > range->max) {
-        error(node, fmt::format("{} {} is outside {}..{}", what, format_quantity(value, kind),
-                                format_quantity(range->min, kind),
-                                format_quantity(range->max, kind)));
+        error(node,
+              fmt::format("{} {} is outside {}..{}", what, format_quantity(value, kind),
+                          format_quantity(range->min, kind), format_quantity(range->max, kind)));
         return std::nullopt;
       }
     }
@@ -148,7 +149,10 @@ class Checker {
     bool ok = true;
     for (int i = 0; i < 3; ++i) {
       auto v = quantity(node[i], kind, what, range);
-      if (v) result[i] = *v; else ok = false;
+      if (v)
+        result[i] = *v;
+      else
+        ok = false;
     }
     if (!ok) return std::nullopt;
     return result;
@@ -202,8 +206,9 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
   scene.base_dir = base_dir_;
   scene.name = fs::path(file_).stem().string();
   if (!root.IsMap()) {
-    diag_.error({file_, 1, 1}, "a scene file must be a mapping with the keys rigc, object, camera "
-                               "and shots");
+    diag_.error({file_, 1, 1},
+                "a scene file must be a mapping with the keys rigc, object, camera "
+                "and shots");
     return std::nullopt;
   }
   check_keys(root, {"rigc", "name", "object", "studio", "camera", "shots", "coverage"},
@@ -252,8 +257,7 @@ void Checker::read_coverage(const YAML::Node& node, spec::SceneSpec& scene) {
     if (auto v = quantity(node[key], kind, key, range)) out = *v;
   };
   read("min_pixels_per_mm2", QuantityKind::kNumber, {0, 1e6}, coverage.min_pixels_per_mm2);
-  read("max_view_angle", QuantityKind::kAngle, {1 * kDeg, 90 * kDeg},
-       coverage.max_view_angle_rad);
+  read("max_view_angle", QuantityKind::kAngle, {1 * kDeg, 90 * kDeg}, coverage.max_view_angle_rad);
   read("max_blur", QuantityKind::kNumber, {0.1, 1000}, coverage.max_blur_px);
   read("min_triangulation_angle", QuantityKind::kAngle, {0, 90 * kDeg},
        coverage.min_triangulation_angle_rad);
@@ -270,14 +274,14 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
   spec::ObjectSpec& object = scene.object;
   object.loc = loc(node);
   if (!expect_map(node, "object")) return;
-  check_keys(node,
-             {"mesh", "primitive", "up", "fit", "scale", "rotate", "translate", "surface"},
+  check_keys(node, {"mesh", "primitive", "up", "fit", "scale", "rotate", "translate", "surface"},
              "object");
   const bool has_mesh = static_cast<bool>(node["mesh"]);
   const bool has_primitive = static_cast<bool>(node["primitive"]);
   if (has_mesh == has_primitive) {
-    error(node, "object needs exactly one of 'mesh' (a model file) or 'primitive' (sphere, box, "
-                "cylinder, statue)");
+    error(node,
+          "object needs exactly one of 'mesh' (a model file) or 'primitive' (sphere, box, "
+          "cylinder, statue)");
   }
   if (has_mesh) {
     if (auto path = scalar(node["mesh"], "mesh")) {
@@ -324,10 +328,10 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
       if (auto name = scalar(shape, "primitive shape")) {
         if (!primitive_from_name(*name)) {
           std::string suggestion = closest_match(*name, primitive_names());
-          error(shape, fmt::format("unknown primitive '{}'{}", *name,
-                                   suggestion.empty()
-                                       ? " (expected sphere, box, cylinder or statue)"
-                                       : fmt::format("; did you mean '{}'?", suggestion)));
+          error(shape,
+                fmt::format("unknown primitive '{}'{}", *name,
+                            suggestion.empty() ? " (expected sphere, box, cylinder or statue)"
+                                               : fmt::format("; did you mean '{}'?", suggestion)));
         } else {
           object.primitive = spec::Located<std::string>{*name, loc(shape)};
         }
@@ -368,8 +372,8 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
       if (auto s = vec3(node["scale"], QuantityKind::kNumber, "scale", Range{0, 1e6, true})) {
         object.scale = *s;
       }
-    } else if (auto s = quantity(node["scale"], QuantityKind::kNumber, "scale",
-                                 Range{0, 1e6, true})) {
+    } else if (auto s =
+                   quantity(node["scale"], QuantityKind::kNumber, "scale", Range{0, 1e6, true})) {
       object.scale = ir::Vec3::Constant(*s);
     }
   }
@@ -390,10 +394,14 @@ void Checker::read_surface(const YAML::Node& node, spec::ObjectSpec& object) {
   if (node["pattern"]) {
     if (auto name = scalar(node["pattern"], "pattern")) {
       const std::vector<std::string> names = {"none", "speckle", "noise", "checker"};
-      if (*name == "none") object.pattern.kind = ir::PatternKind::kNone;
-      else if (*name == "speckle") object.pattern.kind = ir::PatternKind::kSpeckle;
-      else if (*name == "noise") object.pattern.kind = ir::PatternKind::kNoise;
-      else if (*name == "checker") object.pattern.kind = ir::PatternKind::kChecker;
+      if (*name == "none")
+        object.pattern.kind = ir::PatternKind::kNone;
+      else if (*name == "speckle")
+        object.pattern.kind = ir::PatternKind::kSpeckle;
+      else if (*name == "noise")
+        object.pattern.kind = ir::PatternKind::kNoise;
+      else if (*name == "checker")
+        object.pattern.kind = ir::PatternKind::kChecker;
       else {
         std::string suggestion = closest_match(*name, names);
         error(node["pattern"],
@@ -404,8 +412,8 @@ void Checker::read_surface(const YAML::Node& node, spec::ObjectSpec& object) {
     }
   }
   if (node["scale"]) {
-    if (auto v = quantity(node["scale"], QuantityKind::kLength, "pattern scale",
-                          Range{0.0001, 1})) {
+    if (auto v =
+            quantity(node["scale"], QuantityKind::kLength, "pattern scale", Range{0.0001, 1})) {
       object.pattern.scale_m = *v;
     }
   }
@@ -443,8 +451,8 @@ void Checker::read_studio(const YAML::Node& node, spec::SceneSpec& scene) {
         }
       }
       if (table["height"]) {
-        if (auto v = quantity(table["height"], QuantityKind::kLength, "turntable height",
-                              Range{0, 5})) {
+        if (auto v =
+                quantity(table["height"], QuantityKind::kLength, "turntable height", Range{0, 5})) {
           studio.turntable.height_m = *v;
         }
       }
@@ -500,15 +508,16 @@ void Checker::read_studio(const YAML::Node& node, spec::SceneSpec& scene) {
   }
   if (const YAML::Node lights = node["lights"]) {
     if (!lights.IsSequence()) {
-      error(lights, "lights must be a list, e.g. - {type: point, position: [1m, -1m, 1.5m], "
-                    "power: 200W}");
+      error(lights,
+            "lights must be a list, e.g. - {type: point, position: [1m, -1m, 1.5m], "
+            "power: 200W}");
     } else {
       for (const auto& light : lights) read_light(light, scene);
     }
   }
   if (node["ambient"]) {
-    if (auto v = quantity(node["ambient"], QuantityKind::kIlluminance, "ambient",
-                          Range{0, 200000})) {
+    if (auto v =
+            quantity(node["ambient"], QuantityKind::kIlluminance, "ambient", Range{0, 200000})) {
       studio.ambient_lx = *v;
     }
   }
@@ -534,10 +543,14 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
   auto type = scalar(node["type"], "light type");
   if (!type) return;
   const std::vector<std::string> types = {"point", "spot", "directional", "area"};
-  if (*type == "point") light.type = ir::LightType::kPoint;
-  else if (*type == "spot") light.type = ir::LightType::kSpot;
-  else if (*type == "directional") light.type = ir::LightType::kDirectional;
-  else if (*type == "area") light.type = ir::LightType::kArea;
+  if (*type == "point")
+    light.type = ir::LightType::kPoint;
+  else if (*type == "spot")
+    light.type = ir::LightType::kSpot;
+  else if (*type == "directional")
+    light.type = ir::LightType::kDirectional;
+  else if (*type == "area")
+    light.type = ir::LightType::kArea;
   else {
     std::string suggestion = closest_match(*type, types);
     error(node["type"],
@@ -548,7 +561,9 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
   }
   std::vector<std::string> allowed = {"type", "temperature"};
   switch (light.type) {
-    case ir::LightType::kPoint: allowed.insert(allowed.end(), {"position", "power"}); break;
+    case ir::LightType::kPoint:
+      allowed.insert(allowed.end(), {"position", "power"});
+      break;
     case ir::LightType::kSpot:
       allowed.insert(allowed.end(),
                      {"position", "power", "direction", "look_at", "angle", "blend"});
@@ -568,7 +583,8 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
       light.position = *p;
     }
     if (!node["power"]) {
-      if (lacks(node, "power")) error(node, fmt::format("a {} light needs a 'power' (e.g. 200W)", *type));
+      if (lacks(node, "power"))
+        error(node, fmt::format("a {} light needs a 'power' (e.g. 200W)", *type));
     } else if (auto w = quantity(node["power"], QuantityKind::kPower, "light power",
                                  Range{0, 1e6, true})) {
       light.power_w = *w;
@@ -576,8 +592,8 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
   } else {
     if (!node["illuminance"]) {
       error(node, "a directional light needs an 'illuminance' (e.g. 2000lx)");
-    } else if (auto e = quantity(node["illuminance"], QuantityKind::kIlluminance,
-                                 "illuminance", Range{0, 200000, true})) {
+    } else if (auto e = quantity(node["illuminance"], QuantityKind::kIlluminance, "illuminance",
+                                 Range{0, 200000, true})) {
       light.illuminance_lx = *e;
     }
     if (!node["direction"]) error(node, "a directional light needs a 'direction' [x, y, z]");
@@ -647,8 +663,9 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
   if (has_body && has_sensor) {
     error(node["sensor"], "give the camera either a 'body' preset or a 'sensor', not both");
   } else if (!has_body && !has_sensor) {
-    error(node, "the camera needs a 'body' preset (e.g. canon-6d) or a 'sensor' {width, height, "
-                "pixels}");
+    error(node,
+          "the camera needs a 'body' preset (e.g. canon-6d) or a 'sensor' {width, height, "
+          "pixels}");
   }
   if (has_body) {
     if (auto name = scalar(node["body"], "body")) {
@@ -667,10 +684,10 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
         std::string suggestion = closest_match(*name, names);
         std::string list;
         for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-        error(node["body"], fmt::format("unknown camera body '{}'{}", *name,
-                                        suggestion.empty()
-                                            ? fmt::format(" (known: {})", list)
-                                            : fmt::format("; did you mean '{}'?", suggestion)));
+        error(node["body"],
+              fmt::format("unknown camera body '{}'{}", *name,
+                          suggestion.empty() ? fmt::format(" (known: {})", list)
+                                             : fmt::format("; did you mean '{}'?", suggestion)));
       }
     }
   }
@@ -744,8 +761,8 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
         }
       }
       if (lens["vignetting"]) {
-        if (auto v = quantity(lens["vignetting"], QuantityKind::kNumber, "vignetting",
-                              Range{0, 0.95})) {
+        if (auto v =
+                quantity(lens["vignetting"], QuantityKind::kNumber, "vignetting", Range{0, 0.95})) {
           camera.vignetting = *v;
         }
       }
@@ -788,8 +805,8 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     scene.focus_loc = camera.focus_loc = loc(focus);
     if (focus.IsScalar() && focus.Scalar() == "auto") {
       scene.focus_auto = true;
-    } else if (auto d = quantity(focus, QuantityKind::kLength, "focus distance",
-                                 Range{0.01, 1000})) {
+    } else if (auto d =
+                   quantity(focus, QuantityKind::kLength, "focus distance", Range{0.01, 1000})) {
       scene.focus_auto = false;
       scene.focus_distance_m = *d;
     }
@@ -797,18 +814,18 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
   if (const YAML::Node wb = node["white_balance"]) {
     if (wb.IsScalar() && wb.Scalar() == "auto") {
       camera.white_balance = ir::WhiteBalanceMode::kAuto;
-    } else if (auto k = quantity(wb, QuantityKind::kTemperature, "white balance",
-                                 Range{2000, 12000})) {
+    } else if (auto k =
+                   quantity(wb, QuantityKind::kTemperature, "white balance", Range{2000, 12000})) {
       camera.white_balance = ir::WhiteBalanceMode::kKelvin;
       camera.white_balance_k = *k;
     }
   }
   if (const YAML::Node effects = node["effects"]) {
     if (expect_map(effects, "effects")) {
-      check_keys(effects,
-                 {"depth_of_field", "diffraction", "motion_blur", "distortion", "vignetting",
-                  "noise"},
-                 "effects");
+      check_keys(
+          effects,
+          {"depth_of_field", "diffraction", "motion_blur", "distortion", "vignetting", "noise"},
+          "effects");
       auto read = [&](const char* key, bool& out) {
         if (!effects[key]) return;
         if (auto v = boolean(effects[key], key)) out = *v;
@@ -826,9 +843,12 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
       check_keys(output, {"format", "quality"}, "output");
       if (output["format"]) {
         if (auto f = scalar(output["format"], "output format")) {
-          if (*f == "jpeg" || *f == "jpg") camera.format = ir::ImageFormat::kJpeg;
-          else if (*f == "png16") camera.format = ir::ImageFormat::kPng16;
-          else if (*f == "tiff16") camera.format = ir::ImageFormat::kTiff16;
+          if (*f == "jpeg" || *f == "jpg")
+            camera.format = ir::ImageFormat::kJpeg;
+          else if (*f == "png16")
+            camera.format = ir::ImageFormat::kPng16;
+          else if (*f == "tiff16")
+            camera.format = ir::ImageFormat::kTiff16;
           else {
             error(output["format"],
                   fmt::format("unknown output format '{}' (expected jpeg, png16 or tiff16)", *f));
@@ -841,10 +861,9 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     }
   }
   // Acceptable circle of confusion: the sensor diagonal / 1500 (0.029 mm for full frame).
-  camera.circle_of_confusion_m =
-      std::hypot(camera.sensor_width_m, camera.sensor_height_m) / 1500.0;
-  const double pixel_aspect = (camera.sensor_width_m / camera.width_px) /
-                              (camera.sensor_height_m / camera.height_px);
+  camera.circle_of_confusion_m = std::hypot(camera.sensor_width_m, camera.sensor_height_m) / 1500.0;
+  const double pixel_aspect =
+      (camera.sensor_width_m / camera.width_px) / (camera.sensor_height_m / camera.height_px);
   if (std::abs(pixel_aspect - 1) > 0.02) {
     diag_.warning(camera.loc, fmt::format("the sensor's pixels are not square (aspect {:.3f}); "
                                           "check the sensor size and pixel counts",
@@ -868,9 +887,12 @@ void Checker::read_shots(const YAML::Node& node, spec::SceneSpec& scene) {
     const YAML::Node body = entry.begin()->second;
     if (!check_keys(entry, {"turntable", "orbit", "pose"}, "shots")) continue;
     const std::string kind = key.Scalar();
-    if (kind == "turntable") read_turntable_shots(body, group);
-    else if (kind == "orbit") read_orbit_shots(body, group);
-    else read_pose_shot(body, group);
+    if (kind == "turntable")
+      read_turntable_shots(body, group);
+    else if (kind == "orbit")
+      read_orbit_shots(body, group);
+    else
+      read_pose_shot(body, group);
     scene.shots.push_back(group);
   }
 }
@@ -998,8 +1020,10 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   }
   if (node["up"]) {
     if (auto u = vec3(node["up"], QuantityKind::kNumber, "up")) {
-      if (u->norm() < 1e-9) error(node["up"], "up must not be zero");
-      else pose.up = u->normalized();
+      if (u->norm() < 1e-9)
+        error(node["up"], "up must not be zero");
+      else
+        pose.up = u->normalized();
     }
   }
   if (node["turntable"]) {
@@ -1020,8 +1044,7 @@ std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string&
     diag.error({file, e.mark.line + 1, e.mark.column + 1},
                fmt::format("YAML syntax error: {}", e.msg));
   } catch (const YAML::Exception& e) {
-    diag.error({file, e.mark.line + 1, e.mark.column + 1},
-               fmt::format("YAML error: {}", e.msg));
+    diag.error({file, e.mark.line + 1, e.mark.column + 1}, fmt::format("YAML error: {}", e.msg));
   }
   return std::nullopt;
 }

@@ -1,9 +1,10 @@
 // The checking pass: YAML tree -> typed scene description, every problem reported at its location.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <optional>
 #include <string>
-#include <yaml-cpp/yaml.h>
 
 #include "compiler/diagnostics.h"
 #include "compiler/spec.h"

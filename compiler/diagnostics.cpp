@@ -45,9 +45,15 @@ std::string DiagnosticEngine::render(const Diagnostic& d) const {
     if (d.loc.col > 0) out << ':' << d.loc.col;
   }
   switch (d.severity) {
-    case Severity::kError: out << ": error: "; break;
-    case Severity::kWarning: out << ": warning: "; break;
-    case Severity::kNote: out << ": note: "; break;
+    case Severity::kError:
+      out << ": error: ";
+      break;
+    case Severity::kWarning:
+      out << ": warning: ";
+      break;
+    case Severity::kNote:
+      out << ": note: ";
+      break;
   }
   out << d.message << '\n';
   auto it = source_lines_.find(d.loc.file);

@@ -62,18 +62,18 @@ struct Mesh {
 };
 
 struct Object {
-  std::string source;  // mesh path as resolved, or "primitive:statue" etc.
-  Mesh mesh;           // in the mesh frame
+  std::string source;                        // mesh path as resolved, or "primitive:statue" etc.
+  Mesh mesh;                                 // in the mesh frame
   Mat4 object_from_mesh = Mat4::Identity();  // fit, scale, rotate, translate, resting on the table
-  Vec3 bounds_min_object{0, 0, 0};            // axis-aligned bounds in the object frame
+  Vec3 bounds_min_object{0, 0, 0};           // axis-aligned bounds in the object frame
   Vec3 bounds_max_object{0, 0, 0};
   SourceLoc loc;
 };
 
 struct Turntable {
   double diameter_m = 0.4;
-  double height_m = 0.75;     // top surface above the floor
-  double thickness_m = 0.03;  // of the disc
+  double height_m = 0.75;        // top surface above the floor
+  double thickness_m = 0.03;     // of the disc
   Vec3 color{0.18, 0.18, 0.18};  // linear RGB albedo
   SourceLoc loc;
 };
@@ -92,13 +92,13 @@ enum class LightType { kPoint, kSpot, kDirectional, kArea };
 
 struct Light {
   LightType type = LightType::kPoint;
-  Vec3 position{0, 0, 0};   // world (not used by directional)
-  Vec3 direction{0, 0, -1}; // unit, the way light travels (spot, directional, area)
-  double power_w = 0;       // radiant power in Blender's convention (point, spot, area)
+  Vec3 position{0, 0, 0};     // world (not used by directional)
+  Vec3 direction{0, 0, -1};   // unit, the way light travels (spot, directional, area)
+  double power_w = 0;         // radiant power in Blender's convention (point, spot, area)
   double illuminance_lx = 0;  // directional only: illuminance on a surface facing the light
   double temperature_k = 6500;
-  Vec3 color{1, 1, 1};      // linear RGB of the blackbody, normalised to luminance 1
-  Vec2 size_m{0, 0};        // area light width and height
+  Vec3 color{1, 1, 1};        // linear RGB of the blackbody, normalised to luminance 1
+  Vec2 size_m{0, 0};          // area light width and height
   double spot_angle_rad = 0;  // full cone angle
   double spot_blend = 0.15;   // 0 hard edge .. 1 soft
   SourceLoc loc;
@@ -120,15 +120,15 @@ struct Distortion {
 
 // Sensor noise model (ISETCam order). Electrons at clipping scale as FWC * base_iso / iso.
 struct SensorNoise {
-  double full_well_e = 79546;   // electrons at clipping at base ISO
+  double full_well_e = 79546;  // electrons at clipping at base ISO
   double base_iso = 100;
-  double read_noise_e = 25;     // at base ISO (estimate for most presets)
+  double read_noise_e = 25;            // at base ISO (estimate for most presets)
   double read_noise_high_iso_e = 1.7;  // at the highest ISO; interpolated in log ISO
-  double prnu = 0.007;          // pixel gain non-uniformity, fraction
-  double dsnu_e = 1.0;          // dark signal non-uniformity, electrons
+  double prnu = 0.007;                 // pixel gain non-uniformity, fraction
+  double dsnu_e = 1.0;                 // dark signal non-uniformity, electrons
   double dark_current_e_per_s = 0.1;
   int adc_bits = 14;
-  std::string source_note;      // which numbers are measured and which are estimates
+  std::string source_note;  // which numbers are measured and which are estimates
 };
 
 enum class ImageFormat { kJpeg, kPng16, kTiff16 };
@@ -175,14 +175,14 @@ struct Camera {
 
 // Thresholds of the coverage analysis: when a view of a face is usable by SfM.
 struct CoverageSettings {
-  double min_pixels_per_mm2 = 1.0;        // image resolution on the surface
-  double max_view_angle_rad = 1.3089969389957472;    // 75 deg between normal and view ray
+  double min_pixels_per_mm2 = 1.0;                 // image resolution on the surface
+  double max_view_angle_rad = 1.3089969389957472;  // 75 deg between normal and view ray
   double max_blur_px = 0;  // circle of confusion still "in focus", pixels; 0: diagonal/1500
   double min_triangulation_angle_rad = 0.08726646259971647;  // 5 deg between two usable views
-  double min_signal = 0.02;               // normalised signal below: too dark (noise)
-  double max_signal = 0.98;               // above: clipped
-  double min_overlap = 0.6;               // of consecutive shots' seen surface
-  double min_frame_fill = 0.05;           // object's share of the image area
+  double min_signal = 0.02;      // normalised signal below: too dark (noise)
+  double max_signal = 0.98;      // above: clipped
+  double min_overlap = 0.6;      // of consecutive shots' seen surface
+  double min_frame_fill = 0.05;  // object's share of the image area
   SourceLoc loc;
 };
 
@@ -193,9 +193,9 @@ struct Shot {
   std::string name;  // shot_000
   ShotKind kind = ShotKind::kPose;
   Mat4 world_from_camera = Mat4::Identity();
-  double turntable_angle_rad = 0;             // object rotation about world +Z at mid-exposure
-  double turntable_velocity_rad_s = 0;        // rotation speed during the exposure
-  double focus_distance_m = 1;                // along the optical axis
+  double turntable_angle_rad = 0;       // object rotation about world +Z at mid-exposure
+  double turntable_velocity_rad_s = 0;  // rotation speed during the exposure
+  double focus_distance_m = 1;          // along the optical axis
   // The camera pose relative to the object (object rotated back to angle 0): what SfM recovers.
   Mat4 object_from_camera = Mat4::Identity();
   SourceLoc loc;

@@ -9,7 +9,9 @@ json loc_json(const SourceLoc& loc) {
   return json{{"file", loc.file}, {"line", loc.line}, {"col", loc.col}};
 }
 
-json vec_json(const ir::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vec_json(const ir::Vec3& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
 
 json mat_json(const ir::Mat4& m) {
   json rows = json::array();
@@ -21,38 +23,52 @@ json mat_json(const ir::Mat4& m) {
 
 const char* pattern_name(ir::PatternKind kind) {
   switch (kind) {
-    case ir::PatternKind::kNone: return "none";
-    case ir::PatternKind::kSpeckle: return "speckle";
-    case ir::PatternKind::kNoise: return "noise";
-    case ir::PatternKind::kChecker: return "checker";
+    case ir::PatternKind::kNone:
+      return "none";
+    case ir::PatternKind::kSpeckle:
+      return "speckle";
+    case ir::PatternKind::kNoise:
+      return "noise";
+    case ir::PatternKind::kChecker:
+      return "checker";
   }
   return "none";
 }
 
 const char* light_type_name(ir::LightType type) {
   switch (type) {
-    case ir::LightType::kPoint: return "point";
-    case ir::LightType::kSpot: return "spot";
-    case ir::LightType::kDirectional: return "directional";
-    case ir::LightType::kArea: return "area";
+    case ir::LightType::kPoint:
+      return "point";
+    case ir::LightType::kSpot:
+      return "spot";
+    case ir::LightType::kDirectional:
+      return "directional";
+    case ir::LightType::kArea:
+      return "area";
   }
   return "point";
 }
 
 const char* shot_kind_name(ir::ShotKind kind) {
   switch (kind) {
-    case ir::ShotKind::kTurntable: return "turntable";
-    case ir::ShotKind::kOrbit: return "orbit";
-    case ir::ShotKind::kPose: return "pose";
+    case ir::ShotKind::kTurntable:
+      return "turntable";
+    case ir::ShotKind::kOrbit:
+      return "orbit";
+    case ir::ShotKind::kPose:
+      return "pose";
   }
   return "pose";
 }
 
 const char* format_name(ir::ImageFormat format) {
   switch (format) {
-    case ir::ImageFormat::kJpeg: return "jpeg";
-    case ir::ImageFormat::kPng16: return "png16";
-    case ir::ImageFormat::kTiff16: return "tiff16";
+    case ir::ImageFormat::kJpeg:
+      return "jpeg";
+    case ir::ImageFormat::kPng16:
+      return "png16";
+    case ir::ImageFormat::kTiff16:
+      return "tiff16";
   }
   return "jpeg";
 }
@@ -118,10 +134,8 @@ json ir_to_json(const ir::Scene& scene, bool include_geometry) {
   out["materials"] = materials;
   json textures = json::array();
   for (const auto& t : scene.textures) {
-    textures.push_back({{"source", t.source},
-                        {"width", t.width},
-                        {"height", t.height},
-                        {"channels", t.channels}});
+    textures.push_back(
+        {{"source", t.source}, {"width", t.width}, {"height", t.height}, {"channels", t.channels}});
   }
   out["textures"] = textures;
 
@@ -140,24 +154,23 @@ json ir_to_json(const ir::Scene& scene, bool include_geometry) {
                       {"spot_blend", l.spot_blend},
                       {"loc", loc_json(l.loc)}});
   }
-  out["studio"] = {
-      {"turntable",
-       {{"diameter_m", studio.turntable.diameter_m},
-        {"height_m", studio.turntable.height_m},
-        {"thickness_m", studio.turntable.thickness_m},
-        {"color", vec_json(studio.turntable.color)},
-        {"loc", loc_json(studio.turntable.loc)}}},
-      {"backdrop",
-       {{"green_screen", studio.backdrop.green_screen},
-        {"color", vec_json(studio.backdrop.color)},
-        {"distance_m", studio.backdrop.distance_m},
-        {"direction", vec_json(studio.backdrop.direction)},
-        {"width_m", studio.backdrop.width_m},
-        {"height_m", studio.backdrop.height_m},
-        {"loc", loc_json(studio.backdrop.loc)}}},
-      {"lights", lights},
-      {"ambient_lx", studio.ambient_lx},
-      {"floor_color", vec_json(studio.floor_color)}};
+  out["studio"] = {{"turntable",
+                    {{"diameter_m", studio.turntable.diameter_m},
+                     {"height_m", studio.turntable.height_m},
+                     {"thickness_m", studio.turntable.thickness_m},
+                     {"color", vec_json(studio.turntable.color)},
+                     {"loc", loc_json(studio.turntable.loc)}}},
+                   {"backdrop",
+                    {{"green_screen", studio.backdrop.green_screen},
+                     {"color", vec_json(studio.backdrop.color)},
+                     {"distance_m", studio.backdrop.distance_m},
+                     {"direction", vec_json(studio.backdrop.direction)},
+                     {"width_m", studio.backdrop.width_m},
+                     {"height_m", studio.backdrop.height_m},
+                     {"loc", loc_json(studio.backdrop.loc)}}},
+                   {"lights", lights},
+                   {"ambient_lx", studio.ambient_lx},
+                   {"floor_color", vec_json(studio.floor_color)}};
 
   const ir::Camera& c = scene.camera;
   out["camera"] = {
@@ -181,8 +194,8 @@ json ir_to_json(const ir::Scene& scene, bool include_geometry) {
       {"aperture_f_number", c.aperture_f_number},
       {"shutter_s", c.shutter_s},
       {"iso", c.iso},
-      {"white_balance", c.white_balance == ir::WhiteBalanceMode::kAuto ? json("auto")
-                                                                       : json(c.white_balance_k)},
+      {"white_balance",
+       c.white_balance == ir::WhiteBalanceMode::kAuto ? json("auto") : json(c.white_balance_k)},
       {"noise",
        {{"full_well_e", c.noise.full_well_e},
         {"base_iso", c.noise.base_iso},

@@ -1,6 +1,7 @@
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -160,11 +161,10 @@ bool Lowering::lower_object() {
   if (scene_.materials.empty()) scene_.materials.push_back(ir::Material{});
 
   // Rotation and scale first, then fit to the requested size, then rest on the turntable.
-  Eigen::Matrix3d user_rotation =
-      (Eigen::AngleAxisd(object.rotate_rad.z(), Vec3::UnitZ()) *
-       Eigen::AngleAxisd(object.rotate_rad.y(), Vec3::UnitY()) *
-       Eigen::AngleAxisd(object.rotate_rad.x(), Vec3::UnitX()))
-          .toRotationMatrix();
+  Eigen::Matrix3d user_rotation = (Eigen::AngleAxisd(object.rotate_rad.z(), Vec3::UnitZ()) *
+                                   Eigen::AngleAxisd(object.rotate_rad.y(), Vec3::UnitY()) *
+                                   Eigen::AngleAxisd(object.rotate_rad.x(), Vec3::UnitX()))
+                                      .toRotationMatrix();
   Mat4 user_scale = Mat4::Identity();
   user_scale.diagonal().head<3>() = object.scale;
   Mat4 shaped = rotation(user_rotation) * user_scale * rotation(up);
@@ -328,8 +328,8 @@ void Lowering::place_backdrop() {
   mean_view.z() = 0;
   ir::Backdrop& backdrop = scene_.studio.backdrop;
   // A full orbit has no mean direction: the backdrop then stays on the +Y side.
-  backdrop.direction = mean_view.norm() > 0.3 * scene_.shots.size() ? mean_view.normalized()
-                                                                     : Vec3(0, 1, 0);
+  backdrop.direction =
+      mean_view.norm() > 0.3 * scene_.shots.size() ? mean_view.normalized() : Vec3(0, 1, 0);
   if (!spec_.backdrop_distance_set) {
     // Behind every camera's horizontal distance, so no camera stands behind the screen.
     double farthest_camera = 0;

@@ -16,9 +16,9 @@ struct LoadedModel {
 };
 
 // Loads glTF 2.0 (.gltf/.glb, through tinygltf, with base-colour textures) or OBJ/PLY/STL (through
-// Assimp). Applies the file's node transforms so the mesh is in the file's scene frame; glTF's +Y up
-// is converted to RigC's +Z up (x, y, z) -> (x, -z, y). On failure returns nullopt and sets *error
-// to one line that names the file and says what is wrong (no crash, no silent empty mesh).
+// Assimp). Applies the file's node transforms so the mesh is in the file's scene frame; glTF's +Y
+// up is converted to RigC's +Z up (x, y, z) -> (x, -z, y). On failure returns nullopt and sets
+// *error to one line that names the file and says what is wrong (no crash, no silent empty mesh).
 std::optional<LoadedModel> load_model(const std::string& path, std::string* error);
 
 // Writes a mesh as binary little-endian PLY (positions, normals, uvs if any). For benchmarks and

@@ -40,7 +40,7 @@ TEST(Schema, EveryExampleSceneIsValidAndCompiles) {
 TEST(Schema, RejectsWhatTheCompilerRejectsForItsShape) {
   // Bad scenes whose errors are about the language's shape (keys, units, names), not about
   // files, ranges or geometry that a schema cannot see.
-  const std::vector<std::string> bad = {"unknown_keys.yaml", "wrong_units.yaml",
+  const std::vector<std::string> bad = {"unknown_keys.yaml",  "wrong_units.yaml",
                                         "unknown_names.yaml", "missing_sections.yaml",
                                         "not_a_mapping.yaml", "wrong_shapes.yaml"};
   for (const auto& name : bad) {

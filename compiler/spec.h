@@ -44,8 +44,8 @@ struct ObjectSpec {
 };
 
 struct TurntableCameraSpec {
-  double distance_m = 0.8;  // horizontal, from the turntable axis
-  double height_m = 0.2;    // above the turntable top
+  double distance_m = 0.8;                   // horizontal, from the turntable axis
+  double height_m = 0.2;                     // above the turntable top
   double azimuth_rad = -1.5707963267948966;  // where the camera stands; -90deg is the -Y side
   Target aim;
 };

@@ -1,7 +1,8 @@
 #include "compiler/units.h"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -67,30 +68,48 @@ std::string trim(const std::string& text) {
 
 std::string kind_description(QuantityKind kind) {
   switch (kind) {
-    case QuantityKind::kNumber: return "a number";
-    case QuantityKind::kLength: return "a length";
-    case QuantityKind::kAngle: return "an angle";
-    case QuantityKind::kTime: return "a time";
-    case QuantityKind::kFNumber: return "an f-number";
-    case QuantityKind::kTemperature: return "a colour temperature";
-    case QuantityKind::kPower: return "a power";
-    case QuantityKind::kIlluminance: return "an illuminance";
-    case QuantityKind::kAngularVelocity: return "an angular velocity";
+    case QuantityKind::kNumber:
+      return "a number";
+    case QuantityKind::kLength:
+      return "a length";
+    case QuantityKind::kAngle:
+      return "an angle";
+    case QuantityKind::kTime:
+      return "a time";
+    case QuantityKind::kFNumber:
+      return "an f-number";
+    case QuantityKind::kTemperature:
+      return "a colour temperature";
+    case QuantityKind::kPower:
+      return "a power";
+    case QuantityKind::kIlluminance:
+      return "an illuminance";
+    case QuantityKind::kAngularVelocity:
+      return "an angular velocity";
   }
   return "a quantity";
 }
 
 std::string kind_units(QuantityKind kind) {
   switch (kind) {
-    case QuantityKind::kNumber: return "no unit";
-    case QuantityKind::kLength: return "m, cm, mm, in";
-    case QuantityKind::kAngle: return "deg, rad";
-    case QuantityKind::kTime: return "s, ms, or a fraction such as 1/125";
-    case QuantityKind::kFNumber: return "f/N, e.g. f/8";
-    case QuantityKind::kTemperature: return "K";
-    case QuantityKind::kPower: return "W, kW";
-    case QuantityKind::kIlluminance: return "lx";
-    case QuantityKind::kAngularVelocity: return "deg/s, rad/s, rpm";
+    case QuantityKind::kNumber:
+      return "no unit";
+    case QuantityKind::kLength:
+      return "m, cm, mm, in";
+    case QuantityKind::kAngle:
+      return "deg, rad";
+    case QuantityKind::kTime:
+      return "s, ms, or a fraction such as 1/125";
+    case QuantityKind::kFNumber:
+      return "f/N, e.g. f/8";
+    case QuantityKind::kTemperature:
+      return "K";
+    case QuantityKind::kPower:
+      return "W, kW";
+    case QuantityKind::kIlluminance:
+      return "lx";
+    case QuantityKind::kAngularVelocity:
+      return "deg/s, rad/s, rpm";
   }
   return "";
 }
@@ -101,16 +120,23 @@ std::string format_quantity(double v, QuantityKind kind) {
       if (std::abs(v) < 0.01) return fmt::format("{:g}mm", v * 1000);
       if (std::abs(v) < 1) return fmt::format("{:g}cm", v * 100);
       return fmt::format("{:g}m", v);
-    case QuantityKind::kAngle: return fmt::format("{:g}deg", v / kDeg);
+    case QuantityKind::kAngle:
+      return fmt::format("{:g}deg", v / kDeg);
     case QuantityKind::kTime:
       if (v > 0 && v < 0.5) return fmt::format("1/{:g}s", std::round(1.0 / v));
       return fmt::format("{:g}s", v);
-    case QuantityKind::kFNumber: return fmt::format("f/{:g}", v);
-    case QuantityKind::kTemperature: return fmt::format("{:g}K", v);
-    case QuantityKind::kPower: return fmt::format("{:g}W", v);
-    case QuantityKind::kIlluminance: return fmt::format("{:g}lx", v);
-    case QuantityKind::kAngularVelocity: return fmt::format("{:g}deg/s", v / kDeg);
-    case QuantityKind::kNumber: return fmt::format("{:g}", v);
+    case QuantityKind::kFNumber:
+      return fmt::format("f/{:g}", v);
+    case QuantityKind::kTemperature:
+      return fmt::format("{:g}K", v);
+    case QuantityKind::kPower:
+      return fmt::format("{:g}W", v);
+    case QuantityKind::kIlluminance:
+      return fmt::format("{:g}lx", v);
+    case QuantityKind::kAngularVelocity:
+      return fmt::format("{:g}deg/s", v / kDeg);
+    case QuantityKind::kNumber:
+      return fmt::format("{:g}", v);
   }
   return fmt::format("{:g}", v);
 }

@@ -1,12 +1,12 @@
 #include "backends/preview/preview_backend.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fmt/format.h>
 #include <ostream>
 
 #include "backends/common/colmap_text.h"
@@ -47,8 +47,8 @@ int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, con
           .head<3>();
   const ir::Vec3 eye = shot.world_from_camera.block<3, 1>(0, 3);
   const double depth = std::max(0.05, (center_world - eye).norm() - studio.object_radius);
-  const double blur_px = dslr::motion_blur_length_px(camera, scale, shot.turntable_velocity_rad_s,
-                                                     radius, depth);
+  const double blur_px =
+      dslr::motion_blur_length_px(camera, scale, shot.turntable_velocity_rad_s, radius, depth);
   // About one sub-frame per pixel of travel keeps the streak continuous.
   return std::clamp(static_cast<int>(std::ceil(blur_px)) + 1, 1, 48);
 }
@@ -74,7 +74,8 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
     const double sweep = shot.turntable_velocity_rad_s * scene.camera.shutter_s;
     std::vector<double> sum;
     for (int k = 0; k < subframes; ++k) {
-      request.turntable_angle_rad = shot.turntable_angle_rad + sweep * ((k + 0.5) / subframes - 0.5);
+      request.turntable_angle_rad =
+          shot.turntable_angle_rad + sweep * ((k + 0.5) / subframes - 0.5);
       dslr::LinearFrame sub = render_frame(scene, studio, request, &raster);
       if (sum.empty()) sum.assign(sub.rgb.size(), 0.0);
       for (size_t i = 0; i < sub.rgb.size(); ++i) sum[i] += sub.rgb[i];
@@ -183,8 +184,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
-      log << progress_line(done, static_cast<int>(shots.size()), shot.name,
-                           timing.total_ms / 1000) << std::flush;
+      log << progress_line(done, static_cast<int>(shots.size()), shot.name, timing.total_ms / 1000)
+          << std::flush;
     } else {
       log << fmt::format("{}: rendered in {:.2f} s ({} sub-frame{})\n", shot.name,
                          timing.total_ms / 1000, timing.subframes,

@@ -32,7 +32,8 @@ object:
   primitive: {shape: sphere, detail: 5}
   fit: {size: 1cm}
   surface: {pattern: none, color: [0.9, 0.9, 0.9]}
-)" + object_extra + R"(
+)" + object_extra +
+         R"(
 studio:
   turntable: {diameter: 2cm, height: 50cm, color: [0, 0, 0]}
   backdrop: {green_screen: false}
@@ -40,7 +41,8 @@ studio:
   ambient: 2000lx
 camera:
   body: canon-6d
-  lens: {focal_length: 50mm)" + camera_extra + R"(
+  lens: {focal_length: 50mm)" +
+         camera_extra + R"(
   exposure: {aperture: f/8, shutter: 1/125, iso: 200}
   effects: {noise: false, depth_of_field: false, diffraction: false}
 shots:
@@ -86,8 +88,9 @@ Blob bright_extent(const dslr::DevelopResult& result, double fraction) {
 // The ball's image centre must land where COLMAP's OPENCV model, with the exported intrinsics
 // and poses, puts the ball's centre; with strong distortion and off-centre positions.
 TEST(Preview, ObjectLandsWhereColmapProjectsIt) {
-  ir::Scene scene = compile(ball_scene(", distortion: {k1: -0.08, k2: 0.02, p1: 0.001}}",
-                                       R"(  - pose: {position: [0, -0.5m, 0.505m], look_at: [0.12m, 0, 0.55m]}
+  ir::Scene scene =
+      compile(ball_scene(", distortion: {k1: -0.08, k2: 0.02, p1: 0.001}}",
+                         R"(  - pose: {position: [0, -0.5m, 0.505m], look_at: [0.12m, 0, 0.55m]}
   - pose: {position: [0.1m, -0.5m, 0.6m], look_at: [-0.1m, 0, 0.45m]}
   - pose: {position: [0, -0.45m, 0.505m], look_at: [0, 0, 0.505m]}
 )"));
@@ -98,8 +101,7 @@ TEST(Preview, ObjectLandsWhereColmapProjectsIt) {
   auto camera = backends::output_camera(scene.camera, scale, &error);
   ASSERT_TRUE(camera) << error;
   // The ball's centre in the object frame: COLMAP's world.
-  const ir::Vec3 center =
-      (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
+  const ir::Vec3 center = (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
   for (const auto& shot : scene.shots) {
     dslr::DevelopResult result = render_shot(scene, studio, shot, scale, 1);
     ASSERT_EQ(result.width, camera->width);
@@ -125,7 +127,8 @@ double mean_green(const dslr::DevelopResult& result) {
 
 TEST(Preview, ExposureFollowsShutterApertureAndIso) {
   auto render_mean = [](const std::string& exposure) {
-    std::string text = ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
+    std::string text =
+        ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
     text.replace(text.find("{aperture: f/8, shutter: 1/125, iso: 200}"), 41, exposure);
     ir::Scene scene = compile(text);
     StudioScene studio = prepare_studio_scene(scene);
@@ -155,10 +158,10 @@ TEST(Preview, AbsoluteSignalMatchesTheExposureEquation) {
 // The streak of a ball on a turning table is ω·t·R·f/Z pixels longer than the ball.
 TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
   auto extent = [](const std::string& speed) {
-    ir::Scene scene = compile(ball_scene(
-        "}", "  - turntable: {steps: 1, step: 0deg, speed: " + speed +
-                 ", camera: {distance: 40cm, height: 0.5cm}}\n",
-        "  translate: [0, -6cm, 0]\n"));
+    ir::Scene scene = compile(ball_scene("}",
+                                         "  - turntable: {steps: 1, step: 0deg, speed: " + speed +
+                                             ", camera: {distance: 40cm, height: 0.5cm}}\n",
+                                         "  translate: [0, -6cm, 0]\n"));
     StudioScene studio = prepare_studio_scene(scene);
     const ir::Shot& shot = scene.shots[0];
     Blob blob = bright_extent(render_shot(scene, studio, shot, 0.25, 1), 0.02);
@@ -195,9 +198,9 @@ TEST(Preview, RunWritesTheLayoutAndResumes) {
   options.scale = 0.05;
   std::ostringstream log;
   ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
-  for (const char* file : {"images/shot_000.jpg", "images/shot_002.jpg", "masks/shot_001.png",
-                           "sparse/cameras.txt", "sparse/images.txt", "sparse/points3D.txt",
-                           "transforms.json", "manifest.json"}) {
+  for (const char* file :
+       {"images/shot_000.jpg", "images/shot_002.jpg", "masks/shot_001.png", "sparse/cameras.txt",
+        "sparse/images.txt", "sparse/points3D.txt", "transforms.json", "manifest.json"}) {
     EXPECT_TRUE(fs::exists(dir.path() / file)) << file;
   }
   // A rerun renders nothing; a deleted image is rendered again, alone.

@@ -35,11 +35,11 @@ double ms_since(Clock::time_point start) {
 // A triangle after clipping and projection. Attributes are looked up in the source triangle
 // through the barycentric coordinates each clipped vertex has there.
 struct ScreenTriangle {
-  std::array<Vector2f, 3> screen;     // pixel coordinates
-  std::array<float, 3> inv_z;         // 1 / camera z
+  std::array<Vector2f, 3> screen;  // pixel coordinates
+  std::array<float, 3> inv_z;      // 1 / camera z
   std::array<Vector3f, 3> source_bary;
-  float inv_area = 0;                 // 1 / (twice the signed screen area)
-  std::int32_t source = 0;            // triangle index; object triangles first, then studio
+  float inv_area = 0;       // 1 / (twice the signed screen area)
+  std::int32_t source = 0;  // triangle index; object triangles first, then studio
   // Planes in pixel coordinates, value = a·x + b·y + c: the barycentrics w0, w1 and 1/z.
   std::array<float, 3> w0_plane, w1_plane, inv_z_plane;
 
@@ -117,7 +117,7 @@ struct ShadowMap {
   bool orthographic = false;
   Matrix3f light_from_world = Matrix3f::Identity();  // rows: right, down, forward
   Vector3f origin = Vector3f::Zero();                // light position (or ortho centre)
-  float focal = 1;       // perspective: pixels per unit of x/z; ortho: pixels per meter
+  float focal = 1;          // perspective: pixels per unit of x/z; ortho: pixels per meter
   float texel_m_per_z = 0;  // world size of a texel at unit distance (perspective)
   float texel_m = 0;        // world size of a texel (orthographic)
   int size = 0;
@@ -156,8 +156,8 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
     texel = texel_m_per_z * local.z();
   }
   if (u < 0 || v < 0 || u >= size || v >= size) return 1;
-  const float tan_theta = std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)) /
-                          std::max(cos_theta, 0.15f);
+  const float tan_theta =
+      std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)) / std::max(cos_theta, 0.15f);
   const float bias = texel * (1.5f + 2.0f * tan_theta) + 0.002f;
   const float receiver = local.z() - bias;
   auto lookup = [&](float su, float sv) {
@@ -167,16 +167,16 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
   };
   // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels.
   static constexpr float kDisc[16][2] = {
-      {-0.94f, -0.40f}, {0.95f, -0.77f}, {-0.09f, -0.93f}, {0.34f, 0.29f},
-      {-0.92f, 0.46f},  {-0.81f, -0.88f}, {-0.38f, 0.28f}, {0.97f, 0.76f},
+      {-0.94f, -0.40f}, {0.95f, -0.77f},  {-0.09f, -0.93f}, {0.34f, 0.29f},
+      {-0.92f, 0.46f},  {-0.81f, -0.88f}, {-0.38f, 0.28f},  {0.97f, 0.76f},
       {0.44f, -0.98f},  {0.54f, 0.89f},   {-0.26f, -0.60f}, {-0.10f, 0.89f},
-      {0.79f, 0.19f},   {-0.62f, 0.99f},  {0.20f, -0.35f}, {-0.50f, -0.12f}};
+      {0.79f, 0.19f},   {-0.62f, 0.99f},  {0.20f, -0.35f},  {-0.50f, -0.12f}};
   float radius = 1.5f;
   if (light_size_m > 0 && !orthographic) {
     // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
     float blockers = 0, blocker_sum = 0;
-    const float search = std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f,
-                                    2.0f, 24.0f);
+    const float search =
+        std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f, 2.0f, 24.0f);
     // Most points are plainly lit: five taps over the search area settle them cheaply.
     if (lookup(u, v) >= receiver && lookup(u - search, v - search) >= receiver &&
         lookup(u + search, v - search) >= receiver && lookup(u - search, v + search) >= receiver &&
@@ -213,28 +213,29 @@ void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>&
   };
   std::vector<Projected> projected(tris.size());
   std::vector<char> keep(tris.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 4096),
-                    [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t t = range.begin(); t != range.end(); ++t) {
-      Projected& p = projected[t];
-      bool behind = false;
-      for (int i = 0; i < 3; ++i) {
-        const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
-        if (map.orthographic) {
-          p.s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
-        } else {
-          if (l.z() <= kNear) behind = true;
-          p.s[i] = {l.x() / l.z() * map.focal + size / 2.0f,
-                    l.y() / l.z() * map.focal + size / 2.0f};
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, tris.size(), 4096),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t t = range.begin(); t != range.end(); ++t) {
+          Projected& p = projected[t];
+          bool behind = false;
+          for (int i = 0; i < 3; ++i) {
+            const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
+            if (map.orthographic) {
+              p.s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
+            } else {
+              if (l.z() <= kNear) behind = true;
+              p.s[i] = {l.x() / l.z() * map.focal + size / 2.0f,
+                        l.y() / l.z() * map.focal + size / 2.0f};
+            }
+            p.z[i] = l.z();
+          }
+          const float area = edge(p.s[0], p.s[1], p.s[2].x(), p.s[2].y());
+          if (behind || std::abs(area) < 1e-12f) continue;
+          p.inv_area = 1 / area;
+          keep[t] = 1;
         }
-        p.z[i] = l.z();
-      }
-      const float area = edge(p.s[0], p.s[1], p.s[2].x(), p.s[2].y());
-      if (behind || std::abs(area) < 1e-12f) continue;
-      p.inv_area = 1 / area;
-      keep[t] = 1;
-    }
-  });
+      });
   constexpr int kBandRows = 32;
   const int bands = (size + kBandRows - 1) / kBandRows;
   std::vector<std::vector<std::uint32_t>> band_tris(bands);
@@ -253,10 +254,14 @@ void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>&
     for (const std::uint32_t t : band_tris[band]) {
       const Projected& p = projected[t];
       const auto& s = p.s;
-      const int x0 = std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
-      const int x1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
-      const int y0 = std::max(row0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
-      const int y1 = std::min(row1 - 1, static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+      const int x0 =
+          std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
+      const int x1 =
+          std::min(size - 1, static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+      const int y0 =
+          std::max(row0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
+      const int y1 =
+          std::min(row1 - 1, static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
       for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
           const float px = x + 0.5f, py = y + 0.5f;
@@ -266,9 +271,8 @@ void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>&
           if (w0 < 0 || w1 < 0 || w2 < 0) continue;
           // Linear depth is affine in screen space only for orthographic maps; perspective maps
           // interpolate 1/z.
-          const float depth_here =
-              map.orthographic ? w0 * p.z[0] + w1 * p.z[1] + w2 * p.z[2]
-                               : 1 / (w0 / p.z[0] + w1 / p.z[1] + w2 / p.z[2]);
+          const float depth_here = map.orthographic ? w0 * p.z[0] + w1 * p.z[1] + w2 * p.z[2]
+                                                    : 1 / (w0 / p.z[0] + w1 / p.z[1] + w2 / p.z[2]);
           float& stored = map.depth[static_cast<size_t>(y) * size + x];
           stored = std::min(stored, depth_here);
         }
@@ -304,13 +308,15 @@ ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float
   return map;
 }
 
-// Radiometry of one light at a point: the colour-weighted illuminance (lux) arriving along `to_light`.
+// Radiometry of one light at a point: the colour-weighted illuminance (lux) arriving along
+// `to_light`.
 struct LightSample {
   Vector3f to_light;
   Vector3f illuminance;  // per channel, lux
 };
 
-bool sample_light(const ir::Light& light, const Vector3f& color, const Vector3f& p, LightSample* out) {
+bool sample_light(const ir::Light& light, const Vector3f& color, const Vector3f& p,
+                  LightSample* out) {
   if (light.type == ir::LightType::kDirectional) {
     out->to_light = -light.direction.cast<float>().normalized();
     out->illuminance = color * static_cast<float>(light.illuminance_lx);
@@ -349,7 +355,8 @@ float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h, f
   const float d = a2 / (kPi * denom * denom);
   const float k = alpha / 2;
   const float vis = 1 / ((n_dot_l * (1 - k) + k) * (n_dot_v * (1 - k) + k));
-  const float fresnel = f0 + (1 - f0) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h);
+  const float fresnel =
+      f0 + (1 - f0) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h);
   *fresnel_out = fresnel;
   return d * vis * fresnel / 4;
 }
@@ -369,7 +376,7 @@ ScreenSetup setup_screen(int total_tris, const WorldVertex& world_vertex, const 
   std::vector<ScreenTriangle>& screen_tris = setup.tris;
   const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
   const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
-    screen_tris.reserve(total_tris + 64);
+  screen_tris.reserve(total_tris + 64);
   for (int t = 0; t < total_tris; ++t) {
     std::array<Vector3f, 3> cam;
     for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
@@ -538,21 +545,20 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   std::vector<std::array<Vector3f, 3>> casters;
   casters.reserve(total_tris);
   for (int t = 0; t < total_tris; ++t) {
-    const int material = t < object_tris ? object.triangle_material[t]
-                                         : room.triangle_material[t - object_tris];
+    const int material =
+        t < object_tris ? object.triangle_material[t] : room.triangle_material[t - object_tris];
     if (studio.materials[material].casts_shadow) {
       casters.push_back({world_vertex(t, 0), world_vertex(t, 1), world_vertex(t, 2)});
     }
   }
-  const Vector3f caster_center =
-      object_rot * studio.object_center.cast<float>() + object_t;
+  const Vector3f caster_center = object_rot * studio.object_center.cast<float>() + object_t;
   const float table_radius = static_cast<float>(scene.studio.turntable.diameter_m / 2);
-  const float caster_radius = std::max(
-      static_cast<float>(studio.object_radius),
-      std::sqrt(table_radius * table_radius +
-                std::pow(caster_center.z() - object_t.z() +
-                             static_cast<float>(scene.studio.turntable.thickness_m),
-                         2.0f)));
+  const float caster_radius =
+      std::max(static_cast<float>(studio.object_radius),
+               std::sqrt(table_radius * table_radius +
+                         std::pow(caster_center.z() - object_t.z() +
+                                      static_cast<float>(scene.studio.turntable.thickness_m),
+                                  2.0f)));
   std::vector<ShadowMap> shadow_maps;
   for (const auto& light : scene.studio.lights) {
     shadow_maps.push_back(
@@ -580,8 +586,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const auto& tri = g.triangles[local];
     Vector3f b = source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
     b /= b.sum();
-    const Vector3f p_local = b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] +
-                             b.z() * g.positions[tri[2]];
+    const Vector3f p_local =
+        b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
     Vector3f n_local =
         (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
     const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
@@ -596,8 +602,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     if (geometric.dot(v) < 0) geometric = -geometric;
     if (n.dot(v) < 0) n = -n;
 
-    const int material_index = is_object ? object.triangle_material[local]
-                                         : room.triangle_material[local];
+    const int material_index =
+        is_object ? object.triangle_material[local] : room.triangle_material[local];
     const ShadedMaterial& material = studio.materials[material_index];
     Vector3f albedo = material.base_color;
     const float depth = (cam_rot * p + cam_t).z();
@@ -634,9 +640,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       const Vector3f h = (sample.to_light + v).normalized();
       float fresnel = 0;
       const float f0 = 0.04f * (1 - metallic) + metallic;
-      const float specular = ggx_specular(n_dot_l, n_dot_v, std::max(n.dot(h), 0.0f),
-                                          std::max(v.dot(h), 0.0f), material.roughness, f0,
-                                          &fresnel);
+      const float specular =
+          ggx_specular(n_dot_l, n_dot_v, std::max(n.dot(h), 0.0f), std::max(v.dot(h), 0.0f),
+                       material.roughness, f0, &fresnel);
       const Vector3f spec_color =
           metallic > 0 ? Vector3f(Vector3f::Constant(1 - metallic) + albedo * metallic)
                        : Vector3f::Ones();
@@ -647,54 +653,52 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   };
 
   const auto raster_start = Clock::now();
-  rasterize_tiles<kSamples>(setup, canvas, [&](int px, int py, const float* inv_z,
-                                                 const std::int32_t* tri) {
-    Vector3f color = Vector3f::Zero();
-    int object_samples = 0;
-    float nearest = 0;
-    // Samples on one surface (same object membership, depths within 1 %) are shaded
-    // once, with the triangle holding most of them; only silhouettes blend surfaces.
-    std::array<int, kSamples> surface{-1, -1, -1, -1};
-    for (int k = 0; k < kSamples; ++k) {
-      const std::int32_t id = tri[k];
-      nearest = std::max(nearest, inv_z[k]);
-      if (id < 0 || surface[k] >= 0) continue;
-      const bool on_object = screen_tris[id].source < object_tris;
-      int count = 0;
-      for (int j = k; j < kSamples; ++j) {
-        const std::int32_t other = tri[j];
-        if (other < 0 || surface[j] >= 0) continue;
-        if ((screen_tris[other].source < object_tris) != on_object) continue;
-        if (std::abs(inv_z[j] - inv_z[k]) >
-            0.01f * inv_z[k]) {
-          continue;
+  rasterize_tiles<kSamples>(
+      setup, canvas, [&](int px, int py, const float* inv_z, const std::int32_t* tri) {
+        Vector3f color = Vector3f::Zero();
+        int object_samples = 0;
+        float nearest = 0;
+        // Samples on one surface (same object membership, depths within 1 %) are shaded
+        // once, with the triangle holding most of them; only silhouettes blend surfaces.
+        std::array<int, kSamples> surface{-1, -1, -1, -1};
+        for (int k = 0; k < kSamples; ++k) {
+          const std::int32_t id = tri[k];
+          nearest = std::max(nearest, inv_z[k]);
+          if (id < 0 || surface[k] >= 0) continue;
+          const bool on_object = screen_tris[id].source < object_tris;
+          int count = 0;
+          for (int j = k; j < kSamples; ++j) {
+            const std::int32_t other = tri[j];
+            if (other < 0 || surface[j] >= 0) continue;
+            if ((screen_tris[other].source < object_tris) != on_object) continue;
+            if (std::abs(inv_z[j] - inv_z[k]) > 0.01f * inv_z[k]) {
+              continue;
+            }
+            surface[j] = k;
+            ++count;
+          }
+          int best = k, best_votes = 0;
+          for (int j = k; j < kSamples; ++j) {
+            if (surface[j] != k) continue;
+            int votes = 0;
+            for (int m = k; m < kSamples; ++m) {
+              votes += surface[m] == k && tri[m] == tri[j];
+            }
+            if (votes > best_votes) {
+              best = j;
+              best_votes = votes;
+            }
+          }
+          if (on_object) object_samples += count;
+          color += shade(screen_tris[tri[best]], px + 0.5f, py + 0.5f) * (float(count) / kSamples);
         }
-        surface[j] = k;
-        ++count;
-      }
-      int best = k, best_votes = 0;
-      for (int j = k; j < kSamples; ++j) {
-        if (surface[j] != k) continue;
-        int votes = 0;
-        for (int m = k; m < kSamples; ++m) {
-          votes += surface[m] == k && tri[m] == tri[j];
-        }
-        if (votes > best_votes) {
-          best = j;
-          best_votes = votes;
-        }
-      }
-      if (on_object) object_samples += count;
-      color += shade(screen_tris[tri[best]], px + 0.5f, py + 0.5f) *
-               (float(count) / kSamples);
-    }
-    const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
-    frame.rgb[pixel * 3 + 0] = color.x();
-    frame.rgb[pixel * 3 + 1] = color.y();
-    frame.rgb[pixel * 3 + 2] = color.z();
-    if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
-    frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
-  });
+        const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
+        frame.rgb[pixel * 3 + 0] = color.x();
+        frame.rgb[pixel * 3 + 1] = color.y();
+        frame.rgb[pixel * 3 + 2] = color.z();
+        if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
+        frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
+      });
   if (timings) {
     timings->raster_ms += ms_since(raster_start);
   }

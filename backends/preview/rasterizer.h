@@ -14,7 +14,7 @@ namespace rigc::preview {
 struct FrameRequest {
   ir::Mat4 world_from_camera = ir::Mat4::Identity();
   double turntable_angle_rad = 0;
-  dslr::Intrinsics canvas;   // undistorted pinhole grid to render
+  dslr::Intrinsics canvas;  // undistorted pinhole grid to render
   int shadow_map_size = 2048;
 };
 

@@ -95,11 +95,10 @@ float value_noise(const Vector3f& p, std::uint32_t seed) {
     return (hash3(ix + dx, iy + dy, iz + dz, seed) & 0xFFFFFF) / float(0xFFFFFF);
   };
   auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
-  return lerp(lerp(lerp(value(0, 0, 0), value(1, 0, 0), tx), lerp(value(0, 1, 0), value(1, 1, 0), tx),
-                   ty),
-              lerp(lerp(value(0, 0, 1), value(1, 0, 1), tx), lerp(value(0, 1, 1), value(1, 1, 1), tx),
-                   ty),
-              tz);
+  return lerp(
+      lerp(lerp(value(0, 0, 0), value(1, 0, 0), tx), lerp(value(0, 1, 0), value(1, 1, 0), tx), ty),
+      lerp(lerp(value(0, 0, 1), value(1, 0, 1), tx), lerp(value(0, 1, 1), value(1, 1, 1), tx), ty),
+      tz);
 }
 
 void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const Vector3f& edge_v,
@@ -193,14 +192,16 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float
       break;
     }
     case ir::PatternKind::kChecker: {
-      const int parity = (static_cast<int>(std::floor(q.x())) + static_cast<int>(std::floor(q.y())) +
-                          static_cast<int>(std::floor(q.z()))) &
-                         1;
+      const int parity =
+          (static_cast<int>(std::floor(q.x())) + static_cast<int>(std::floor(q.y())) +
+           static_cast<int>(std::floor(q.z()))) &
+          1;
       darkness = static_cast<float>(parity);
       mean_darkness = 0.5f;
       break;
     }
-    case ir::PatternKind::kNone: break;
+    case ir::PatternKind::kNone:
+      break;
   }
   darkness = resolve * darkness + (1 - resolve) * mean_darkness;
   return 1.0f - contrast * darkness;
@@ -240,11 +241,9 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   if (object.triangle_material.size() != object.triangles.size()) {
     object.triangle_material.assign(object.triangles.size(), 0);
   }
-  out.object_center =
-      (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
+  out.object_center = (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
   for (const auto& p : object.positions) {
-    out.object_radius =
-        std::max(out.object_radius, (p.cast<double>() - out.object_center).norm());
+    out.object_radius = std::max(out.object_radius, (p.cast<double>() - out.object_center).norm());
   }
 
   // The studio, in the world frame.
@@ -266,8 +265,7 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   // The stand under the disc.
   add_cylinder(out.studio, std::min(0.04f, radius / 2), 0.0f,
                top - static_cast<float>(studio.turntable.thickness_m), table_material);
-  add_quad(out.studio, Vector3f(-6, -6, 0), Vector3f(12, 0, 0), Vector3f(0, 12, 0),
-           floor_material);
+  add_quad(out.studio, Vector3f(-6, -6, 0), Vector3f(12, 0, 0), Vector3f(0, 12, 0), floor_material);
   if (studio.backdrop.green_screen) {
     const int backdrop_material = add_material(studio.backdrop.color, 0.95f);
     const Vector3f toward = studio.backdrop.direction.cast<float>().normalized();

@@ -56,6 +56,7 @@ StudioScene prepare_studio_scene(const ir::Scene& scene);
 
 // Albedo multiplier of a procedural pattern at an object-frame position; `footprint_m` is the
 // size of a pixel on the surface, so patterns finer than a pixel fade to their mean (no aliasing).
-float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p, float footprint_m);
+float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p,
+                     float footprint_m);
 
 }  // namespace rigc::preview
