@@ -11,6 +11,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/manifest.h"
+#include "backends/common/run_folder.h"
 #include "backends/common/transforms_json.h"
 #include "dslr/exposure.h"
 #include "dslr/image_io.h"
@@ -101,19 +102,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
 int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostream& log,
                 std::vector<ShotTiming>* timings) {
   const fs::path run_dir = options.output_dir;
-  std::error_code ec;
-  for (const char* sub : {"images", "masks", "sparse"}) {
-    fs::create_directories(run_dir / sub, ec);
-    if (ec || !fs::is_directory(run_dir / sub)) {
-      log << fmt::format("rigc: error: cannot create the output folder '{}': {}\n",
-                         (run_dir / sub).string(), ec ? ec.message() : "not a folder");
-      return 1;
-    }
-  }
-  if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
-    log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
-    return 1;
-  }
+  if (!backends::prepare_run_folder(run_dir, {}, log)) return 1;
   std::vector<int> shots = options.shots;
   if (shots.empty()) {
     for (const auto& shot : scene.shots) shots.push_back(shot.index);
@@ -194,28 +183,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   }
   if (options.progress_bar) log << '\n';
 
-  // Ground truth for every shot that has its image in this run folder.
-  std::vector<int> present;
-  for (const auto& shot : scene.shots) {
-    if (manifest.find(shot.name) &&
-        fs::exists(run_dir / backends::image_relative_path(scene.camera, shot))) {
-      present.push_back(shot.index);
-    }
-  }
-  std::string error;
-  if (!backends::write_colmap_sparse(run_dir / "sparse", scene, present, options.scale, &error) ||
-      !backends::write_transforms_json(run_dir / "transforms.json", scene, present, options.scale,
-                                       &error)) {
-    log << fmt::format("rigc: error: {}\n", error);
-    return 2;
-  }
-  if (failures) {
-    log << fmt::format("rigc: {} of {} shots failed; rerun to retry them\n", failures,
-                       shots.size());
-    return 2;
-  }
-  log << fmt::format("rigc: {} shots in {}\n", shots.size(), run_dir.string());
-  return 0;
+  return backends::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);
 }
 
 }  // namespace rigc::preview

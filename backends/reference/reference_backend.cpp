@@ -9,6 +9,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/manifest.h"
+#include "backends/common/run_folder.h"
 #include "backends/common/transforms_json.h"
 #include "backends/reference/process.h"
 #include "dslr/image_io.h"
@@ -87,20 +88,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
                   std::ostream& log, std::vector<ShotTiming>* timings) {
   const fs::path run_dir = options.output_dir;
   const fs::path work_dir = render_folder(run_dir);
-  std::error_code ec;
-  for (const fs::path& dir :
-       {run_dir / "images", run_dir / "masks", run_dir / "sparse", work_dir}) {
-    fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir)) {
-      log << fmt::format("rigc: error: cannot create the output folder '{}': {}\n", dir.string(),
-                         ec ? ec.message() : "not a folder");
-      return 1;
-    }
-  }
-  if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
-    log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
-    return 1;
-  }
+  if (!backends::prepare_run_folder(run_dir, {work_dir}, log)) return 1;
   if (!(options.scale > 0) || options.samples < 0) {
     log << "rigc: error: the scale must be positive and the samples not negative\n";
     return 1;
@@ -167,6 +155,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
     }
     const auto start = Clock::now();
     const fs::path log_path = work_dir / (shot.name + ".log");
+    std::error_code ec;
     fs::remove(log_path, ec);
     RenderedShot rendered;
     std::string error;
@@ -229,28 +218,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
   }
   if (options.progress_bar) log << '\n';
 
-  // Ground truth for every shot that has its image in this run folder.
-  std::vector<int> present;
-  for (const auto& shot : scene.shots) {
-    if (manifest.find(shot.name) &&
-        fs::exists(run_dir / backends::image_relative_path(scene.camera, shot))) {
-      present.push_back(shot.index);
-    }
-  }
-  std::string error;
-  if (!backends::write_colmap_sparse(run_dir / "sparse", scene, present, options.scale, &error) ||
-      !backends::write_transforms_json(run_dir / "transforms.json", scene, present, options.scale,
-                                       &error)) {
-    log << fmt::format("rigc: error: {}\n", error);
-    return 2;
-  }
-  if (failures) {
-    log << fmt::format("rigc: {} of {} shots failed; rerun to retry them\n", failures,
-                       shots.size());
-    return 2;
-  }
-  log << fmt::format("rigc: {} shots in {}\n", shots.size(), run_dir.string());
-  return 0;
+  return backends::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);
 }
 
 }  // namespace rigc::reference

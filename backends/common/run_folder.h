@@ -1,0 +1,25 @@
+// The parts of a backend run that do not depend on the renderer: preparing the run folder and,
+// at the end, writing the ground truth for the shots whose images are there.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <vector>
+
+#include "backends/common/manifest.h"
+#include "compiler/ir.h"
+
+namespace rigc::backends {
+
+// Creates run_dir/{images,masks,sparse} and `extra` folders and checks that they are writable.
+// False after writing a `rigc: error:` line to `log`.
+bool prepare_run_folder(const std::filesystem::path& run_dir,
+                        const std::vector<std::filesystem::path>& extra, std::ostream& log);
+
+// Writes sparse/ and transforms.json for every shot that has its image in the run folder, and
+// the closing line. Returns the run's exit code: 2 if anything failed, else 0.
+int finish_run(const ir::Scene& scene, const Manifest& manifest,
+               const std::filesystem::path& run_dir, double scale, int failures, size_t shots,
+               std::ostream& log);
+
+}  // namespace rigc::backends
