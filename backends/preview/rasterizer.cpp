@@ -376,27 +376,38 @@ ScreenSetup setup_screen(int total_tris, const WorldVertex& world_vertex, const 
   std::vector<ScreenTriangle>& screen_tris = setup.tris;
   const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
   const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
-  screen_tris.reserve(total_tris + 64);
-  for (int t = 0; t < total_tris; ++t) {
-    std::array<Vector3f, 3> cam;
-    for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
-    if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
-    clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
-      ScreenTriangle s;
-      for (int c = 0; c < 3; ++c) {
-        s.inv_z[c] = 1 / p[c].z();
-        // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
-        s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
-        s.source_bary[c] = b[c];
-      }
-      const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
-      if (std::abs(area) < 1e-10f) return;
-      s.inv_area = 1 / area;
-      s.source = t;
-      s.compute_planes();
-      screen_tris.push_back(s);
-    });
-  }
+  // Chunks in parallel, joined in order, so the result (and any depth tie) matches a serial pass.
+  constexpr int kChunk = 8192;
+  const int chunks = (total_tris + kChunk - 1) / kChunk;
+  std::vector<std::vector<ScreenTriangle>> parts(chunks);
+  tbb::parallel_for(0, chunks, [&](int chunk) {
+    std::vector<ScreenTriangle>& part = parts[chunk];
+    const int end = std::min(total_tris, (chunk + 1) * kChunk);
+    for (int t = chunk * kChunk; t < end; ++t) {
+      std::array<Vector3f, 3> cam;
+      for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
+      if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
+      clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
+        ScreenTriangle s;
+        for (int c = 0; c < 3; ++c) {
+          s.inv_z[c] = 1 / p[c].z();
+          // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
+          s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
+          s.source_bary[c] = b[c];
+        }
+        const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
+        if (std::abs(area) < 1e-10f) return;
+        s.inv_area = 1 / area;
+        s.source = t;
+        s.compute_planes();
+        part.push_back(s);
+      });
+    }
+  });
+  size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  screen_tris.reserve(total);
+  for (const auto& part : parts) screen_tris.insert(screen_tris.end(), part.begin(), part.end());
   const int tiles_x = setup.tiles_x = (canvas.width + kTileSize - 1) / kTileSize;
   const int tiles_y = setup.tiles_y = (canvas.height + kTileSize - 1) / kTileSize;
   auto& bins = setup.bins;
