@@ -26,6 +26,8 @@ constexpr double kBlurBinWidth = 0.01;
 struct ShotSums {
   double visible = 0, fresh = 0, overlap = 0, out_of_focus = 0, clipped = 0, dark = 0, oblique = 0,
          coarse = 0;
+  double seen_gain[4] = {0, 0, 0, 0};  // area whose view count reached 1, 2, 3 in this shot
+  double reconstructable_gain = 0;
   double nearest = 1e30;
   std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
 };
@@ -100,6 +102,7 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
   std::vector<double> blur_histogram(kBlurBins + 1, 0.0);
   const double cos_max_angle = std::cos(settings.max_view_angle_rad);
   const double cos_min_triangulation = std::cos(settings.min_triangulation_angle_rad);
+  double seen_area[4] = {0, 0, 0, 0}, reconstructable_area = 0;
 
   for (int s = 0; s < shot_count; ++s) {
     const ir::Shot& shot = scene.shots[s];
@@ -146,6 +149,7 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
             if (result.views[f] == 1) result.second_seen[f] = static_cast<std::uint16_t>(s);
             sum.nearest = std::min(sum.nearest, p.z());
             ++result.views[f];
+            if (result.views[f] <= 3) sum.seen_gain[result.views[f]] += area;
 
             // Footprint at full resolution.
             const auto& t = mesh.triangles[f];
@@ -196,6 +200,7 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
               if (ray.dot((eye_object[earlier] - center[f]).normalized()) <=
                   cos_min_triangulation) {
                 result.reconstructable[f] = 1;
+                sum.reconstructable_gain += area;
                 break;
               }
             }
@@ -213,6 +218,8 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
       total.oblique += part.oblique;
       total.coarse += part.coarse;
       total.nearest = std::min(total.nearest, part.nearest);
+      for (int k = 1; k <= 3; ++k) seen_area[k] += part.seen_gain[k];
+      reconstructable_area += part.reconstructable_gain;
       for (int b = 0; b <= kBlurBins; ++b) blur_histogram[b] += part.blur_histogram[b];
     }
     ShotCoverage coverage;
@@ -230,19 +237,12 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
     size_t object_pixels = 0;
     for (const auto id : buffer.object_triangle) object_pixels += id >= 0;
     coverage.frame_fill = static_cast<double>(object_pixels) / buffer.object_triangle.size();
-    double seen[4] = {0, 0, 0, 0}, reconstructable = 0;
-    for (size_t f = 0; f < face_count; ++f) {
-      const double area = result.face_area_m2[f];
-      for (int k = 1; k <= 3; ++k) {
-        if (result.views[f] >= k) seen[k] += area;
-      }
-      if (result.reconstructable[f]) reconstructable += area;
-    }
     const double total_area = std::max(result.total_area_m2, 1e-30);
-    coverage.seen_1 = seen[1] / total_area;
-    coverage.seen_2 = seen[2] / total_area;
-    coverage.seen_3 = seen[3] / total_area;
-    coverage.reconstructable = reconstructable / total_area;
+    // Running totals: the faces that gained a view or became reconstructable in this shot.
+    coverage.seen_1 = seen_area[1] / total_area;
+    coverage.seen_2 = seen_area[2] / total_area;
+    coverage.seen_3 = seen_area[3] / total_area;
+    coverage.reconstructable = reconstructable_area / total_area;
     result.shots.push_back(coverage);
     std::swap(seen_previous, seen_now);
   }

@@ -3,9 +3,10 @@
 // are rendered at --visibility-scale (default: about 1400 px across); footprints, angles, focus
 // and exposure are computed per face at full sensor resolution.
 // Usage: coverage_table [--visibility-scale S]
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cstring>
-#include <fmt/format.h>
 #include <iostream>
 
 #include "analysis/coverage.h"
