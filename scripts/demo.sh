@@ -6,6 +6,7 @@ cd "$(dirname "$0")/.."
 bash scripts/build.sh
 scene=scenes/paper-turntable.yaml
 out=out/paper-turntable
+mkdir -p out
 ./build/rigc check "$scene"
 ./build/rigc compile "$scene" --target ir --no-geometry -o "$out.ir.json"
 # A quarter of the Canon 6D's resolution keeps the demo quick; drop --scale for full size.
