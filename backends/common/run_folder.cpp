@@ -12,6 +12,13 @@ namespace rigc::backends {
 
 namespace fs = std::filesystem;
 
+std::string progress_line(int done, int total, const std::string& name, double seconds) {
+  constexpr int kWidth = 30;
+  const int filled = total > 0 ? done * kWidth / total : kWidth;
+  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s", std::string(filled, '#'),
+                     std::string(kWidth - filled, ' '), done, total, name, seconds);
+}
+
 bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& extra,
                         std::ostream& log) {
   std::vector<fs::path> folders = {run_dir / "images", run_dir / "masks", run_dir / "sparse"};

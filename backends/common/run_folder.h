@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <iosfwd>
+#include <string>
 #include <vector>
 
 #include "backends/common/manifest.h"
@@ -15,6 +16,9 @@ namespace rigc::backends {
 // False after writing a `rigc: error:` line to `log`.
 bool prepare_run_folder(const std::filesystem::path& run_dir,
                         const std::vector<std::filesystem::path>& extra, std::ostream& log);
+
+// "\r[#####     ] 5/18 shot_004 0.42 s": the progress bar a run redraws on a terminal.
+std::string progress_line(int done, int total, const std::string& name, double seconds);
 
 // Writes sparse/ and transforms.json for every shot that has its image in the run folder, and
 // the closing line. Returns the run's exit code: 2 if anything failed, else 0.

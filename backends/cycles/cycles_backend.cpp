@@ -183,23 +183,7 @@ class CyclesRenderer : public reference::Renderer {
 
 bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
                                 int samples, std::string* error) {
-  if (!(scale > 0) || !std::isfinite(scale)) {
-    *error = "the render scale must be a positive number";
-    return false;
-  }
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir)) {
-    *error = fmt::format("cannot create the folder '{}'", dir.string());
-    return false;
-  }
-  for (const auto& shot : scene.shots) {
-    if (!reference::is_plain_file_stem(shot.name)) {
-      *error =
-          fmt::format("shot name '{}' cannot be a file name", reference::comment_text(shot.name));
-      return false;
-    }
-  }
+  if (!reference::prepare_emit_folder(scene, dir, scale, error)) return false;
   const preview::StudioScene studio = preview::prepare_studio_scene(scene);
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());

@@ -28,13 +28,6 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-std::string progress_line(int done, int total, const std::string& name, double seconds) {
-  constexpr int kWidth = 30;
-  const int filled = total > 0 ? done * kWidth / total : kWidth;
-  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s", std::string(filled, '#'),
-                     std::string(kWidth - filled, ' '), done, total, name, seconds);
-}
-
 }  // namespace
 
 int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
@@ -173,7 +166,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
-      log << progress_line(done, static_cast<int>(shots.size()), shot.name, timing.total_ms / 1000)
+      log << backends::progress_line(done, static_cast<int>(shots.size()), shot.name,
+                                     timing.total_ms / 1000)
           << std::flush;
     } else {
       log << fmt::format("{}: rendered in {:.2f} s ({} sub-frame{})\n", shot.name,

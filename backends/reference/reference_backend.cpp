@@ -12,6 +12,7 @@
 #include "backends/common/run_folder.h"
 #include "backends/common/transforms_json.h"
 #include "backends/reference/process.h"
+#include "backends/reference/script_text.h"
 #include "dslr/image_io.h"
 #include "dslr/lens.h"
 #include "dslr/pipeline.h"
@@ -25,13 +26,6 @@ namespace {
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string progress_line(int done, int total, const std::string& name, double seconds) {
-  constexpr int kWidth = 30;
-  const int filled = total > 0 ? done * kWidth / total : kWidth;
-  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s", std::string(filled, '#'),
-                     std::string(kWidth - filled, ' '), done, total, name, seconds);
 }
 
 }  // namespace
@@ -80,6 +74,27 @@ bool write_texture_png(const fs::path& path, const ir::Texture& texture, std::st
     *error = fmt::format("cannot write the texture '{}': {}", path.string(),
                          output ? output->geterror() : OIIO::geterror());
     return false;
+  }
+  return true;
+}
+
+bool prepare_emit_folder(const ir::Scene& scene, const fs::path& dir, double scale,
+                         std::string* error) {
+  if (!(scale > 0) || !std::isfinite(scale)) {
+    *error = "the render scale must be a positive number";
+    return false;
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) {
+    *error = fmt::format("cannot create the folder '{}'", dir.string());
+    return false;
+  }
+  for (const auto& shot : scene.shots) {
+    if (!is_plain_file_stem(shot.name)) {
+      *error = fmt::format("shot name '{}' cannot be a file name", comment_text(shot.name));
+      return false;
+    }
   }
   return true;
 }
@@ -209,7 +224,8 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
-      log << progress_line(done, static_cast<int>(shots.size()), shot.name, timing.total_ms / 1000)
+      log << backends::progress_line(done, static_cast<int>(shots.size()), shot.name,
+                                     timing.total_ms / 1000)
           << std::flush;
     } else {
       log << fmt::format("{}: rendered with {} in {:.2f} s\n", shot.name, renderer.name(),

@@ -62,6 +62,11 @@ class Renderer {
                       std::string* error) = 0;
 };
 
+// What every emit() checks first: a positive scale, that `dir` exists or can be made, and that
+// every shot name can be a file name. False with a one-line `error`.
+bool prepare_emit_folder(const ir::Scene& scene, const std::filesystem::path& dir, double scale,
+                         std::string* error);
+
 // Runs the whole backend; returns the exit code (0 ok, 1 user error, 2 renderer failure).
 int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Renderer& renderer,
                   std::ostream& log, std::vector<ShotTiming>* timings = nullptr);
