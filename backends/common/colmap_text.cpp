@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "backends/common/files.h"
+#include "dslr/lens.h"
 
 namespace rigc::backends {
 namespace fs = std::filesystem;
@@ -68,20 +69,15 @@ std::optional<OutputCamera> output_camera(const ir::Camera& camera, double scale
     }
     return std::nullopt;
   }
-  // Same rounding and fallbacks as dslr::sensor_intrinsics, which the renderers develop with.
+  // The grid the renderers develop onto, so the ground truth describes the written images.
+  const dslr::Intrinsics sensor = dslr::sensor_intrinsics(camera, scale);
   OutputCamera out;
-  out.width = std::max(1, static_cast<int>(std::lround(camera.width_px * scale)));
-  out.height = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
-  const double sx = static_cast<double>(out.width) / camera.width_px;
-  const double sy = static_cast<double>(out.height) / camera.height_px;
-  const double fx =
-      camera.fx > 0 ? camera.fx : camera.focal_length_m * camera.width_px / camera.sensor_width_m;
-  const double fy =
-      camera.fy > 0 ? camera.fy : camera.focal_length_m * camera.height_px / camera.sensor_height_m;
-  out.fx = fx * sx;
-  out.fy = fy * sy;
-  out.cx = (camera.cx > 0 ? camera.cx : camera.width_px / 2.0) * sx;
-  out.cy = (camera.cy > 0 ? camera.cy : camera.height_px / 2.0) * sy;
+  out.width = sensor.width;
+  out.height = sensor.height;
+  out.fx = sensor.fx;
+  out.fy = sensor.fy;
+  out.cx = sensor.cx;
+  out.cy = sensor.cy;
   if (camera.effects.distortion) out.distortion = camera.distortion;
   out.model = out.distortion.k3 != 0 ? "FULL_OPENCV" : "OPENCV";
   return out;
