@@ -10,9 +10,11 @@
 #include <iostream>
 
 #include "analysis/coverage.h"
+#include "backends/common/allocator.h"
 #include "compiler/frontend.h"
 
 int main(int argc, char** argv) {
+  rigc::keep_freed_memory();  // as the rigc command does
   double visibility_scale = 0;
   for (int i = 1; i + 1 < argc; ++i) {
     if (!std::strcmp(argv[i], "--visibility-scale")) visibility_scale = std::atof(argv[i + 1]);

@@ -15,6 +15,7 @@
 #include <map>
 #include <sstream>
 
+#include "backends/common/allocator.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "compiler/primitives.h"
@@ -91,6 +92,7 @@ rigc::ir::Scene load(const std::string& path, int statue_detail) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rigc::keep_freed_memory();  // as the rigc command does
   std::string scene_path = "scenes/paper-turntable.yaml";
   bool full = false;
   int shots = 18;

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "backends/common/allocator.h"
 #include "backends/cycles/cycles_backend.h"
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
@@ -51,6 +52,7 @@ Row measure(const std::string& backend, const rigc::ir::Scene& scene, Options op
 }  // namespace
 
 int main(int argc, char** argv) {
+  rigc::keep_freed_memory();  // as the rigc command does
   std::string scene_path = "scenes/paper-turntable.yaml";
   int shots = 2, samples = 16;
   for (int i = 1; i < argc; ++i) {

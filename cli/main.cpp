@@ -1,5 +1,7 @@
+#include "backends/common/allocator.h"
 #include "cli/commands.h"
 
 int main(int argc, char** argv) {
+  rigc::keep_freed_memory();
   return rigc::cli::run_main(std::vector<std::string>(argv, argv + argc));
 }

@@ -32,30 +32,33 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// A triangle after clipping and projection. Attributes are looked up in the source triangle
-// through the barycentric coordinates each clipped vertex has there.
+// A triangle after clipping and projection, 64 bytes: a million of them are set up per frame,
+// so their size is memory traffic. Attributes are looked up in the source triangle through the
+// barycentric coordinates each corner has there (identity unless the triangle was clipped).
 struct ScreenTriangle {
-  std::array<Vector2f, 3> screen;  // pixel coordinates
-  std::array<float, 3> inv_z;      // 1 / camera z
-  std::array<Vector3f, 3> source_bary;
-  float inv_area = 0;       // 1 / (twice the signed screen area)
-  std::int32_t source = 0;  // triangle index; object triangles first, then studio
   // Planes in pixel coordinates, value = a·x + b·y + c: the barycentrics w0, w1 and 1/z.
   std::array<float, 3> w0_plane, w1_plane, inv_z_plane;
-
-  void compute_planes() {
-    auto edge_plane = [&](const Vector2f& a, const Vector2f& b) {
-      return std::array<float, 3>{-(b.y() - a.y()) * inv_area, (b.x() - a.x()) * inv_area,
-                                  ((b.y() - a.y()) * a.x() - (b.x() - a.x()) * a.y()) * inv_area};
-    };
-    w0_plane = edge_plane(screen[1], screen[2]);
-    w1_plane = edge_plane(screen[2], screen[0]);
-    // w2 = 1 - w0 - w1, so 1/z = iz2 + w0·(iz0 - iz2) + w1·(iz1 - iz2).
-    const float d0 = inv_z[0] - inv_z[2], d1 = inv_z[1] - inv_z[2];
-    for (int i = 0; i < 3; ++i) inv_z_plane[i] = w0_plane[i] * d0 + w1_plane[i] * d1;
-    inv_z_plane[2] += inv_z[2];
-  }
+  std::array<float, 3> inv_z;  // 1 / camera z at the corners
+  // Pixels the bounding box touches on the canvas, inclusive.
+  std::uint16_t x0, y0, x1, y1;
+  std::int32_t source;   // triangle index; object triangles first, then studio
+  std::int32_t clipped;  // -1, or index of the corners' source barycentrics in ScreenSetup
 };
+static_assert(sizeof(ScreenTriangle) == 64);
+
+// The planes of a screen triangle with corners `screen`, given 1 / (twice its signed area).
+void compute_planes(ScreenTriangle& t, const std::array<Vector2f, 3>& screen, float inv_area) {
+  auto edge_plane = [&](const Vector2f& a, const Vector2f& b) {
+    return std::array<float, 3>{-(b.y() - a.y()) * inv_area, (b.x() - a.x()) * inv_area,
+                                ((b.y() - a.y()) * a.x() - (b.x() - a.x()) * a.y()) * inv_area};
+  };
+  t.w0_plane = edge_plane(screen[1], screen[2]);
+  t.w1_plane = edge_plane(screen[2], screen[0]);
+  // w2 = 1 - w0 - w1, so 1/z = iz2 + w0·(iz0 - iz2) + w1·(iz1 - iz2).
+  const float d0 = t.inv_z[0] - t.inv_z[2], d1 = t.inv_z[1] - t.inv_z[2];
+  for (int i = 0; i < 3; ++i) t.inv_z_plane[i] = t.w0_plane[i] * d0 + t.w1_plane[i] * d1;
+  t.inv_z_plane[2] += t.inv_z[2];
+}
 
 struct FrameGeometry {
   const Geometry* object;
@@ -100,16 +103,12 @@ inline float edge(const Vector2f& a, const Vector2f& b, float px, float py) {
 
 // Perspective-correct barycentrics of the screen triangle at (px, py), unclamped.
 inline Vector3f screen_bary(const ScreenTriangle& t, float px, float py) {
-  const float w0 = edge(t.screen[1], t.screen[2], px, py) * t.inv_area;
-  const float w1 = edge(t.screen[2], t.screen[0], px, py) * t.inv_area;
+  const float w0 = t.w0_plane[0] * px + t.w0_plane[1] * py + t.w0_plane[2];
+  const float w1 = t.w1_plane[0] * px + t.w1_plane[1] * py + t.w1_plane[2];
   const float w2 = 1 - w0 - w1;
   Vector3f p(w0 * t.inv_z[0], w1 * t.inv_z[1], w2 * t.inv_z[2]);
   const float sum = p.sum();
   return sum != 0 ? Vector3f(p / sum) : Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3);
-}
-
-inline Vector3f source_bary(const ScreenTriangle& t, const Vector3f& b) {
-  return b.x() * t.source_bary[0] + b.y() * t.source_bary[1] + b.z() * t.source_bary[2];
 }
 
 // A depth map from a light, over the shadow casters (object and turntable).
@@ -363,72 +362,144 @@ float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h, f
 
 struct ScreenSetup {
   std::vector<ScreenTriangle> tris;
-  std::vector<std::vector<std::int32_t>> bins;  // per tile, indices into tris
+  std::vector<std::array<Vector3f, 3>> clipped_bary;  // per clipped triangle, its corners'
+  // Triangles per tile: tile_tris[tile_start[tile] .. tile_start[tile + 1]), in triangle order.
+  std::vector<std::int32_t> tile_start;
+  std::vector<std::int32_t> tile_tris;
   int tiles_x = 0;
   int tiles_y = 0;
+
+  // Barycentrics in the source triangle of a point with barycentrics b in screen triangle t.
+  Vector3f source_bary(const ScreenTriangle& t, const Vector3f& b) const {
+    if (t.clipped < 0) return b;
+    const auto& corner = clipped_bary[t.clipped];
+    return b.x() * corner[0] + b.y() * corner[1] + b.z() * corner[2];
+  }
 };
 
-// Transforms (world_vertex(t, corner) -> world), clips, projects and bins every triangle.
-template <typename WorldVertex>
-ScreenSetup setup_screen(int total_tris, const WorldVertex& world_vertex, const Matrix3f& cam_rot,
-                         const Vector3f& cam_t, const dslr::Intrinsics& canvas) {
+// Transforms (camera_vertex(t, corner) -> camera space), clips, projects and bins every triangle.
+// Chunks run in parallel and are joined in order, so the result (and any depth tie) matches a
+// serial pass.
+template <typename CameraVertex>
+ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
+                         const dslr::Intrinsics& canvas) {
   ScreenSetup setup;
-  std::vector<ScreenTriangle>& screen_tris = setup.tris;
   const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
   const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
-  // Chunks in parallel, joined in order, so the result (and any depth tie) matches a serial pass.
-  constexpr int kChunk = 8192;
+  const int width = canvas.width, height = canvas.height;
+  struct Part {
+    std::vector<ScreenTriangle> tris;
+    std::vector<std::array<Vector3f, 3>> clipped_bary;
+  };
+  constexpr int kChunk = 16384;
   const int chunks = (total_tris + kChunk - 1) / kChunk;
-  std::vector<std::vector<ScreenTriangle>> parts(chunks);
+  std::vector<Part> parts(chunks);
   tbb::parallel_for(0, chunks, [&](int chunk) {
-    std::vector<ScreenTriangle>& part = parts[chunk];
-    const int end = std::min(total_tris, (chunk + 1) * kChunk);
-    for (int t = chunk * kChunk; t < end; ++t) {
+    Part& part = parts[chunk];
+    const int begin = chunk * kChunk, end = std::min(total_tris, begin + kChunk);
+    part.tris.reserve(end - begin);
+    // Projects a camera-space triangle; keeps it when it has area and touches the canvas.
+    auto emit = [&](int source, const std::array<Vector3f, 3>& p, std::int32_t clipped) {
+      ScreenTriangle s;
+      std::array<Vector2f, 3> screen;
+      for (int c = 0; c < 3; ++c) {
+        s.inv_z[c] = 1 / p[c].z();
+        // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
+        screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
+      }
+      const float area = edge(screen[0], screen[1], screen[2].x(), screen[2].y());
+      if (std::abs(area) < 1e-10f) return false;
+      const float min_x = std::min({screen[0].x(), screen[1].x(), screen[2].x()});
+      const float max_x = std::max({screen[0].x(), screen[1].x(), screen[2].x()});
+      const float min_y = std::min({screen[0].y(), screen[1].y(), screen[2].y()});
+      const float max_y = std::max({screen[0].y(), screen[1].y(), screen[2].y()});
+      if (max_x < 0 || max_y < 0 || min_x >= width || min_y >= height) return false;
+      s.x0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_x)));
+      s.y0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_y)));
+      s.x1 = static_cast<std::uint16_t>(std::min<float>(width - 1, std::floor(max_x)));
+      s.y1 = static_cast<std::uint16_t>(std::min<float>(height - 1, std::floor(max_y)));
+      s.source = source;
+      s.clipped = clipped;
+      compute_planes(s, screen, 1 / area);
+      part.tris.push_back(s);
+      return true;
+    };
+    for (int t = begin; t < end; ++t) {
       std::array<Vector3f, 3> cam;
-      for (int c = 0; c < 3; ++c) cam[c] = cam_rot * world_vertex(t, c) + cam_t;
-      if (cam[0].z() < kNear && cam[1].z() < kNear && cam[2].z() < kNear) continue;
+      for (int c = 0; c < 3; ++c) cam[c] = camera_vertex(t, c);
+      const int in_front = (cam[0].z() >= kNear) + (cam[1].z() >= kNear) + (cam[2].z() >= kNear);
+      if (in_front == 0) continue;
+      if (in_front == 3) {
+        emit(t, cam, -1);
+        continue;
+      }
       clip_near(cam, [&](const std::array<Vector3f, 3>& p, const std::array<Vector3f, 3>& b) {
-        ScreenTriangle s;
-        for (int c = 0; c < 3; ++c) {
-          s.inv_z[c] = 1 / p[c].z();
-          // Pixel centres at +0.5: u = fx·x/z + cx puts the image centre at cx.
-          s.screen[c] = {fx * p[c].x() * s.inv_z[c] + cx, fy * p[c].y() * s.inv_z[c] + cy};
-          s.source_bary[c] = b[c];
+        if (emit(t, p, static_cast<std::int32_t>(part.clipped_bary.size()))) {
+          part.clipped_bary.push_back(b);
         }
-        const float area = edge(s.screen[0], s.screen[1], s.screen[2].x(), s.screen[2].y());
-        if (std::abs(area) < 1e-10f) return;
-        s.inv_area = 1 / area;
-        s.source = t;
-        s.compute_planes();
-        part.push_back(s);
       });
     }
   });
-  size_t total = 0;
-  for (const auto& part : parts) total += part.size();
-  screen_tris.reserve(total);
-  for (const auto& part : parts) screen_tris.insert(screen_tris.end(), part.begin(), part.end());
-  const int tiles_x = setup.tiles_x = (canvas.width + kTileSize - 1) / kTileSize;
-  const int tiles_y = setup.tiles_y = (canvas.height + kTileSize - 1) / kTileSize;
-  auto& bins = setup.bins;
-  bins.resize(static_cast<size_t>(tiles_x) * tiles_y);
-  for (size_t i = 0; i < screen_tris.size(); ++i) {
-    const auto& s = screen_tris[i];
-    const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-    const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-    const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-    const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-    if (max_x < 0 || max_y < 0 || min_x >= canvas.width || min_y >= canvas.height) continue;
-    const int tx0 = std::max(0, static_cast<int>(min_x) / kTileSize);
-    const int tx1 = std::min(tiles_x - 1, static_cast<int>(max_x) / kTileSize);
-    const int ty0 = std::max(0, static_cast<int>(min_y) / kTileSize);
-    const int ty1 = std::min(tiles_y - 1, static_cast<int>(max_y) / kTileSize);
-    for (int ty = ty0; ty <= ty1; ++ty) {
-      for (int tx = tx0; tx <= tx1; ++tx) {
-        bins[static_cast<size_t>(ty) * tiles_x + tx].push_back(static_cast<std::int32_t>(i));
-      }
+  // Join the chunks in order.
+  std::vector<size_t> tri_offset(chunks + 1, 0), clipped_offset(chunks + 1, 0);
+  for (int c = 0; c < chunks; ++c) {
+    tri_offset[c + 1] = tri_offset[c] + parts[c].tris.size();
+    clipped_offset[c + 1] = clipped_offset[c] + parts[c].clipped_bary.size();
+  }
+  setup.tris.resize(tri_offset[chunks]);
+  setup.clipped_bary.resize(clipped_offset[chunks]);
+  tbb::parallel_for(0, chunks, [&](int c) {
+    std::copy(parts[c].clipped_bary.begin(), parts[c].clipped_bary.end(),
+              setup.clipped_bary.begin() + clipped_offset[c]);
+    ScreenTriangle* out = setup.tris.data() + tri_offset[c];
+    for (ScreenTriangle s : parts[c].tris) {
+      if (s.clipped >= 0) s.clipped += static_cast<std::int32_t>(clipped_offset[c]);
+      *out++ = s;
+    }
+    std::vector<ScreenTriangle>().swap(parts[c].tris);
+  });
+
+  // Bin into tiles: count per block of triangles and tile, then fill, both in parallel; tile-major
+  // offsets with blocks in order keep each tile's list in triangle order.
+  const int tiles_x = setup.tiles_x = (width + kTileSize - 1) / kTileSize;
+  const int tiles_y = setup.tiles_y = (height + kTileSize - 1) / kTileSize;
+  const int tiles = tiles_x * tiles_y;
+  const int tri_count = static_cast<int>(setup.tris.size());
+  const int blocks = std::clamp(tri_count / 16384, 1, 64);
+  auto block_begin = [&](int b) {
+    return static_cast<int>(static_cast<std::int64_t>(tri_count) * b / blocks);
+  };
+  std::vector<std::int32_t> cursor(static_cast<size_t>(blocks) * tiles, 0);
+  auto for_each_tile = [&](const ScreenTriangle& s, auto&& fn) {
+    for (int ty = s.y0 / kTileSize; ty <= s.y1 / kTileSize; ++ty) {
+      for (int tx = s.x0 / kTileSize; tx <= s.x1 / kTileSize; ++tx) fn(ty * tiles_x + tx);
+    }
+  };
+  tbb::parallel_for(0, blocks, [&](int b) {
+    std::int32_t* count = cursor.data() + static_cast<size_t>(b) * tiles;
+    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
+      for_each_tile(setup.tris[i], [&](int tile) { ++count[tile]; });
+    }
+  });
+  setup.tile_start.resize(tiles + 1);
+  std::int32_t running = 0;
+  for (int tile = 0; tile < tiles; ++tile) {
+    setup.tile_start[tile] = running;
+    for (int b = 0; b < blocks; ++b) {
+      std::int32_t& slot = cursor[static_cast<size_t>(b) * tiles + tile];
+      const std::int32_t count = slot;
+      slot = running;
+      running += count;
     }
   }
+  setup.tile_start[tiles] = running;
+  setup.tile_tris.resize(running);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    std::int32_t* next = cursor.data() + static_cast<size_t>(b) * tiles;
+    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
+      for_each_tile(setup.tris[i], [&](int tile) { setup.tile_tris[next[tile]++] = i; });
+    }
+  });
   return setup;
 }
 
@@ -450,16 +521,12 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
           const int y1 = std::min(y0 + kTileSize, canvas.height);
           std::fill(sample_inv_z.begin(), sample_inv_z.end(), 0.0f);
           std::fill(sample_tri.begin(), sample_tri.end(), -1);
-          for (const std::int32_t id : setup.bins[tile]) {
+          const std::int32_t* bin = setup.tile_tris.data();
+          for (std::int32_t i = setup.tile_start[tile]; i < setup.tile_start[tile + 1]; ++i) {
+            const std::int32_t id = bin[i];
             const ScreenTriangle& s = setup.tris[id];
-            const float min_x = std::min({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-            const float max_x = std::max({s.screen[0].x(), s.screen[1].x(), s.screen[2].x()});
-            const float min_y = std::min({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-            const float max_y = std::max({s.screen[0].y(), s.screen[1].y(), s.screen[2].y()});
-            const int px0 = std::max(x0, static_cast<int>(std::floor(min_x)));
-            const int px1 = std::min(x1 - 1, static_cast<int>(std::floor(max_x)));
-            const int py0 = std::max(y0, static_cast<int>(std::floor(min_y)));
-            const int py1 = std::min(y1 - 1, static_cast<int>(std::floor(max_y)));
+            const int px0 = std::max<int>(x0, s.x0), px1 = std::min<int>(x1 - 1, s.x1);
+            const int py0 = std::max<int>(y0, s.y0), py1 = std::min<int>(y1 - 1, s.y1);
             for (int py = py0; py <= py1; ++py) {
               for (int px = px0; px <= px1; ++px) {
                 const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
@@ -511,8 +578,23 @@ struct FrameContext {
     return room.positions[room.triangles[tri - object_tris][corner]];
   }
   ScreenSetup setup(const dslr::Intrinsics& canvas) const {
+    // One affine map per mesh, written out: Eigen's generic product did not inline here.
+    const Matrix3f object_to_cam = cam_rot * object_rot;
+    const Vector3f object_to_cam_t = cam_rot * object_t + cam_t;
+    auto apply = [](const Matrix3f& m, const Vector3f& t, const Vector3f& p) {
+      return Vector3f(m(0, 0) * p.x() + m(0, 1) * p.y() + m(0, 2) * p.z() + t.x(),
+                      m(1, 0) * p.x() + m(1, 1) * p.y() + m(1, 2) * p.z() + t.y(),
+                      m(2, 0) * p.x() + m(2, 1) * p.y() + m(2, 2) * p.z() + t.z());
+    };
     return setup_screen(
-        total_tris, [&](int t, int c) { return world_vertex(t, c); }, cam_rot, cam_t, canvas);
+        total_tris,
+        [&](int t, int c) {
+          if (t < object_tris) {
+            return apply(object_to_cam, object_to_cam_t, object.positions[object.triangles[t][c]]);
+          }
+          return apply(cam_rot, cam_t, room.positions[room.triangles[t - object_tris][c]]);
+        },
+        canvas);
   }
 
   const Geometry& object;
@@ -595,7 +677,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const Geometry& g = is_object ? object : room;
     const int local = is_object ? t : t - object_tris;
     const auto& tri = g.triangles[local];
-    Vector3f b = source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
+    Vector3f b = setup.source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
     b /= b.sum();
     const Vector3f p_local =
         b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
@@ -622,7 +704,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size())) {
       const MipTexture& texture = studio.textures[material.texture];
       auto uv_at = [&](float qx, float qy) {
-        Vector3f bq = source_bary(s, screen_bary(s, qx, qy));
+        Vector3f bq = setup.source_bary(s, screen_bary(s, qx, qy));
         return Vector2f(bq.x() * g.uvs[tri[0]] + bq.y() * g.uvs[tri[1]] + bq.z() * g.uvs[tri[2]]);
       };
       const Vector2f uv = b.x() * g.uvs[tri[0]] + b.y() * g.uvs[tri[1]] + b.z() * g.uvs[tri[2]];
