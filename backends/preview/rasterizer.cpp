@@ -111,6 +111,51 @@ inline Vector3f screen_bary(const ScreenTriangle& t, float px, float py) {
   return sum != 0 ? Vector3f(p / sum) : Vector3f(1.0f / 3, 1.0f / 3, 1.0f / 3);
 }
 
+// Items (triangles) sorted into cells (tiles, bands): cell c holds
+// items[start[c] .. start[c + 1]), in item order, so ties resolve as in a serial pass.
+struct CellBins {
+  std::vector<std::int32_t> start;
+  std::vector<std::int32_t> items;
+};
+
+// cells_of(i, fn) calls fn(cell) for every cell item i touches. Counting per block of items and
+// cell, then filling, both in parallel.
+template <typename CellsOf>
+CellBins bin_items(int item_count, int cell_count, const CellsOf& cells_of) {
+  CellBins bins;
+  const int blocks = std::clamp(item_count / 16384, 1, 64);
+  auto block_begin = [&](int b) {
+    return static_cast<int>(static_cast<std::int64_t>(item_count) * b / blocks);
+  };
+  std::vector<std::int32_t> cursor(static_cast<size_t>(blocks) * cell_count, 0);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    std::int32_t* count = cursor.data() + static_cast<size_t>(b) * cell_count;
+    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
+      cells_of(i, [&](int cell) { ++count[cell]; });
+    }
+  });
+  bins.start.resize(cell_count + 1);
+  std::int32_t running = 0;
+  for (int cell = 0; cell < cell_count; ++cell) {
+    bins.start[cell] = running;
+    for (int b = 0; b < blocks; ++b) {
+      std::int32_t& slot = cursor[static_cast<size_t>(b) * cell_count + cell];
+      const std::int32_t count = slot;
+      slot = running;
+      running += count;
+    }
+  }
+  bins.start[cell_count] = running;
+  bins.items.resize(running);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    std::int32_t* next = cursor.data() + static_cast<size_t>(b) * cell_count;
+    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
+      cells_of(i, [&](int cell) { bins.items[next[cell]++] = i; });
+    }
+  });
+  return bins;
+}
+
 // A depth map from a light, over the shadow casters (object and turntable).
 struct ShadowMap {
   bool orthographic = false;
@@ -190,6 +235,7 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
       }
     }
     if (blockers == 0) return 1;
+    if (blockers == 16) return 0;  // the whole search area blocks: umbra
     const float blocker = blocker_sum / blockers;
     const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
     radius = std::clamp(penumbra_m / texel, 1.5f, 24.0f);
@@ -203,78 +249,86 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
 
 void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>& tris) {
   const int size = map.size;
-  map.depth.assign(static_cast<size_t>(size) * size, std::numeric_limits<float>::infinity());
-  // Project once, then bin by bands of rows: each band owns its rows, so no locks are needed.
+  // Rasterized as a key that grows towards the light, one plane per triangle: -z for orthographic
+  // maps (z is affine in screen space) and 1/z for perspective ones. Converted to z at the end.
   struct Projected {
-    std::array<Vector2f, 3> s;
-    std::array<float, 3> z;
-    float inv_area;
+    std::array<float, 3> w0_plane, w1_plane, key_plane;
+    std::uint16_t x0, y0, x1, y1;
   };
   std::vector<Projected> projected(tris.size());
   std::vector<char> keep(tris.size(), 0);
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, tris.size(), 4096),
-      [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t t = range.begin(); t != range.end(); ++t) {
-          Projected& p = projected[t];
-          bool behind = false;
-          for (int i = 0; i < 3; ++i) {
-            const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
-            if (map.orthographic) {
-              p.s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
-            } else {
-              if (l.z() <= kNear) behind = true;
-              p.s[i] = {l.x() / l.z() * map.focal + size / 2.0f,
-                        l.y() / l.z() * map.focal + size / 2.0f};
-            }
-            p.z[i] = l.z();
-          }
-          const float area = edge(p.s[0], p.s[1], p.s[2].x(), p.s[2].y());
-          if (behind || std::abs(area) < 1e-12f) continue;
-          p.inv_area = 1 / area;
-          keep[t] = 1;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 4096), [&](const tbb::blocked_range<
+                                                                          size_t>& range) {
+    for (size_t t = range.begin(); t != range.end(); ++t) {
+      std::array<Vector2f, 3> s;
+      std::array<float, 3> key;
+      bool behind = false;
+      for (int i = 0; i < 3; ++i) {
+        const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
+        if (map.orthographic) {
+          s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
+          key[i] = -l.z();
+        } else {
+          if (l.z() <= kNear) behind = true;
+          s[i] = {l.x() / l.z() * map.focal + size / 2.0f, l.y() / l.z() * map.focal + size / 2.0f};
+          key[i] = 1 / l.z();
         }
-      });
+      }
+      const float area = edge(s[0], s[1], s[2].x(), s[2].y());
+      if (behind || std::abs(area) < 1e-12f) continue;
+      const float min_x = std::min({s[0].x(), s[1].x(), s[2].x()});
+      const float max_x = std::max({s[0].x(), s[1].x(), s[2].x()});
+      const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
+      const float max_y = std::max({s[0].y(), s[1].y(), s[2].y()});
+      if (max_x < 0 || max_y < 0 || min_x >= size || min_y >= size) continue;
+      Projected& p = projected[t];
+      // Texel centres at +0.5: texels whose centre can fall inside.
+      p.x0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_x - 0.5f)));
+      p.y0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_y - 0.5f)));
+      p.x1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_x)));
+      p.y1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_y)));
+      ScreenTriangle planes;
+      planes.inv_z = key;
+      compute_planes(planes, s, 1 / area);
+      p.w0_plane = planes.w0_plane;
+      p.w1_plane = planes.w1_plane;
+      p.key_plane = planes.inv_z_plane;
+      keep[t] = 1;
+    }
+  });
   constexpr int kBandRows = 32;
   const int bands = (size + kBandRows - 1) / kBandRows;
-  std::vector<std::vector<std::uint32_t>> band_tris(bands);
-  for (size_t t = 0; t < tris.size(); ++t) {
-    if (!keep[t]) continue;
-    const auto& s = projected[t].s;
-    const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
-    const float max_y = std::max({s[0].y(), s[1].y(), s[2].y()});
-    if (max_y < 0 || min_y >= size) continue;
-    const int b0 = std::max(0, static_cast<int>(min_y) / kBandRows);
-    const int b1 = std::min(bands - 1, static_cast<int>(max_y) / kBandRows);
-    for (int b = b0; b <= b1; ++b) band_tris[b].push_back(static_cast<std::uint32_t>(t));
-  }
+  const CellBins bins = bin_items(static_cast<int>(tris.size()), bands, [&](int t, auto&& fn) {
+    if (!keep[t]) return;
+    for (int b = projected[t].y0 / kBandRows; b <= projected[t].y1 / kBandRows; ++b) fn(b);
+  });
+  const float empty = -std::numeric_limits<float>::infinity();
+  map.depth.resize(static_cast<size_t>(size) * size);
   tbb::parallel_for(0, bands, [&](int band) {
     const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
-    for (const std::uint32_t t : band_tris[band]) {
-      const Projected& p = projected[t];
-      const auto& s = p.s;
-      const int x0 =
-          std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
-      const int x1 =
-          std::min(size - 1, static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
-      const int y0 =
-          std::max(row0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
-      const int y1 =
-          std::min(row1 - 1, static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+    float* key_rows = map.depth.data() + static_cast<size_t>(row0) * size;
+    std::fill(key_rows, key_rows + static_cast<size_t>(row1 - row0) * size, empty);
+    for (std::int32_t i = bins.start[band]; i < bins.start[band + 1]; ++i) {
+      const Projected& p = projected[bins.items[i]];
+      const int y0 = std::max<int>(row0, p.y0), y1 = std::min<int>(row1 - 1, p.y1);
       for (int y = y0; y <= y1; ++y) {
-        for (int x = x0; x <= x1; ++x) {
-          const float px = x + 0.5f, py = y + 0.5f;
-          const float w0 = edge(s[1], s[2], px, py) * p.inv_area;
-          const float w1 = edge(s[2], s[0], px, py) * p.inv_area;
-          const float w2 = 1 - w0 - w1;
-          if (w0 < 0 || w1 < 0 || w2 < 0) continue;
-          // Linear depth is affine in screen space only for orthographic maps; perspective maps
-          // interpolate 1/z.
-          const float depth_here = map.orthographic ? w0 * p.z[0] + w1 * p.z[1] + w2 * p.z[2]
-                                                    : 1 / (w0 / p.z[0] + w1 / p.z[1] + w2 / p.z[2]);
-          float& stored = map.depth[static_cast<size_t>(y) * size + x];
-          stored = std::min(stored, depth_here);
+        const float py = y + 0.5f;
+        float* row = map.depth.data() + static_cast<size_t>(y) * size;
+        for (int x = p.x0; x <= p.x1; ++x) {
+          const float px = x + 0.5f;
+          const float w0 = p.w0_plane[0] * px + p.w0_plane[1] * py + p.w0_plane[2];
+          const float w1 = p.w1_plane[0] * px + p.w1_plane[1] * py + p.w1_plane[2];
+          if (w0 < 0 || w1 < 0 || w0 + w1 > 1) continue;
+          row[x] = std::max(row[x], p.key_plane[0] * px + p.key_plane[1] * py + p.key_plane[2]);
         }
+      }
+    }
+    const float inf = std::numeric_limits<float>::infinity();
+    for (float* key = key_rows; key != map.depth.data() + static_cast<size_t>(row1) * size; ++key) {
+      if (map.orthographic) {
+        *key = -*key;
+      } else {
+        *key = *key > 0 ? 1 / *key : inf;
       }
     }
   });
@@ -307,6 +361,41 @@ ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float
   return map;
 }
 
+// A light with its constants in float, worked out once per frame rather than per pixel.
+struct FrameLight {
+  ir::LightType type = ir::LightType::kPoint;
+  Vector3f position = Vector3f::Zero();
+  Vector3f direction = Vector3f::UnitZ();  // unit
+  // Directional: colour x illuminance (lux). Area: colour x on-axis intensity (cd). Point and
+  // spot: colour x intensity (cd).
+  Vector3f scaled_color = Vector3f::Zero();
+  float spot_outer_cos = -1, spot_inner_cos = -1;
+
+  explicit FrameLight(const ir::Light& light, const Vector3f& color)
+      : type(light.type),
+        position(light.position.cast<float>()),
+        direction(light.direction.cast<float>().normalized()) {
+    const float watts = static_cast<float>(light.power_w);
+    switch (type) {
+      case ir::LightType::kDirectional:
+        scaled_color = color * static_cast<float>(light.illuminance_lx);
+        break;
+      case ir::LightType::kArea:
+        // A one-sided Lambertian emitter of power P has intensity P/π along its normal.
+        scaled_color = color * (kLumensPerWatt * watts / kPi);
+        break;
+      case ir::LightType::kPoint:
+      case ir::LightType::kSpot: {
+        scaled_color = color * (kLumensPerWatt * watts / (4 * kPi));
+        const float half = static_cast<float>(light.spot_angle_rad / 2);
+        spot_outer_cos = std::cos(half);
+        spot_inner_cos = std::cos(half * (1 - static_cast<float>(light.spot_blend)));
+        break;
+      }
+    }
+  }
+};
+
 // Radiometry of one light at a point: the colour-weighted illuminance (lux) arriving along
 // `to_light`.
 struct LightSample {
@@ -314,35 +403,27 @@ struct LightSample {
   Vector3f illuminance;  // per channel, lux
 };
 
-bool sample_light(const ir::Light& light, const Vector3f& color, const Vector3f& p,
-                  LightSample* out) {
+bool sample_light(const FrameLight& light, const Vector3f& p, LightSample* out) {
   if (light.type == ir::LightType::kDirectional) {
-    out->to_light = -light.direction.cast<float>().normalized();
-    out->illuminance = color * static_cast<float>(light.illuminance_lx);
+    out->to_light = -light.direction;
+    out->illuminance = light.scaled_color;
     return true;
   }
-  const Vector3f d = light.position.cast<float>() - p;
+  const Vector3f d = light.position - p;
   const float dist2 = std::max(d.squaredNorm(), 1e-6f);
   out->to_light = d / std::sqrt(dist2);
-  const float watts = static_cast<float>(light.power_w);
-  float intensity_cd;  // candela towards p
+  float falloff = 1 / dist2;
   if (light.type == ir::LightType::kArea) {
-    // A one-sided Lambertian emitter of power P has intensity P/π along its normal.
-    const float cos_emit = std::max(0.0f, -light.direction.cast<float>().dot(out->to_light));
-    intensity_cd = kLumensPerWatt * watts / kPi * cos_emit;
-  } else {
-    intensity_cd = kLumensPerWatt * watts / (4 * kPi);
-    if (light.type == ir::LightType::kSpot) {
-      const float cos_axis = light.direction.cast<float>().dot(-out->to_light);
-      const float half = static_cast<float>(light.spot_angle_rad / 2);
-      const float outer = std::cos(half);
-      const float inner = std::cos(half * (1 - static_cast<float>(light.spot_blend)));
-      const float t = std::clamp((cos_axis - outer) / std::max(inner - outer, 1e-4f), 0.0f, 1.0f);
-      intensity_cd *= t * t * (3 - 2 * t);
-    }
+    falloff *= std::max(0.0f, -light.direction.dot(out->to_light));
+  } else if (light.type == ir::LightType::kSpot) {
+    const float cos_axis = light.direction.dot(-out->to_light);
+    const float t = std::clamp((cos_axis - light.spot_outer_cos) /
+                                   std::max(light.spot_inner_cos - light.spot_outer_cos, 1e-4f),
+                               0.0f, 1.0f);
+    falloff *= t * t * (3 - 2 * t);
   }
-  out->illuminance = color * (intensity_cd / dist2);
-  return intensity_cd > 0;
+  out->illuminance = light.scaled_color * falloff;
+  return falloff > 0;
 }
 
 // GGX microfacet specular (Smith-Schlick visibility), times π so that it sits beside albedo/π·π.
@@ -459,47 +540,20 @@ ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
     std::vector<ScreenTriangle>().swap(parts[c].tris);
   });
 
-  // Bin into tiles: count per block of triangles and tile, then fill, both in parallel; tile-major
-  // offsets with blocks in order keep each tile's list in triangle order.
+  // Bin into tiles.
   const int tiles_x = setup.tiles_x = (width + kTileSize - 1) / kTileSize;
   const int tiles_y = setup.tiles_y = (height + kTileSize - 1) / kTileSize;
-  const int tiles = tiles_x * tiles_y;
-  const int tri_count = static_cast<int>(setup.tris.size());
-  const int blocks = std::clamp(tri_count / 16384, 1, 64);
-  auto block_begin = [&](int b) {
-    return static_cast<int>(static_cast<std::int64_t>(tri_count) * b / blocks);
-  };
-  std::vector<std::int32_t> cursor(static_cast<size_t>(blocks) * tiles, 0);
-  auto for_each_tile = [&](const ScreenTriangle& s, auto&& fn) {
-    for (int ty = s.y0 / kTileSize; ty <= s.y1 / kTileSize; ++ty) {
-      for (int tx = s.x0 / kTileSize; tx <= s.x1 / kTileSize; ++tx) fn(ty * tiles_x + tx);
-    }
-  };
-  tbb::parallel_for(0, blocks, [&](int b) {
-    std::int32_t* count = cursor.data() + static_cast<size_t>(b) * tiles;
-    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
-      for_each_tile(setup.tris[i], [&](int tile) { ++count[tile]; });
-    }
-  });
-  setup.tile_start.resize(tiles + 1);
-  std::int32_t running = 0;
-  for (int tile = 0; tile < tiles; ++tile) {
-    setup.tile_start[tile] = running;
-    for (int b = 0; b < blocks; ++b) {
-      std::int32_t& slot = cursor[static_cast<size_t>(b) * tiles + tile];
-      const std::int32_t count = slot;
-      slot = running;
-      running += count;
-    }
-  }
-  setup.tile_start[tiles] = running;
-  setup.tile_tris.resize(running);
-  tbb::parallel_for(0, blocks, [&](int b) {
-    std::int32_t* next = cursor.data() + static_cast<size_t>(b) * tiles;
-    for (int i = block_begin(b); i < block_begin(b + 1); ++i) {
-      for_each_tile(setup.tris[i], [&](int tile) { setup.tile_tris[next[tile]++] = i; });
-    }
-  });
+  CellBins bins =
+      bin_items(static_cast<int>(setup.tris.size()), tiles_x * tiles_y, [&](int i, auto&& fn) {
+        const ScreenTriangle& t = setup.tris[i];
+        for (int ty = t.y0 / kTileSize; ty <= t.y1 / kTileSize; ++ty) {
+          for (int tx = t.x0 / kTileSize; tx <= t.x1 / kTileSize; ++tx) {
+            fn(ty * tiles_x + tx);
+          }
+        }
+      });
+  setup.tile_start = std::move(bins.start);
+  setup.tile_tris = std::move(bins.items);
   return setup;
 }
 
@@ -666,9 +720,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   const float fx = static_cast<float>(canvas.fx);
   if (timings) timings->setup_ms += ms_since(setup_start);
 
-  // Light colours and the ambient term, once.
-  std::vector<Vector3f> light_colors;
-  for (const auto& light : scene.studio.lights) light_colors.push_back(light.color.cast<float>());
+  // Lights and the ambient term, once.
+  std::vector<FrameLight> lights;
+  for (const auto& light : scene.studio.lights)
+    lights.emplace_back(light, light.color.cast<float>());
   const float ambient_lx = static_cast<float>(scene.studio.ambient_lx);
 
   auto shade = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
@@ -688,9 +743,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const Vector3f v = (eye - p).normalized();
     // Geometric normal for shadow bias; shading normals are flipped towards the viewer, so
     // back faces of open meshes still shade.
-    const Vector3f e1 = g.positions[tri[1]] - g.positions[tri[0]];
-    const Vector3f e2 = g.positions[tri[2]] - g.positions[tri[0]];
-    Vector3f geometric = e1.cross(e2).normalized();
+    Vector3f geometric = g.face_normals[local];
     if (is_object) geometric = object_rot * geometric;
     if (geometric.dot(v) < 0) geometric = -geometric;
     if (n.dot(v) < 0) n = -n;
@@ -722,9 +775,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // Ambient: a uniform white room of the given illuminance.
     Vector3f radiance = diffuse_albedo * (ambient_lx / kPi);
     const float n_dot_v = std::max(n.dot(v), 1e-3f);
-    for (size_t l = 0; l < scene.studio.lights.size(); ++l) {
+    for (size_t l = 0; l < lights.size(); ++l) {
       LightSample sample;
-      if (!sample_light(scene.studio.lights[l], light_colors[l], p, &sample)) continue;
+      if (!sample_light(lights[l], p, &sample)) continue;
       const float n_dot_l = n.dot(sample.to_light);
       const float geo_dot_l = geometric.dot(sample.to_light);
       if (n_dot_l <= 0 || geo_dot_l <= -0.05f) continue;
@@ -805,7 +858,9 @@ namespace rigc::preview {
 Eigen::Vector3f light_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
                                   const Eigen::Vector3f& normal) {
   LightSample sample;
-  if (!sample_light(light, light.color.cast<float>(), point, &sample)) return Vector3f::Zero();
+  if (!sample_light(FrameLight(light, light.color.cast<float>()), point, &sample)) {
+    return Vector3f::Zero();
+  }
   return sample.illuminance * std::max(0.0f, normal.dot(sample.to_light));
 }
 

@@ -207,6 +207,17 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float
   return 1.0f - contrast * darkness;
 }
 
+void Geometry::compute_face_normals() {
+  face_normals.resize(triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const Vector3f cross =
+        (positions[tri[1]] - positions[tri[0]]).cross(positions[tri[2]] - positions[tri[0]]);
+    const float length = cross.norm();
+    face_normals[t] = length > 0 ? Vector3f(cross / length) : Vector3f::UnitZ();
+  }
+}
+
 StudioScene prepare_studio_scene(const ir::Scene& scene) {
   StudioScene out;
   for (const auto& texture : scene.textures) out.textures.push_back(build_mips(texture));
@@ -276,6 +287,8 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
     add_quad(out.studio, center + across * half_width, -across * (2 * half_width),
              Vector3f(0, 0, static_cast<float>(studio.backdrop.height_m)), backdrop_material);
   }
+  out.object.compute_face_normals();
+  out.studio.compute_face_normals();
   const double table_radius = studio.turntable.diameter_m / 2;
   out.turntable_caster_radius =
       std::max(out.object_center.head<2>().norm() + out.object_radius, table_radius) +

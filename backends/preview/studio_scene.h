@@ -40,6 +40,9 @@ struct Geometry {
   std::vector<Eigen::Vector2f> uvs;  // one per vertex (zeros where the source had none)
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::int32_t> triangle_material;  // index into StudioScene::materials
+  std::vector<Eigen::Vector3f> face_normals;    // unit, from the winding; filled by prepare
+
+  void compute_face_normals();
 };
 
 struct StudioScene {
