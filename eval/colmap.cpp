@@ -3,13 +3,19 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <numeric>
 #include <sstream>
+
+#include "backends/common/files.h"
 
 extern char** environ;
 
@@ -17,7 +23,8 @@ namespace rigc::eval {
 
 namespace fs = std::filesystem;
 
-int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::string* error) {
+int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::string* error,
+               double* cpu_seconds) {
   if (argv.empty()) {
     *error = "no program to run";
     return -1;
@@ -60,11 +67,18 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
     return -1;
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
+  rusage usage{};
+  while (wait4(pid, &status, 0, &usage) < 0) {
     if (errno != EINTR) {
       *error = fmt::format("waiting for {} failed: {}", argv[0], std::strerror(errno));
       return -1;
     }
+  }
+  if (cpu_seconds) {
+    auto seconds = [](const timeval& t) {
+      return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6;
+    };
+    *cpu_seconds = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   }
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
@@ -116,6 +130,11 @@ std::optional<ColmapFlags> probe_colmap(const std::string& executable, const fs:
     flags.matching_gpu = "--FeatureMatching.use_gpu";
   }
   fs::remove(log, ec);
+  run_logged({executable, "matches_importer", "-h"}, log, &why);
+  text = read_all(log);
+  flags.imports_pair_lists = text.find("match_list_path") != std::string::npos &&
+                             text.find("match_type") != std::string::npos;
+  fs::remove(log, ec);
   run_logged({executable, "-h"}, log, &why);
   std::istringstream lines(read_all(log));
   std::string line;
@@ -126,6 +145,43 @@ std::optional<ColmapFlags> probe_colmap(const std::string& executable, const fs:
     }
   }
   return flags;
+}
+
+std::vector<std::pair<int, int>> neighbour_pairs(const std::vector<ir::Vec3>& optical_axes,
+                                                 const NeighbourPairOptions& options) {
+  const int n = static_cast<int>(optical_axes.size());
+  // A thousandth of a degree of slack: 3 x 15 deg read back from text is not exactly 45.
+  const double max_angle = (options.max_angle_deg + 1e-3) * M_PI / 180;
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<double> angle(n);
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) {
+    const ir::Vec3 a = optical_axes[i].normalized();
+    for (int j = 0; j < n; ++j) {
+      const ir::Vec3 b = optical_axes[j].normalized();
+      angle[j] = std::atan2(a.cross(b).norm(), a.dot(b));  // accurate for small angles too
+    }
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return angle[x] < angle[y]; });
+    int taken = 0;
+    for (int j : order) {
+      if (j == i) continue;
+      const bool near = angle[j] <= max_angle && taken < options.max_per_image;
+      if (!near && taken >= options.min_per_image) break;
+      pairs.emplace_back(std::min(i, j), std::max(i, j));
+      ++taken;
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+bool write_pair_list(const fs::path& path, const std::vector<std::string>& names,
+                     const std::vector<std::pair<int, int>>& pairs, std::string* error) {
+  std::string text;
+  for (const auto& [i, j] : pairs) text += names.at(i) + " " + names.at(j) + "\n";
+  return backends::write_file_atomically(path, text, error);
 }
 
 double SparseModel::mean_track_length() const {
