@@ -186,24 +186,38 @@ struct ColmapRun {
   double seconds = 0;
   fs::path model_txt;
   json prior;
+  json matching;        // which matcher, how many pairs and how they were chosen
+  bool reused = false;  // --reuse-colmap found a model: the times are the earlier run's
 };
+
+// True when every image has a planned pose (the run's sparse/images.txt): the neighbours matcher
+// can choose its pairs.
+bool every_image_planned(const std::vector<std::string>& image_names,
+                         const std::map<std::string, ir::Mat4>& planned_poses) {
+  return std::all_of(image_names.begin(), image_names.end(),
+                     [&](const std::string& name) { return planned_poses.count(name) > 0; });
+}
 
 // Features, matches, mapper, text export of the largest model.
 ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs::path& run_dir,
-                     const fs::path& out, int image_count, std::ostream& log) {
+                     const fs::path& out, const std::vector<std::string>& image_names,
+                     const std::map<std::string, ir::Mat4>& planned_poses, std::ostream& log) {
   ColmapRun r;
+  const int image_count = static_cast<int>(image_names.size());
   const fs::path work = out / "colmap";
   const fs::path logs = out / "logs";
   const fs::path txt = work / "model_txt";
   std::error_code ec;
   if (o.reuse_colmap && fs::exists(txt / "points3D.txt")) {
     r.ok = true;
+    r.reused = true;
     r.model_txt = txt;
     json previous = json::parse(read_text(out / "eval.json"), nullptr, false);
     if (!previous.is_discarded() && previous.contains("colmap")) {
       r.steps = previous["colmap"].value("steps", json::array());
       r.seconds = previous["colmap"].value("seconds", 0.0);
       r.prior = previous["colmap"].value("intrinsics_prior", json());
+      r.matching = previous["colmap"].value("matching", json());
     }
     if (!o.quiet) log << "rigc eval: reusing the COLMAP model in " << txt.string() << "\n";
     return r;
@@ -269,9 +283,59 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
       r.prior["masks"] = masks.string();
     }
   }
+  // Matching costs about features^2 per pair on the CPU: with a capture plan, match only the
+  // views that can overlap.
   std::string matcher = o.matcher;
-  if (matcher == "auto") matcher = image_count > 100 ? "sequential" : "exhaustive";
-  std::vector<std::string> match = {o.colmap, matcher + "_matcher", "--database_path", db.string()};
+  const bool planned = every_image_planned(image_names, planned_poses);
+  if (matcher == "auto") {
+    matcher = planned && flags->imports_pair_lists ? "neighbours"
+              : image_count > 100                  ? "sequential"
+                                                   : "exhaustive";
+  }
+  const long all_pairs = static_cast<long>(image_count) * (image_count - 1) / 2;
+  r.matching = {{"matcher", matcher}, {"all_pairs", all_pairs}};
+  std::vector<std::string> match;
+  if (matcher == "neighbours") {
+    if (!flags->imports_pair_lists) {
+      r.exit_code = 2;
+      r.failure = fmt::format(
+          "this COLMAP's matches_importer takes no pair list (see {}); use --matcher exhaustive",
+          (logs / "colmap_probe.log").string());
+      return r;
+    }
+    NeighbourPairOptions rule;
+    rule.max_angle_deg = o.neighbour_angle_deg;
+    std::vector<ir::Vec3> axes;
+    for (const auto& name : image_names) {
+      // The optical axis (camera +Z) in the world: the third row of camera_from_world's rotation.
+      axes.push_back(planned_poses.at(name).block<1, 3>(2, 0).transpose());
+    }
+    const auto pairs = neighbour_pairs(axes, rule);
+    const fs::path pair_list = work / "pairs.txt";
+    if (!write_pair_list(pair_list, image_names, pairs, &error)) {
+      r.exit_code = 2;
+      r.failure = error;
+      return r;
+    }
+    match = {o.colmap,
+             "matches_importer",
+             "--database_path",
+             db.string(),
+             "--match_list_path",
+             pair_list.string(),
+             "--match_type",
+             "pairs"};
+    r.matching["pairs"] = pairs.size();
+    r.matching["pair_list"] = pair_list.string();
+    r.matching["rule"] = fmt::format(
+        "planned poses ({}): views whose optical axes are at most {} deg apart, the nearest {} "
+        "at most, the nearest {} at least",
+        (run_dir / "sparse" / "images.txt").string(), rule.max_angle_deg, rule.max_per_image,
+        rule.min_per_image);
+  } else {
+    match = {o.colmap, matcher + "_matcher", "--database_path", db.string()};
+    if (matcher == "exhaustive") r.matching["pairs"] = all_pairs;
+  }
   if (!flags->matching_gpu.empty()) {
     match.push_back(flags->matching_gpu);
     match.push_back("0");
@@ -291,18 +355,26 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
     std::string name;
     std::vector<std::string> argv;
   };
-  const std::vector<Step> steps = {
-      {"feature_extractor", fe}, {matcher + "_matcher", match}, {"mapper", map}};
+  const std::vector<Step> steps = {{"feature_extractor", fe}, {match[1], match}, {"mapper", map}};
   for (const auto& step : steps) {
     const fs::path step_log = logs / (step.name + ".log");
     fs::remove(step_log, ec);
     if (!o.quiet) log << fmt::format("rigc eval: colmap {} ...\n", step.name);
     const auto t0 = Clock::now();
-    const int rc = run_logged(step.argv, step_log, &error);
+    double cpu_s = 0;
+    const int rc = run_logged(step.argv, step_log, &error, &cpu_s);
     const double s = seconds_since(t0);
     r.seconds += s;
-    r.steps.push_back(
-        {{"name", step.name}, {"seconds", s}, {"exit_code", rc}, {"log", step_log.string()}});
+    r.steps.push_back({{"name", step.name},
+                       {"seconds", s},
+                       {"cpu_seconds", cpu_s},
+                       {"exit_code", rc},
+                       {"log", step_log.string()}});
+    if (step.name == "feature_extractor") {
+      if (const auto features = mean_features(step_log)) {
+        r.matching["mean_features_per_image"] = *features;
+      }
+    }
     if (rc != 0 && step.name != "mapper") {
       r.exit_code = 2;
       r.failure = rc < 0 ? error
@@ -314,14 +386,18 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
   // The mapper may write several models (sparse/0, sparse/1, ...): keep the largest.
   fs::path best;
   std::size_t best_images = 0;
+  const auto t_convert = Clock::now();
+  double convert_cpu_s = 0;
   for (const auto& e : fs::directory_iterator(work / "sparse", ec)) {
     if (!e.is_directory()) continue;
     const fs::path tmp = work / ("txt_" + e.path().filename().string());
     fs::create_directories(tmp, ec);
     const fs::path conv_log = logs / "model_converter.log";
+    double cpu_s = 0;
     const int rc = run_logged({o.colmap, "model_converter", "--input_path", e.path().string(),
                                "--output_path", tmp.string(), "--output_type", "TXT"},
-                              conv_log, &error);
+                              conv_log, &error, &cpu_s);
+    convert_cpu_s += cpu_s;
     if (rc != 0) continue;
     auto images = backends::read_colmap_images(tmp / "images.txt", &why);
     if (images && images->size() > best_images) {
@@ -329,6 +405,12 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
       best = tmp;
     }
   }
+  const double convert_s = seconds_since(t_convert);
+  r.seconds += convert_s;
+  r.steps.push_back({{"name", "model_converter"},
+                     {"seconds", convert_s},
+                     {"cpu_seconds", convert_cpu_s},
+                     {"log", (logs / "model_converter.log").string()}});
   if (best.empty()) {
     r.exit_code = 2;
     const fs::path fe_log = logs / "feature_extractor.log";
@@ -350,6 +432,7 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
 }  // namespace
 
 int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
+  const auto t_start = Clock::now();
   EvalSummary local;
   EvalSummary& sum = summary ? *summary : local;
   const bool photos = !o.photos_dir.empty();
@@ -400,6 +483,13 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     for (const auto& im : *images) gt_poses[im.name] = im.camera_from_world;
     gt_camera = cams->front();
   }
+  if (o.matcher == "neighbours" && !every_image_planned(image_names, gt_poses)) {
+    log << fmt::format(
+        "rigc eval: error: --matcher neighbours needs a planned pose for every image (a run "
+        "folder's sparse/images.txt); {} has images without one\n",
+        images_dir.string());
+    return 1;
+  }
 
   json report;
   report["rigc_eval_version"] = 1;
@@ -411,10 +501,12 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
                      {"ground_truth_poses", !gt_poses.empty()}};
 
   // 1. COLMAP.
-  ColmapRun colmap =
-      run_colmap(o, images_dir, run_dir, out, static_cast<int>(image_names.size()), log);
-  report["colmap"] = {
-      {"steps", colmap.steps}, {"seconds", colmap.seconds}, {"intrinsics_prior", colmap.prior}};
+  const double setup_s = seconds_since(t_start);  // ground truth and poses
+  ColmapRun colmap = run_colmap(o, images_dir, run_dir, out, image_names, gt_poses, log);
+  report["colmap"] = {{"steps", colmap.steps},
+                      {"seconds", colmap.seconds},
+                      {"matching", colmap.matching},
+                      {"intrinsics_prior", colmap.prior}};
   sum.colmap_s = colmap.seconds;
   auto write_report = [&]() {
     std::string why;
@@ -744,9 +836,12 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   files["color_range_mm"] = range;
   report["files"] = files;
   sum.rigc_s = seconds_since(t_rigc);
-  report["timing_s"] = {{"colmap", colmap.seconds},
-                        {"rigc_alignment_and_metrics", rigc_metrics_s},
-                        {"rigc_total", sum.rigc_s}};
+  // total: this call's wall time (with --reuse-colmap it holds no COLMAP time).
+  const double total_s = seconds_since(t_start);
+  report["timing_s"] = {
+      {"colmap", colmap.seconds},     {"colmap_reused", colmap.reused},
+      {"rigc_ground_truth", setup_s}, {"rigc_alignment_and_metrics", rigc_metrics_s},
+      {"rigc_total", sum.rigc_s},     {"total", total_s}};
   if (!write_report()) return 2;
 
   if (!o.quiet) {
@@ -756,6 +851,18 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
         stats.mean, stats.stddev, stats.median, stats.p90_abs, stats.count,
         report["compared"].get<std::string>() == "points" ? "points" : "Poisson-mesh samples",
         f.fscore, o.tau_mm, f.precision, f.recall);
+    std::string split;
+    for (const auto& step : colmap.steps) {
+      split += fmt::format("{}{} {:.1f}", split.empty() ? "" : ", ", step.value("name", ""),
+                           step.value("seconds", 0.0));
+    }
+    log << fmt::format(
+        "rigc eval: {:.1f} s in all: COLMAP {:.1f} s{} ({}; {} matching, {} pairs), RigC {:.1f} s "
+        "(ground truth {:.1f} s, alignment and metrics {:.1f} s, files {:.1f} s)\n",
+        total_s, colmap.seconds, colmap.reused ? " (reused, from the earlier run)" : "", split,
+        colmap.matching.value("matcher", "?"),
+        colmap.matching.contains("pairs") ? colmap.matching["pairs"].dump() : "?",
+        setup_s + sum.rigc_s, setup_s, rigc_metrics_s, sum.rigc_s - rigc_metrics_s);
     log << fmt::format("rigc eval: wrote {}\n", (out / "eval.json").string());
   }
   return 0;

@@ -24,10 +24,13 @@ struct EvalOptions {
   std::string scene;         // scene file; default: manifest.json's inputs.source_file
   std::string output_dir;    // default: RUN_DIR/eval (PHOTOS_DIR/eval)
   std::string colmap = "colmap";
-  std::string matcher = "auto";    // auto, exhaustive, sequential
-  bool use_masks = true;           // the run's masks/ (what a green screen gives)
-  bool refine_intrinsics = false;  // let COLMAP refine a known (ground-truth) intrinsics prior
-  bool reuse_colmap = false;       // skip COLMAP when the output folder has its model already
+  // auto, exhaustive, sequential, neighbours (pairs of nearby views from the run's planned
+  // poses; auto picks it when every image has one, else exhaustive, sequential above 100 images)
+  std::string matcher = "auto";
+  double neighbour_angle_deg = 45;  // neighbours: the widest angle between paired optical axes
+  bool use_masks = true;            // the run's masks/ (what a green screen gives)
+  bool refine_intrinsics = false;   // let COLMAP refine a known (ground-truth) intrinsics prior
+  bool reuse_colmap = false;        // skip COLMAP when the output folder has its model already
   bool icp = true;
   bool poisson = false;  // also mesh the points (Open3D's screened Poisson) and compare the mesh
   int poisson_depth = 9;

@@ -39,9 +39,14 @@ std::optional<int> parse_options(CLI::App& app, const std::vector<std::string>& 
 void add_eval_options(CLI::App& app, EvalOptions& o) {
   app.add_option("--colmap", o.colmap, "COLMAP executable")->capture_default_str();
   app.add_option("--matcher", o.matcher,
-                 "feature matching: exhaustive, sequential, or auto "
-                 "(sequential above 100 images)")
-      ->check(CLI::IsMember({"auto", "exhaustive", "sequential"}))
+                 "feature matching: exhaustive, sequential, neighbours (views whose planned "
+                 "optical axes are close, from the run's sparse/images.txt), or auto (neighbours "
+                 "for a run folder, else exhaustive; sequential above 100 images)")
+      ->check(CLI::IsMember({"auto", "exhaustive", "sequential", "neighbours"}))
+      ->capture_default_str();
+  app.add_option("--neighbour-angle", o.neighbour_angle_deg,
+                 "neighbours: the widest angle (deg) between the optical axes of a matched pair")
+      ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str();
   app.add_flag("!--no-masks", o.use_masks, "ignore the run's masks/ (object masks)");
   app.add_flag("--refine-intrinsics", o.refine_intrinsics,

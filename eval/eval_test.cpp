@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -175,6 +177,139 @@ TEST(EvalColmap, ReadsPointsWithTracks) {
   EXPECT_NE(error.find("bad.txt:1"), std::string::npos);
 }
 
+// Optical axis of a camera at azimuth `azimuth_deg` and elevation `elevation_deg` looking at the
+// origin.
+Vec3 axis_towards_origin(double azimuth_deg, double elevation_deg) {
+  const double a = azimuth_deg * M_PI / 180, e = elevation_deg * M_PI / 180;
+  return -Vec3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+}
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180 / M_PI;
+}
+
+// Partners of every view in `pairs`.
+std::vector<std::vector<int>> partners(int count, const std::vector<std::pair<int, int>>& pairs) {
+  std::vector<std::vector<int>> p(count);
+  for (const auto& [i, j] : pairs) {
+    p[i].push_back(j);
+    p[j].push_back(i);
+  }
+  return p;
+}
+
+bool connected(int count, const std::vector<std::pair<int, int>>& pairs) {
+  const auto p = partners(count, pairs);
+  std::vector<bool> seen(count, false);
+  std::vector<int> stack = {0};
+  seen[0] = true;
+  int reached = 1;
+  while (!stack.empty()) {
+    const int i = stack.back();
+    stack.pop_back();
+    for (int j : p[i]) {
+      if (!seen[j]) {
+        seen[j] = true;
+        ++reached;
+        stack.push_back(j);
+      }
+    }
+  }
+  return reached == count;
+}
+
+TEST(EvalNeighbourPairs, TurntableRingPairsNearViewsAndWrapsAround) {
+  // The paper scene at 24 steps of 15 deg: each view with the 3 before and the 3 after it.
+  std::vector<Vec3> axes;
+  for (int i = 0; i < 24; ++i) axes.push_back(axis_towards_origin(15.0 * i, -9.5));
+  const auto pairs = neighbour_pairs(axes);
+  EXPECT_EQ(pairs.size(), 72u);  // of 276
+  for (const auto& [i, j] : pairs) {
+    EXPECT_LT(i, j);
+    const int steps = std::min(j - i, 24 - (j - i));
+    EXPECT_LE(steps, 3) << i << " " << j;
+  }
+  auto has = [&](int i, int j) {
+    return std::find(pairs.begin(), pairs.end(), std::make_pair(i, j)) != pairs.end();
+  };
+  EXPECT_TRUE(has(0, 1));
+  EXPECT_TRUE(has(0, 23));  // wrap-around
+  EXPECT_TRUE(has(0, 21));
+  EXPECT_TRUE(has(2, 23));
+  EXPECT_FALSE(has(0, 4));
+  EXPECT_FALSE(has(0, 20));
+  EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+  // A narrower angle keeps fewer.
+  NeighbourPairOptions narrow;
+  narrow.max_angle_deg = 30;
+  EXPECT_EQ(neighbour_pairs(axes, narrow).size(), 48u);
+}
+
+TEST(EvalNeighbourPairs, SparseRingStaysConnectedAndDenseRingIsCapped) {
+  // 6 views 60 deg apart: none within 45 deg, the nearest two still pair.
+  std::vector<Vec3> sparse;
+  for (int i = 0; i < 6; ++i) sparse.push_back(axis_towards_origin(60.0 * i, 0));
+  const auto sparse_pairs = neighbour_pairs(sparse);
+  EXPECT_EQ(sparse_pairs.size(), 6u);
+  EXPECT_TRUE(connected(6, sparse_pairs));
+  // 72 views 5 deg apart: 18 within 45 deg, the nearest 10 (5 on each side) kept.
+  std::vector<Vec3> dense;
+  for (int i = 0; i < 72; ++i) dense.push_back(axis_towards_origin(5.0 * i, 0));
+  const auto dense_pairs = neighbour_pairs(dense);
+  EXPECT_EQ(dense_pairs.size(), 72u * 5);
+  for (const auto& [i, j] : dense_pairs) EXPECT_LE(angle_deg(dense[i], dense[j]), 25.001);
+}
+
+TEST(EvalNeighbourPairs, MultiRingPairsAcrossRings) {
+  // scenes/multi-ring.yaml's orbits: 16 views at 10 deg elevation, 12 at 35, 6 at 65.
+  std::vector<Vec3> axes;
+  std::vector<int> ring;
+  const std::array<std::pair<int, double>, 3> rings = {{{16, 10}, {12, 35}, {6, 65}}};
+  for (int r = 0; r < 3; ++r) {
+    for (int i = 0; i < rings[r].first; ++i) {
+      axes.push_back(axis_towards_origin(360.0 * i / rings[r].first, rings[r].second));
+      ring.push_back(r);
+    }
+  }
+  const int count = static_cast<int>(axes.size());
+  const auto pairs = neighbour_pairs(axes);
+  EXPECT_TRUE(connected(count, pairs));
+  int across = 0;
+  for (const auto& [i, j] : pairs) {
+    if (ring[i] != ring[j]) ++across;
+  }
+  EXPECT_GT(across, 0);
+  EXPECT_LT(pairs.size(), static_cast<std::size_t>(count * (count - 1) / 2) / 3);
+  // A pair is within 45 deg, or one of its views' two nearest (which keep sparse views linked).
+  auto second_nearest_deg = [&](int i) {
+    std::vector<double> angles;
+    for (int k = 0; k < count; ++k) {
+      if (k != i) angles.push_back(angle_deg(axes[i], axes[k]));
+    }
+    std::sort(angles.begin(), angles.end());
+    return angles[1];
+  };
+  for (const auto& [i, j] : pairs) {
+    const double a = angle_deg(axes[i], axes[j]);
+    EXPECT_TRUE(a <= 45.001 || a <= second_nearest_deg(i) + 1e-9 ||
+                a <= second_nearest_deg(j) + 1e-9)
+        << i << " " << j << " " << a;
+  }
+  for (const auto& p : partners(count, pairs)) EXPECT_GE(p.size(), 2u);
+}
+
+TEST(EvalNeighbourPairs, PairListNamesTheImages) {
+  rigc::testing::TempDir dir;
+  std::string error;
+  ASSERT_TRUE(
+      write_pair_list(dir.file("pairs.txt"), {"a.jpg", "b.jpg", "c.jpg"}, {{0, 1}, {1, 2}}, &error))
+      << error;
+  std::ifstream in(dir.file("pairs.txt"));
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), "a.jpg b.jpg\nb.jpg c.jpg\n");
+}
+
 TEST(EvalPictures, HeatColoursFollowCloudCompare) {
   using C = std::array<std::uint8_t, 3>;
   EXPECT_EQ(signed_distance_color(-1, 1), (C{0, 0, 255}));
@@ -209,6 +344,29 @@ TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   std::ifstream report(dir.file("run/eval/eval.json"));
   ASSERT_TRUE(report.good());
   EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");
+}
+
+TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  for (const char* name : {"a.jpg", "b.jpg", "c.jpg"})
+    rigc::testing::write_text(dir.file("photos/") + name, "x");
+  std::vector<Eigen::Vector3f> v;
+  std::vector<std::array<std::uint32_t, 3>> t;
+  cube(0.1, &v, &t);
+  ir::Mesh mesh;
+  mesh.positions = v;
+  mesh.triangles = t;
+  std::string error;
+  ASSERT_TRUE(write_ply(dir.file("cube.ply"), mesh, &error)) << error;
+  EvalOptions o;
+  o.photos_dir = dir.file("photos");
+  o.ground_truth = dir.file("cube.ply");
+  o.matcher = "neighbours";
+  o.colmap = dir.file("no-such-colmap");
+  std::ostringstream log;
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("planned pose"), std::string::npos) << log.str();
 }
 
 // ---------------------------------------------------------------------------------------------
