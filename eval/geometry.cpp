@@ -8,10 +8,10 @@
 #include <open3d/pipelines/registration/Feature.h>
 #include <open3d/pipelines/registration/Registration.h>
 #include <open3d/pipelines/registration/TransformationEstimation.h>
-#include <open3d/t/geometry/RaycastingScene.h>
 #include <open3d/utility/Logging.h>
 #include <open3d/utility/Random.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -23,7 +23,6 @@
 namespace rigc::eval {
 
 namespace o3d = open3d;
-using o3d::core::Tensor;
 
 namespace {
 
@@ -31,14 +30,6 @@ void quiet_open3d() {
   static std::once_flag once;
   std::call_once(once,
                  [] { o3d::utility::SetVerbosityLevel(o3d::utility::VerbosityLevel::Error); });
-}
-
-Tensor points_tensor(const std::vector<Vec3>& points) {
-  std::vector<float> flat(points.size() * 3);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int k = 0; k < 3; ++k) flat[3 * i + k] = static_cast<float>(points[i][k]);
-  }
-  return Tensor(std::move(flat), {static_cast<int64_t>(points.size()), 3}, o3d::core::Float32);
 }
 
 o3d::geometry::PointCloud to_cloud(const std::vector<Vec3>& points,
@@ -163,23 +154,160 @@ Vec3 ViewCamera::center() const {
 // ---------------------------------------------------------------------------------------------
 // Surface
 
-// Nearest-triangle queries through Open3D's RaycastingScene; rays through Embree directly
-// (Debian's Open3D 0.16 build returns no hits from CastRays/TestOcclusions).
+namespace {
+
+// The point of triangle abc nearest to p (Ericson, Real-Time Collision Detection, 5.1.5): the
+// Voronoi region of p decides between a vertex, an edge and the face.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  }
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// One nearest-triangle query: the query point in double precision and the best triangle so far.
+struct NearestTriangle {
+  const float* vertices;
+  const unsigned* indices;
+  Vec3 point;
+  // Embree culls with the float query point: the radius carries this much extra so that no
+  // triangle nearer than the best is culled by rounding.
+  float slack = 0;
+  double best_squared = std::numeric_limits<double>::infinity();
+  double best_facing = -1;  // see facing(); -1 until a tie needs it
+  unsigned triangle = RTC_INVALID_GEOMETRY_ID;
+  Vec3 closest = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  // of the best triangle, not normalized
+
+  Vec3 vertex(unsigned i) const {
+    const float* v = vertices + 3 * std::size_t{i};
+    return Vec3(v[0], v[1], v[2]);
+  }
+};
+
+// How squarely `point` lies in front of or behind a triangle's plane: |cos| of the angle between
+// the normal and point - closest (0 when either is 0).
+double facing(const Vec3& point, const Vec3& closest, const Vec3& normal) {
+  const double length = (point - closest).norm() * normal.norm();
+  return length > 0 ? std::abs((point - closest).dot(normal)) / length : 0;
+}
+
+// Embree calls this for every triangle in a BVH leaf the query sphere reaches; shrinking the
+// radius culls the rest of the tree.
+bool nearest_triangle_callback(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<NearestTriangle*>(args->userPtr);
+  const unsigned* t = q->indices + 3 * std::size_t{args->primID};
+  const Vec3 a = q->vertex(t[0]), b = q->vertex(t[1]), c = q->vertex(t[2]);
+  const Vec3 p = closest_point_on_triangle(q->point, a, b, c);
+  const double squared = (q->point - p).squaredNorm();
+  const double tie = 1e-9 * q->best_squared;
+  if (squared > q->best_squared + tie) return false;
+  const Vec3 normal = (b - a).cross(c - a);
+  double facing_here = -1;
+  if (squared >= q->best_squared - tie) {
+    // Triangles meeting at the nearest edge or vertex tie (up to rounding) and may disagree on
+    // the sign: the one the point lies most squarely in front of or behind wins, then the lower
+    // index, so the answer depends neither on the traversal order nor on the threads.
+    facing_here = facing(q->point, p, normal);
+    if (q->best_facing < 0) q->best_facing = facing(q->point, q->closest, q->normal);
+    if (facing_here < q->best_facing ||
+        (facing_here == q->best_facing && args->primID > q->triangle)) {
+      return false;
+    }
+  }
+  q->best_squared = squared;
+  q->best_facing = facing_here;
+  q->triangle = args->primID;
+  q->closest = p;
+  q->normal = normal;
+  // Rounded up and widened by the tie band and the slack, so that tied triangles stay in.
+  const float radius =
+      std::nextafter(static_cast<float>(std::sqrt(squared * (1 + 2e-9))) + q->slack,
+                     std::numeric_limits<float>::infinity());
+  if (radius >= args->query->radius) return false;
+  args->query->radius = radius;
+  return true;
+}
+
+// Indices of the finite `points` in Morton (Z-curve) order of a 1024^3 grid over their bounds.
+std::vector<std::uint32_t> spatial_order(const std::vector<Vec3>& points) {
+  Eigen::AlignedBox3d box;
+  for (const Vec3& p : points) {
+    if (p.allFinite()) box.extend(p);
+  }
+  if (box.isEmpty()) return {};
+  const Vec3 scale = 1023.0 / box.sizes().cwiseMax(1e-300).array();
+  // Spreads the low 10 bits of v to every third bit.
+  auto spread = [](std::uint64_t v) {
+    v &= 0x3ff;
+    v = (v | (v << 16)) & 0x30000ff;
+    v = (v | (v << 8)) & 0x300f00f;
+    v = (v | (v << 4)) & 0x30c30c3;
+    v = (v | (v << 2)) & 0x9249249;
+    return v;
+  };
+  // Key: the cell's code above the point's index (unique keys: a deterministic order).
+  std::vector<std::uint64_t> keys(points.size(), ~std::uint64_t{0});
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        if (!points[i].allFinite()) continue;
+                        const Eigen::Array3d cell = (points[i] - box.min()).array() * scale.array();
+                        const std::uint64_t code =
+                            spread(static_cast<std::uint64_t>(cell.x())) |
+                            spread(static_cast<std::uint64_t>(cell.y())) << 1 |
+                            spread(static_cast<std::uint64_t>(cell.z())) << 2;
+                        keys[i] = code << 32 | i;
+                      }
+                    });
+  tbb::parallel_sort(keys.begin(), keys.end());
+  std::vector<std::uint32_t> order;
+  order.reserve(keys.size());
+  for (std::uint64_t key : keys) {
+    if (key != ~std::uint64_t{0}) order.push_back(static_cast<std::uint32_t>(key));
+  }
+  return order;
+}
+
+}  // namespace
+
+// One Embree BVH answers both ray casts and nearest-triangle queries (rtcPointQuery). The
+// Open3D mesh is kept only for its area-uniform sampler. (Debian's Open3D 0.16 build returns no
+// hits from RaycastingScene's CastRays/TestOcclusions, so rays never went through Open3D.)
 struct Surface::Impl {
-  o3d::t::geometry::RaycastingScene scene;
-  std::shared_ptr<o3d::geometry::TriangleMesh> legacy;
+  std::shared_ptr<o3d::geometry::TriangleMesh> legacy;  // with triangle normals, for sampling
+  Eigen::AlignedBox3d box;
+  std::size_t triangle_count = 0;
   RTCDevice device = nullptr;
-  RTCScene rays = nullptr;
+  RTCScene scene = nullptr;
+  // Embree's own copies (alive as long as the scene), read by the nearest-triangle callback.
+  const float* vertices = nullptr;
+  const unsigned* indices = nullptr;
 
   ~Impl() {
-    if (rays) rtcReleaseScene(rays);
+    if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
 
-  void build_rays(const std::vector<Eigen::Vector3f>& positions,
-                  const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  void build_scene(const std::vector<Eigen::Vector3f>& positions,
+                   const std::vector<std::array<std::uint32_t, 3>>& triangles) {
     device = rtcNewDevice(nullptr);
-    rays = rtcNewScene(device);
+    scene = rtcNewScene(device);
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
         g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), positions.size()));
@@ -191,10 +319,13 @@ struct Surface::Impl {
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (int k = 0; k < 3; ++k) f[3 * i + k] = triangles[i][k];
     }
+    vertices = v;
+    indices = f;
+    triangle_count = triangles.size();
     rtcCommitGeometry(g);
-    rtcAttachGeometry(rays, g);
+    rtcAttachGeometry(scene, g);
     rtcReleaseGeometry(g);
-    rtcCommitScene(rays);
+    rtcCommitScene(scene);
   }
 
   static RTCRay make_ray(const Vec3& o, const Vec3& d, float tnear, float tfar) {
@@ -219,32 +350,33 @@ Surface::Surface(const std::vector<Eigen::Vector3f>& positions,
                  const std::vector<std::array<std::uint32_t, 3>>& triangles)
     : impl_(std::make_unique<Impl>()) {
   quiet_open3d();
-  std::vector<float> v(positions.size() * 3);
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    for (int k = 0; k < 3; ++k) v[3 * i + k] = positions[i][k];
-  }
-  std::vector<std::uint32_t> f(triangles.size() * 3);
-  for (std::size_t i = 0; i < triangles.size(); ++i) {
-    for (int k = 0; k < 3; ++k) f[3 * i + k] = triangles[i][k];
-  }
-  impl_->scene.AddTriangles(
-      Tensor(std::move(v), {static_cast<int64_t>(positions.size()), 3}, o3d::core::Float32),
-      Tensor(std::move(f), {static_cast<int64_t>(triangles.size()), 3}, o3d::core::UInt32));
-  impl_->build_rays(positions, triangles);
-  impl_->legacy = std::make_shared<o3d::geometry::TriangleMesh>();
-  impl_->legacy->vertices_.reserve(positions.size());
-  for (const auto& p : positions) impl_->legacy->vertices_.push_back(p.cast<double>());
-  impl_->legacy->triangles_.reserve(triangles.size());
-  for (const auto& t : triangles) {
-    impl_->legacy->triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
-                                           static_cast<int>(t[2]));
-  }
+  impl_->build_scene(positions, triangles);
+  for (const auto& p : positions) impl_->box.extend(p.cast<double>());
+  auto& legacy = impl_->legacy = std::make_shared<o3d::geometry::TriangleMesh>();
+  legacy->vertices_.resize(positions.size());
+  legacy->triangles_.resize(triangles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        legacy->vertices_[i] = positions[i].cast<double>();
+                      }
+                    });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        const auto& t = triangles[i];
+                        legacy->triangles_[i] = Eigen::Vector3i(
+                            static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]));
+                      }
+                    });
+  // Once here, so that sampling neither copies the mesh nor writes to it.
+  legacy->ComputeTriangleNormals(true);
 }
 
 Surface::~Surface() = default;
 
 std::size_t Surface::triangle_count() const {
-  return impl_->legacy->triangles_.size();
+  return impl_->triangle_count;
 }
 
 double Surface::area() const {
@@ -252,26 +384,46 @@ double Surface::area() const {
 }
 
 Eigen::AlignedBox3d Surface::bounds() const {
-  Eigen::AlignedBox3d box;
-  for (const auto& p : impl_->legacy->vertices_) box.extend(p);
-  return box;
+  return impl_->box;
 }
 
 std::vector<double> Surface::signed_distance(const std::vector<Vec3>& points) const {
   std::vector<double> out(points.size(), std::numeric_limits<double>::quiet_NaN());
-  if (points.empty()) return out;
-  auto result = impl_->scene.ComputeClosestPoints(points_tensor(points));
-  const Tensor closest = result["points"].Contiguous();
-  const Tensor normals = result["primitive_normals"].Contiguous();
-  const float* c = closest.GetDataPtr<float>();
-  const float* nrm = normals.GetDataPtr<float>();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Vec3 q(c[3 * i], c[3 * i + 1], c[3 * i + 2]);
-    const Vec3 n(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
-    const Vec3 d = points[i] - q;
-    const double dist = d.norm();
-    out[i] = d.dot(n) < 0 ? -dist : dist;
-  }
+  if (points.empty() || impl_->triangle_count == 0) return out;
+  // Queries in Z-curve order share BVH nodes in cache, and each starts from its predecessor's
+  // triangle as an upper bound. Blocks of fixed size (not TBB's ranges) keep that chain, and so
+  // the answers, independent of the scheduling.
+  const std::vector<std::uint32_t> order = spatial_order(points);
+  const std::size_t block = 256;
+  tbb::parallel_for(std::size_t{0}, (order.size() + block - 1) / block, [&](std::size_t b) {
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    unsigned previous = RTC_INVALID_GEOMETRY_ID;
+    for (std::size_t k = b * block; k < std::min(order.size(), (b + 1) * block); ++k) {
+      const std::size_t i = order[k];
+      NearestTriangle nearest{impl_->vertices, impl_->indices, points[i]};
+      RTCPointQuery query;
+      query.x = static_cast<float>(points[i].x());
+      query.y = static_cast<float>(points[i].y());
+      query.z = static_cast<float>(points[i].z());
+      nearest.slack = 4 * std::numeric_limits<float>::epsilon() *
+                      (std::abs(query.x) + std::abs(query.y) + std::abs(query.z));
+      query.time = 0;
+      query.radius = std::numeric_limits<float>::infinity();
+      if (previous != RTC_INVALID_GEOMETRY_ID) {
+        RTCPointQueryFunctionArguments hint{};
+        hint.query = &query;
+        hint.userPtr = &nearest;
+        hint.primID = previous;
+        nearest_triangle_callback(&hint);
+      }
+      rtcPointQuery(impl_->scene, &query, &context, nearest_triangle_callback, &nearest);
+      if (nearest.triangle == RTC_INVALID_GEOMETRY_ID) continue;
+      previous = nearest.triangle;
+      const double distance = std::sqrt(nearest.best_squared);
+      out[i] = (points[i] - nearest.closest).dot(nearest.normal) < 0 ? -distance : distance;
+    }
+  });
   return out;
 }
 
@@ -282,9 +434,9 @@ void Surface::sample(int count, std::uint64_t seed, std::vector<Vec3>* points,
   {
     std::lock_guard<std::mutex> lock(seed_mutex);
     o3d::utility::random::Seed(static_cast<int>(seed & 0x7fffffff));
-    auto mesh = std::make_shared<o3d::geometry::TriangleMesh>(*impl_->legacy);
-    mesh->ComputeTriangleNormals(true);
-    cloud = mesh->SamplePointsUniformly(static_cast<std::size_t>(std::max(count, 0)), true);
+    // The mesh already has its triangle normals, so Open3D only reads it.
+    cloud =
+        impl_->legacy->SamplePointsUniformly(static_cast<std::size_t>(std::max(count, 0)), true);
   }
   points->assign(cloud->points_.begin(), cloud->points_.end());
   if (normals) normals->assign(cloud->normals_.begin(), cloud->normals_.end());
@@ -292,41 +444,36 @@ void Surface::sample(int count, std::uint64_t seed, std::vector<Vec3>* points,
 
 std::vector<int> Surface::visible(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,
                                   const std::vector<ViewCamera>& cameras) const {
+  const double offset = 1e-6 * std::max(impl_->box.diagonal().norm(), 1e-9);
+  std::vector<Vec3> eyes;
+  for (const ViewCamera& cam : cameras) eyes.push_back(cam.center());
+  auto sees = [&](std::size_t c, std::size_t i, RTCIntersectContext* context) {
+    const ViewCamera& cam = cameras[c];
+    if ((eyes[c] - points[i]).dot(normals[i]) <= 0) return false;  // back-facing
+    const Vec3 pc = cam.camera_from_world.topLeftCorner<3, 3>() * points[i] +
+                    cam.camera_from_world.topRightCorner<3, 1>();
+    if (pc.z() <= 0) return false;
+    const double u = cam.fx * pc.x() / pc.z() + cam.cx;
+    const double v = cam.fy * pc.y() / pc.z() + cam.cy;
+    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) return false;
+    const Vec3 origin = points[i] + offset * normals[i];
+    RTCRay ray = Impl::make_ray(origin, eyes[c] - origin, 1e-5f, 1.0f);
+    rtcOccluded1(impl_->scene, context, &ray);
+    return ray.tfar >= 0;  // tfar becomes -inf when something is hit
+  };
+  // Each point tries the cameras until one sees it and writes only its own flag: the answer
+  // does not depend on the scheduling.
   std::vector<char> seen(points.size(), 0);
-  const Eigen::AlignedBox3d box = bounds();
-  const double offset = 1e-6 * std::max(box.diagonal().norm(), 1e-9);
-  for (const ViewCamera& cam : cameras) {
-    const Vec3 eye = cam.center();
-    std::vector<int> candidates;
-    std::vector<Vec3> origins, directions;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (seen[i]) continue;
-      const Vec3 to_eye = eye - points[i];
-      if (to_eye.dot(normals[i]) <= 0) continue;  // back-facing
-      const Vec3 pc = cam.camera_from_world.topLeftCorner<3, 3>() * points[i] +
-                      cam.camera_from_world.topRightCorner<3, 1>();
-      if (pc.z() <= 0) continue;
-      const double u = cam.fx * pc.x() / pc.z() + cam.cx;
-      const double v = cam.fy * pc.y() / pc.z() + cam.cy;
-      if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) continue;
-      candidates.push_back(static_cast<int>(i));
-      const Vec3 origin = points[i] + offset * normals[i];
-      origins.push_back(origin);
-      directions.push_back(eye - origin);
-    }
-    if (candidates.empty()) continue;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        RTCIntersectContext context;
-                        rtcInitIntersectContext(&context);
-                        for (std::size_t k = range.begin(); k < range.end(); ++k) {
-                          RTCRay ray = Impl::make_ray(origins[k], directions[k], 1e-5f, 1.0f);
-                          rtcOccluded1(impl_->rays, &context, &ray);
-                          // tfar becomes -inf when something is hit.
-                          if (ray.tfar >= 0) seen[candidates[k]] = 1;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      RTCIntersectContext context;
+                      rtcInitIntersectContext(&context);
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        for (std::size_t c = 0; c < cameras.size() && !seen[i]; ++c) {
+                          seen[i] = sees(c, i, &context);
                         }
-                      });
-  }
+                      }
+                    });
   std::vector<int> out;
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (seen[i]) out.push_back(static_cast<int>(i));
@@ -350,7 +497,7 @@ RayHits Surface::cast_rays(const std::vector<Vec3>& origins,
                                                 std::numeric_limits<float>::infinity());
                         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                         rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-                        rtcIntersect1(impl_->rays, &context, &rh);
+                        rtcIntersect1(impl_->scene, &context, &rh);
                         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
                         hits.t[i] = rh.ray.tfar;
                         hits.normals[i] =

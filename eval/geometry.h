@@ -1,6 +1,7 @@
-// Geometry for evaluation: similarity alignment (Eigen's Umeyama inside RANSAC), and a ground-truth
-// surface backed by Open3D (Embree nearest-triangle queries and ray casts, area-uniform sampling,
-// ICP, Poisson meshing). Open3D stays behind this header: no Open3D type appears here.
+// Geometry for evaluation: similarity alignment (Eigen's Umeyama inside RANSAC); a ground-truth
+// surface whose Embree BVH answers nearest-triangle queries (rtcPointQuery) and ray casts, sampled
+// area-uniformly by Open3D; nearest-point distances, ICP, global registration and Poisson meshing
+// from Open3D. No Open3D or Embree type appears here.
 #pragma once
 
 #include <Eigen/Core>
@@ -87,7 +88,9 @@ class Surface {
 
   // Distance to the nearest triangle, signed by that triangle's normal (CloudCompare's
   // point-to-mesh convention): positive on the side the normal points to (outside for a mesh
-  // with outward normals), negative inside.
+  // with outward normals), negative inside. When the nearest point is on an edge or vertex that
+  // several triangles share, the triangle the point lies most squarely in front of or behind
+  // gives the sign. NaN for non-finite points. Parallel; the result does not depend on threads.
   std::vector<double> signed_distance(const std::vector<Vec3>& points) const;
 
   // Area-uniform samples on the surface with their triangle normals (deterministic for a seed).
