@@ -18,6 +18,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <nanoflann.hpp>
 #include <random>
 
 namespace rigc::eval {
@@ -572,15 +573,43 @@ std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
   return Mat4(r.transformation_);
 }
 
+namespace {
+
+// nanoflann's view of a point vector (no copy).
+struct CloudAdaptor {
+  const std::vector<Vec3>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][axis]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+
+}  // namespace
+
 std::vector<double> nearest_distances(const std::vector<Vec3>& queries,
                                       const std::vector<Vec3>& cloud) {
-  quiet_open3d();
-  if (cloud.empty()) {
-    return std::vector<double>(queries.size(), std::numeric_limits<double>::infinity());
-  }
-  auto q = to_cloud(queries);
-  const auto c = to_cloud(cloud);
-  return q.ComputePointCloudDistance(c);
+  std::vector<double> out(queries.size(), std::numeric_limits<double>::infinity());
+  if (cloud.empty() || queries.empty()) return out;
+  using KdTree =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>,
+                                          CloudAdaptor, 3, std::size_t>;
+  const CloudAdaptor adaptor{cloud};
+  const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(20));  // builds
+  // Queries are const on the tree; each writes only its own entry.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        std::size_t nearest = 0;
+                        double squared = 0;
+                        nanoflann::KNNResultSet<double, std::size_t> result(1);
+                        result.init(&nearest, &squared);
+                        tree.findNeighbors(result, queries[i].data(), nanoflann::SearchParams());
+                        out[i] = std::sqrt(squared);
+                      }
+                    });
+  return out;
 }
 
 std::optional<PoissonMesh> poisson_mesh(const std::vector<Vec3>& points,

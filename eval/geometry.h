@@ -1,7 +1,7 @@
 // Geometry for evaluation: similarity alignment (Eigen's Umeyama inside RANSAC); a ground-truth
 // surface whose Embree BVH answers nearest-triangle queries (rtcPointQuery) and ray casts, sampled
-// area-uniformly by Open3D; nearest-point distances, ICP, global registration and Poisson meshing
-// from Open3D. No Open3D or Embree type appears here.
+// area-uniformly by Open3D; nearest-point distances through a nanoflann KD-tree; ICP, global
+// registration and Poisson meshing from Open3D. No Open3D, Embree or nanoflann type appears here.
 #pragma once
 
 #include <Eigen/Core>
@@ -123,7 +123,7 @@ IcpResult icp_similarity(const std::vector<Vec3>& source, const std::vector<Vec3
 std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
                                         const std::vector<Vec3>& target, double voxel_size);
 
-// For every query point, the distance to the nearest point of `cloud` (KD-tree).
+// For every query point, the distance to the nearest point of `cloud` (KD-tree; parallel).
 std::vector<double> nearest_distances(const std::vector<Vec3>& queries,
                                       const std::vector<Vec3>& cloud);
 
