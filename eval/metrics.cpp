@@ -19,13 +19,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double percentile_sorted(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const double pos = q * static_cast<double>(sorted.size() - 1);
+// The q-quantile with linear interpolation between the order statistics at floor and ceil of
+// q·(n-1), as on a sorted copy, but by selection: `values` is reordered, not sorted.
+double percentile(std::vector<double>& values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const double pos = q * static_cast<double>(values.size() - 1);
   const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  const std::size_t hi = std::min(lo + 1, values.size() - 1);
   const double f = pos - static_cast<double>(lo);
-  return sorted[lo] * (1 - f) + sorted[hi] * f;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(lo), values.end());
+  const double at_lo = values[lo];
+  // After the selection everything past lo is >= values[lo]: the next order statistic is the
+  // smallest of them.
+  const double at_hi =
+      hi == lo ? at_lo
+               : *std::min_element(values.begin() + static_cast<std::ptrdiff_t>(hi), values.end());
+  return at_lo * (1 - f) + at_hi * f;
 }
 
 // 8-bit RGB canvas written through OpenImageIO (temporary file, then rename).
@@ -109,12 +118,11 @@ DistanceStats distance_stats(const std::vector<double>& d) {
   double var = 0;
   for (double x : values) var += (x - s.mean) * (x - s.mean);
   s.stddev = values.size() > 1 ? std::sqrt(var / (n - 1)) : 0;
-  std::sort(values.begin(), values.end());
-  std::sort(absolute.begin(), absolute.end());
-  s.median = percentile_sorted(values, 0.5);
-  s.p90_abs = percentile_sorted(absolute, 0.9);
-  s.min = values.front();
-  s.max = values.back();
+  const auto [min, max] = std::minmax_element(values.begin(), values.end());
+  s.min = *min;
+  s.max = *max;
+  s.median = percentile(values, 0.5);
+  s.p90_abs = percentile(absolute, 0.9);
   return s;
 }
 
