@@ -262,7 +262,8 @@ std::vector<std::uint32_t> spatial_order(const std::vector<Vec3>& points) {
     v = (v | (v << 2)) & 0x9249249;
     return v;
   };
-  // Key: the cell's code above the point's index (unique keys: a deterministic order).
+  // Key: the cell's code above the point's index (unique keys: a deterministic order; clouds of
+  // 2^32 points or more are not expected).
   std::vector<std::uint64_t> keys(points.size(), ~std::uint64_t{0});
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
