@@ -247,8 +247,39 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
   return lit / 16;
 }
 
-void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>& tris) {
+// Shadow casters for one frame: world positions and the triangles over them.
+struct CasterMesh {
+  std::vector<Vector3f> positions;
+  const std::vector<std::array<std::uint32_t, 3>>* triangles = nullptr;
+};
+
+void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   const int size = map.size;
+  const auto& tris = *casters.triangles;
+  // Every vertex into light space once (vertices are shared by about six triangles).
+  struct LightVertex {
+    Vector2f s;
+    float key;
+    bool behind;
+  };
+  std::vector<LightVertex> light_vertices(casters.positions.size());
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, casters.positions.size(), 8192),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+          const Vector3f l = map.light_from_world * (casters.positions[v] - map.origin);
+          LightVertex& out = light_vertices[v];
+          if (map.orthographic) {
+            out = {
+                {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f}, -l.z(), false};
+          } else {
+            out = {
+                {l.x() / l.z() * map.focal + size / 2.0f, l.y() / l.z() * map.focal + size / 2.0f},
+                1 / l.z(),
+                l.z() <= kNear};
+          }
+        }
+      });
   // Rasterized as a key that grows towards the light, one plane per triangle: -z for orthographic
   // maps (z is affine in screen space) and 1/z for perspective ones. Converted to z at the end.
   struct Projected {
@@ -257,45 +288,41 @@ void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>&
   };
   std::vector<Projected> projected(tris.size());
   std::vector<char> keep(tris.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 4096), [&](const tbb::blocked_range<
-                                                                          size_t>& range) {
-    for (size_t t = range.begin(); t != range.end(); ++t) {
-      std::array<Vector2f, 3> s;
-      std::array<float, 3> key;
-      bool behind = false;
-      for (int i = 0; i < 3; ++i) {
-        const Vector3f l = map.light_from_world * (tris[t][i] - map.origin);
-        if (map.orthographic) {
-          s[i] = {l.x() * map.focal + size / 2.0f, l.y() * map.focal + size / 2.0f};
-          key[i] = -l.z();
-        } else {
-          if (l.z() <= kNear) behind = true;
-          s[i] = {l.x() / l.z() * map.focal + size / 2.0f, l.y() / l.z() * map.focal + size / 2.0f};
-          key[i] = 1 / l.z();
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, tris.size(), 4096),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t t = range.begin(); t != range.end(); ++t) {
+          std::array<Vector2f, 3> s;
+          std::array<float, 3> key;
+          bool behind = false;
+          for (int i = 0; i < 3; ++i) {
+            const LightVertex& v = light_vertices[tris[t][i]];
+            s[i] = v.s;
+            key[i] = v.key;
+            behind = behind || v.behind;
+          }
+          const float area = edge(s[0], s[1], s[2].x(), s[2].y());
+          if (behind || std::abs(area) < 1e-12f) continue;
+          const float min_x = std::min({s[0].x(), s[1].x(), s[2].x()});
+          const float max_x = std::max({s[0].x(), s[1].x(), s[2].x()});
+          const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
+          const float max_y = std::max({s[0].y(), s[1].y(), s[2].y()});
+          if (max_x < 0 || max_y < 0 || min_x >= size || min_y >= size) continue;
+          Projected& p = projected[t];
+          // Texel centres at +0.5: texels whose centre can fall inside.
+          p.x0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_x - 0.5f)));
+          p.y0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_y - 0.5f)));
+          p.x1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_x)));
+          p.y1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_y)));
+          ScreenTriangle planes;
+          planes.inv_z = key;
+          compute_planes(planes, s, 1 / area);
+          p.w0_plane = planes.w0_plane;
+          p.w1_plane = planes.w1_plane;
+          p.key_plane = planes.inv_z_plane;
+          keep[t] = 1;
         }
-      }
-      const float area = edge(s[0], s[1], s[2].x(), s[2].y());
-      if (behind || std::abs(area) < 1e-12f) continue;
-      const float min_x = std::min({s[0].x(), s[1].x(), s[2].x()});
-      const float max_x = std::max({s[0].x(), s[1].x(), s[2].x()});
-      const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
-      const float max_y = std::max({s[0].y(), s[1].y(), s[2].y()});
-      if (max_x < 0 || max_y < 0 || min_x >= size || min_y >= size) continue;
-      Projected& p = projected[t];
-      // Texel centres at +0.5: texels whose centre can fall inside.
-      p.x0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_x - 0.5f)));
-      p.y0 = static_cast<std::uint16_t>(std::max(0.0f, std::floor(min_y - 0.5f)));
-      p.x1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_x)));
-      p.y1 = static_cast<std::uint16_t>(std::min<float>(size - 1, std::ceil(max_y)));
-      ScreenTriangle planes;
-      planes.inv_z = key;
-      compute_planes(planes, s, 1 / area);
-      p.w0_plane = planes.w0_plane;
-      p.w1_plane = planes.w1_plane;
-      p.key_plane = planes.inv_z_plane;
-      keep[t] = 1;
-    }
-  });
+      });
   constexpr int kBandRows = 32;
   const int bands = (size + kBandRows - 1) / kBandRows;
   const CellBins bins = bin_items(static_cast<int>(tris.size()), bands, [&](int t, auto&& fn) {
@@ -335,7 +362,7 @@ void rasterize_depth(ShadowMap& map, const std::vector<std::array<Vector3f, 3>>&
 }
 
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
-                           const std::vector<std::array<Vector3f, 3>>& casters, int size) {
+                           const CasterMesh& casters, int size) {
   ShadowMap map;
   map.size = size;
   if (light.type == ir::LightType::kDirectional) {
@@ -684,20 +711,20 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   const Geometry& object = studio.object;
   const Geometry& room = studio.studio;
   const int object_tris = context.object_tris;
-  const int total_tris = context.total_tris;
-  auto world_vertex = [&](int tri, int corner) { return context.world_vertex(tri, corner); };
 
   // Shadow maps: one per light, over the object (at this turntable angle) and the turntable.
   auto shadow_start = Clock::now();
-  std::vector<std::array<Vector3f, 3>> casters;
-  casters.reserve(total_tris);
-  for (int t = 0; t < total_tris; ++t) {
-    const int material =
-        t < object_tris ? object.triangle_material[t] : room.triangle_material[t - object_tris];
-    if (studio.materials[material].casts_shadow) {
-      casters.push_back({world_vertex(t, 0), world_vertex(t, 1), world_vertex(t, 2)});
-    }
-  }
+  CasterMesh casters;
+  casters.triangles = &studio.shadow_casters;
+  casters.positions.resize(object.positions.size() + room.positions.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, object.positions.size(), 8192),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t v = range.begin(); v != range.end(); ++v) {
+                        casters.positions[v] = object_rot * object.positions[v] + object_t;
+                      }
+                    });
+  std::copy(room.positions.begin(), room.positions.end(),
+            casters.positions.begin() + object.positions.size());
   const Vector3f caster_center = object_rot * studio.object_center.cast<float>() + object_t;
   const float table_radius = static_cast<float>(scene.studio.turntable.diameter_m / 2);
   const float caster_radius =

@@ -289,6 +289,18 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   }
   out.object.compute_face_normals();
   out.studio.compute_face_normals();
+  const auto studio_base = static_cast<std::uint32_t>(out.object.positions.size());
+  for (size_t t = 0; t < out.object.triangles.size(); ++t) {
+    if (out.materials[out.object.triangle_material[t]].casts_shadow) {
+      out.shadow_casters.push_back(out.object.triangles[t]);
+    }
+  }
+  for (size_t t = 0; t < out.studio.triangles.size(); ++t) {
+    if (!out.materials[out.studio.triangle_material[t]].casts_shadow) continue;
+    const auto& tri = out.studio.triangles[t];
+    out.shadow_casters.push_back(
+        {tri[0] + studio_base, tri[1] + studio_base, tri[2] + studio_base});
+  }
   const double table_radius = studio.turntable.diameter_m / 2;
   out.turntable_caster_radius =
       std::max(out.object_center.head<2>().norm() + out.object_radius, table_radius) +

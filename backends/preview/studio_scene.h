@@ -53,6 +53,9 @@ struct StudioScene {
   Eigen::Vector3d object_center{0, 0, 0};  // object frame
   double object_radius = 0;                // bounding sphere about object_center
   double turntable_caster_radius = 0;      // bounding sphere of object + turntable, about the axis
+  // Triangles that cast shadows, as indices into the object's vertices followed by the studio's
+  // (studio vertex i is number object.positions.size() + i).
+  std::vector<std::array<std::uint32_t, 3>> shadow_casters;
 };
 
 StudioScene prepare_studio_scene(const ir::Scene& scene);
