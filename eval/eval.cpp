@@ -186,8 +186,8 @@ struct ColmapRun {
   double seconds = 0;
   fs::path model_txt;
   json prior;
-  json matching;        // which matcher, how many pairs and how they were chosen
-  bool reused = false;  // --reuse-colmap found a model: the times are the earlier run's
+  json matching = json::object();  // which matcher, how many pairs and how they were chosen
+  bool reused = false;             // --reuse-colmap found a model: the times are the earlier run's
 };
 
 // True when every image has a planned pose (the run's sparse/images.txt): the neighbours matcher
@@ -213,11 +213,12 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
     r.reused = true;
     r.model_txt = txt;
     json previous = json::parse(read_text(out / "eval.json"), nullptr, false);
-    if (!previous.is_discarded() && previous.contains("colmap")) {
+    if (!previous.is_discarded() && previous.contains("colmap") && previous["colmap"].is_object()) {
       r.steps = previous["colmap"].value("steps", json::array());
       r.seconds = previous["colmap"].value("seconds", 0.0);
       r.prior = previous["colmap"].value("intrinsics_prior", json());
-      r.matching = previous["colmap"].value("matching", json());
+      r.matching = previous["colmap"].value("matching", json::object());
+      if (!r.matching.is_object()) r.matching = json::object();
     }
     if (!o.quiet) log << "rigc eval: reusing the COLMAP model in " << txt.string() << "\n";
     return r;
@@ -851,18 +852,23 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
         stats.mean, stats.stddev, stats.median, stats.p90_abs, stats.count,
         report["compared"].get<std::string>() == "points" ? "points" : "Poisson-mesh samples",
         f.fscore, o.tau_mm, f.precision, f.recall);
-    std::string split;
+    // The time split: COLMAP's steps, then RigC's own parts.
+    std::string colmap_split;
     for (const auto& step : colmap.steps) {
-      split += fmt::format("{}{} {:.1f}", split.empty() ? "" : ", ", step.value("name", ""),
-                           step.value("seconds", 0.0));
+      if (!step.is_object()) continue;
+      colmap_split +=
+          fmt::format(", {} {:.1f}", step.value("name", "?"), step.value("seconds", 0.0));
+    }
+    if (colmap.matching.contains("pairs")) {
+      colmap_split += fmt::format("; {} matching, {} pairs", colmap.matching.value("matcher", "?"),
+                                  colmap.matching["pairs"].dump());
     }
     log << fmt::format(
-        "rigc eval: {:.1f} s in all: COLMAP {:.1f} s{} ({}; {} matching, {} pairs), RigC {:.1f} s "
-        "(ground truth {:.1f} s, alignment and metrics {:.1f} s, files {:.1f} s)\n",
-        total_s, colmap.seconds, colmap.reused ? " (reused, from the earlier run)" : "", split,
-        colmap.matching.value("matcher", "?"),
-        colmap.matching.contains("pairs") ? colmap.matching["pairs"].dump() : "?",
-        setup_s + sum.rigc_s, setup_s, rigc_metrics_s, sum.rigc_s - rigc_metrics_s);
+        "rigc eval: {:.1f} s in all: COLMAP {:.1f} s{}{}, RigC {:.1f} s (ground truth {:.1f}, "
+        "alignment and metrics {:.1f}, files {:.1f})\n",
+        total_s, colmap.seconds, colmap.reused ? " (reused: the earlier run's)" : "",
+        colmap_split.empty() ? "" : " (" + colmap_split.substr(2) + ")", setup_s + sum.rigc_s,
+        setup_s, rigc_metrics_s, sum.rigc_s - rigc_metrics_s);
     log << fmt::format("rigc eval: wrote {}\n", (out / "eval.json").string());
   }
   return 0;
