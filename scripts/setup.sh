@@ -9,7 +9,7 @@ packages=(
   libassimp-dev assimp-testmodels libeigen3-dev libcli11-dev libfmt-dev
   nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema python3-yaml
-  povray blender colmap libopen3d-dev libembree-dev fonts-dejavu-core
+  povray blender colmap libopen3d-dev libembree-dev libnanoflann-dev fonts-dejavu-core
 )
 
 missing=()
