@@ -130,5 +130,16 @@ int main(int argc, char** argv) {
     }
     std::cout << '\n';
   }
+  // The same split in milliseconds per shot.
+  std::cout << fmt::format("{:<24} {:>25}", "ms per shot", "");
+  for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
+  std::cout << '\n';
+  for (const auto& row : rows) {
+    std::cout << fmt::format("{:<24} {:>25}", row.name, "");
+    for (const auto& [stage, ms] : row.stage_ms) {
+      std::cout << fmt::format(" {:>12.1f}", ms / std::max(row.shots, 1));
+    }
+    std::cout << '\n';
+  }
   std::cout << fmt::format("peak memory: {:.0f} MB\n", peak_rss_mb());
 }

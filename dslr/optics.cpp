@@ -191,13 +191,17 @@ void composite(const GroupSums& s, int lane, float* out) {
 
 namespace {
 
-// `coarse_level`: this call gathers for the coarse tiles of a frame twice its size, which adds
-// the 2x2 box and the bilinear upsampling's blur (variance 1/3 + 2/3 px² at the full size,
-// 1/4 px² here); discs shrink to keep the total variance r²/4 of the thin-lens disc. One level
-// only: the added blur would compound.
+// `level` 0 is the canvas itself; level k gathers for the coarse tiles of level k - 1, on a frame
+// half its size. Each step down and up adds the 2x2 box and the bilinear upsampling's blur
+// (variance 1/3 + 2/3 px² at the finer level, 1/4 px² at the coarser), and the blur added above
+// shrinks by 4 at each level, so level k removes 1 + 1/4 + ... (k terms) from r² to keep the
+// total variance r²/4 of the thin-lens disc. Big discs thus cost about the same taps per pixel
+// on a quarter of the pixels at each level.
+constexpr int kMaxCoarseLevel = 3;
+
 void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Intrinsics& canvas,
                     const std::vector<float>& rgb, const std::vector<float>& depth_m,
-                    std::vector<float>& out, bool coarse_level) {
+                    std::vector<float>& out, int level, const std::vector<char>* needed_tiles) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   out.resize(rgb.size());
@@ -212,7 +216,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       0.5 * coc_diameter_m(f, f_number, focus_distance_m, std::numeric_limits<double>::infinity()) *
       canvas.fx / f);
   const float focus = static_cast<float>(focus_distance_m);
-  const float removed_radius_sq = coarse_level ? 1.0f : 0.0f;
+  float removed_radius_sq = 0;
+  for (int k = 0; k < level; ++k) removed_radius_sq += std::ldexp(1.0f, -2 * k);
   auto radius_at = [&](float z) {
     const float radius = radius_at_infinity * std::abs(1 - focus / z);
     return std::clamp(std::sqrt(std::max(0.0f, radius * radius - removed_radius_sq)), 0.5f,
@@ -222,6 +227,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // Largest disc per tile, then the largest disc reaching each tile.
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
   std::vector<float> tile_max(static_cast<std::size_t>(tiles_x) * tiles_y, 0.5f);
+  // Tiles this call must produce: all of them at the top level; those the level above samples
+  // below it. The output elsewhere is left as it is.
+  auto active = [&](std::size_t t) { return needed_tiles == nullptr || (*needed_tiles)[t]; };
   std::vector<float> tile_min(tile_max.size(), static_cast<float>(kMaxCocRadiusPx));
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     for (int ty = r.begin(); ty < r.end(); ++ty) {
@@ -260,7 +268,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // kCoarseRadiusPx or more. Their result comes from the same gather on a half-size frame.
   std::vector<char> coarse(tile_max.size(), 0);
   bool any_coarse = false;
-  if (!coarse_level && w >= 8 * kTile && h >= 8 * kTile) {
+  if (level < kMaxCoarseLevel && w >= 8 * kTile && h >= 8 * kTile) {
     for (int ty = 0; ty < tiles_y; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
@@ -271,7 +279,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             smallest = std::min(smallest, tile_min[static_cast<std::size_t>(sy) * tiles_x + sx]);
           }
         }
-        coarse[t] = smallest >= kCoarseRadiusPx;
+        coarse[t] = active(t) && smallest >= kCoarseRadiusPx;
         any_coarse = any_coarse || coarse[t];
       }
     }
@@ -303,7 +311,25 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         half_depth[q] = nearest;
       }
     });
-    depth_of_field(camera, focus_distance_m, half, half_rgb, half_depth, half_out, true);
+    // The level below computes only the tiles that the coarse tiles here sample (bilinear:
+    // with a margin of one tile).
+    const int half_tiles_x = (half.width + kTile - 1) / kTile;
+    const int half_tiles_y = (half.height + kTile - 1) / kTile;
+    std::vector<char> half_needed(static_cast<std::size_t>(half_tiles_x) * half_tiles_y, 0);
+    for (int ty = 0; ty < tiles_y; ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        if (!coarse[static_cast<std::size_t>(ty) * tiles_x + tx]) continue;
+        for (int hy = std::max(0, (ty - 1) / 2); hy <= std::min(half_tiles_y - 1, (ty + 1) / 2);
+             ++hy) {
+          for (int hx = std::max(0, (tx - 1) / 2); hx <= std::min(half_tiles_x - 1, (tx + 1) / 2);
+               ++hx) {
+            half_needed[static_cast<std::size_t>(hy) * half_tiles_x + hx] = 1;
+          }
+        }
+      }
+    }
+    depth_of_field(camera, focus_distance_m, half, half_rgb, half_depth, half_out, level + 1,
+                   &half_needed);
   }
   // Bilinear from the half-size result: full pixel centre x + 0.5 sits at half x (x + 0.5) / 2.
   auto upsample_tile = [&](int x0, int x1, int y0, int y1) {
@@ -326,9 +352,16 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
   };
 
+  // The strips' padding only needs the taps of the tiles gathered at this level: the big discs
+  // of coarse tiles are gathered below.
+  float fine_reach_max = 0.5f;
+  for (std::size_t t = 0; t < reach.size(); ++t) {
+    if (active(t) && !coarse[t]) fine_reach_max = std::max(fine_reach_max, reach[t]);
+  }
   const TapSet& set = tap_set();
-  const int max_taps = set.count_for_radius[std::min<int>(
-      static_cast<int>(std::ceil(reach_max)), static_cast<int>(set.count_for_radius.size()) - 1)];
+  const int max_taps =
+      set.count_for_radius[std::min<int>(static_cast<int>(std::ceil(fine_reach_max)),
+                                         static_cast<int>(set.count_for_radius.size()) - 1)];
   int tap_extent = 0;
   for (int t = 0; t < max_taps; ++t) {
     tap_extent = std::max({tap_extent, std::abs(set.dx[t]), std::abs(set.dy[t])});
@@ -349,6 +382,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       for (int ty = ty0; ty < ty1; ++ty) {
         for (int tx = 0; tx < tiles_x; ++tx) {
           const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+          if (!active(t)) continue;
           if (coarse[t]) {
             upsample_tile(tx * kTile, std::min(w, (tx + 1) * kTile), ty * kTile,
                           std::min(h, (ty + 1) * kTile));
@@ -360,7 +394,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       if (strip_reach <= 0.5f) {  // sharp, apart from any coarse tiles done above
         for (int y = sy0; y < sy1; ++y) {
           for (int tx = 0; tx < tiles_x; ++tx) {
-            if (coarse[static_cast<std::size_t>(y / kTile) * tiles_x + tx]) continue;
+            const std::size_t t = static_cast<std::size_t>(y / kTile) * tiles_x + tx;
+            if (coarse[t] || !active(t)) continue;
             const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + tx * kTile);
             const std::size_t b =
                 3 * (static_cast<std::size_t>(y) * w + std::min(w, (tx + 1) * kTile));
@@ -372,14 +407,32 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       pl.pad = pad;
       pl.stride = w + 2 * pad + kTile;  // a tile's last group may run past the right edge
       pl.y0 = sy0;
-      const std::size_t size = static_cast<std::size_t>(pl.stride) * (sy1 - sy0 + 2 * pad);
-      pl.r.assign(size, 0);
-      pl.g.assign(size, 0);
-      pl.b.assign(size, 0);
-      pl.z.assign(size, -inf);
-      pl.radius.assign(size, 0.5f);
-      pl.inv_area.assign(size, 0);
-      for (int y = std::max(0, sy0 - pad); y < std::min(h, sy1 + pad); ++y) {
+      const int plane_rows = sy1 - sy0 + 2 * pad;
+      const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
+      for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
+        plane->resize(size);
+      }
+      // Padding (rows outside the image, columns left and right of it) holds no energy and
+      // sits in front of everything; the image's own pixels are all written below.
+      auto clear_span = [&](std::size_t begin, std::size_t end) {
+        for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.inv_area}) {
+          std::fill(plane->begin() + begin, plane->begin() + end, 0.0f);
+        }
+        std::fill(pl.z.begin() + begin, pl.z.begin() + end, -inf);
+        std::fill(pl.radius.begin() + begin, pl.radius.begin() + end, 0.5f);
+      };
+      const int image_row0 = std::max(0, sy0 - pad), image_row1 = std::min(h, sy1 + pad);
+      for (int row = 0; row < plane_rows; ++row) {
+        const int y = sy0 - pad + row;
+        const std::size_t begin = static_cast<std::size_t>(row) * pl.stride;
+        if (y < image_row0 || y >= image_row1) {
+          clear_span(begin, begin + pl.stride);
+        } else {
+          clear_span(begin, begin + pad);
+          clear_span(begin + pad + w, begin + pl.stride);
+        }
+      }
+      for (int y = image_row0; y < image_row1; ++y) {
         for (int x = 0; x < w; ++x) {
           const std::size_t p = static_cast<std::size_t>(y) * w + x, i = pl.index(x, y);
           const float z = depth_m[p] > 0 ? depth_m[p] : inf;
@@ -396,7 +449,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         for (int tx = 0; tx < tiles_x; ++tx) {
           const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
           const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
-          if (coarse[static_cast<std::size_t>(ty) * tiles_x + tx]) continue;  // done above
+          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+          if (coarse[t] || !active(t)) continue;  // done above, or not asked for
           const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
           if (radius <= 0.5f) {  // everything here and around it is sharp
             for (int y = y0; y < y1; ++y) {
@@ -427,7 +481,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
                           const std::vector<float>& depth_m, std::vector<float>& out) {
-  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, false);
+  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr);
 }
 
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,

@@ -118,6 +118,7 @@ TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
   expect_disc_blur(1.3, 0.125, 8);   // ~8.8 px: the dense taps
   expect_disc_blur(3.0, 0.25, 30);   // ~33 px: the ring taps
   expect_disc_blur(0.5, 0.125, 12);  // ~13.6 px, in front of the focus
+  expect_disc_blur(20.0, 0.5, 80);   // ~87 px: gathered three levels down, at an eighth
 }
 
 TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {

@@ -7,6 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <future>
+#include <memory>
+#include <optional>
 #include <ostream>
 
 #include "backends/common/colmap_text.h"
@@ -112,39 +115,41 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
                        {"seed", options.seed}});
   const StudioScene studio = prepare_studio_scene(scene);
   int failures = 0, done = 0;
-  for (int index : shots) {
-    const ir::Shot& shot = scene.shots[index];
-    const std::string key =
-        backends::shot_key(scene, content_hash, shot, "preview", options.scale, options.seed);
+
+  // A shot's files are encoded and written on a thread of their own while the next shot
+  // renders: JPEG encoding is serial, and the renderer keeps both cores busy meanwhile. The
+  // manifest records a shot only once its files are in place.
+  struct WriteOutcome {
+    std::string error;  // empty when both files are in place
+    double ms = 0;
+  };
+  struct PendingWrite {
+    const ir::Shot* shot = nullptr;
+    std::string key, image, mask;
     ShotTiming timing;
-    if (manifest.is_done(shot.name, key, run_dir)) {
-      timing.skipped = true;
-      ++done;
-      if (timings) timings->push_back(timing);
-      if (!options.progress_bar) log << fmt::format("{}: up to date, skipped\n", shot.name);
-      continue;
-    }
-    dslr::DevelopResult result =
-        render_shot(scene, studio, shot, options.scale, options.seed, &timing);
-    const auto write_start = Clock::now();
-    const std::string image = backends::image_relative_path(scene.camera, shot);
-    const std::string mask = backends::mask_relative_path(shot);
-    std::string error;
-    bool ok = !result.encoded.empty();
-    if (!ok) error = "the DSLR model produced no image";
-    ok = ok && dslr::write_image(run_dir / image, result, scene.camera, &error);
-    ok = ok && dslr::write_mask(run_dir / mask, result.mask, result.width, result.height, &error);
-    timing.write_ms = ms_since(write_start);
-    timing.total_ms += timing.write_ms;
-    if (!ok) {
+    std::future<WriteOutcome> outcome;
+  };
+  std::optional<PendingWrite> pending;
+  bool manifest_failed = false;
+  auto finish_pending = [&]() {
+    if (!pending) return;
+    PendingWrite write = std::move(*pending);
+    pending.reset();
+    const WriteOutcome outcome = write.outcome.get();
+    const std::string& error = outcome.error;
+    const ir::Shot& shot = *write.shot;
+    ShotTiming& timing = write.timing;
+    timing.write_ms = outcome.ms;
+    timing.total_ms += outcome.ms;
+    if (!error.empty()) {
       log << fmt::format("{}rigc: error: {}: {}\n", options.progress_bar ? "\n" : "", shot.name,
                          error);
       ++failures;
-      continue;
+      return;
     }
     backends::ShotRecord record;
     record.name = shot.name;
-    record.key = key;
+    record.key = write.key;
     record.render_ms = timing.total_ms;
     record.stage_ms = {{"shadows", timing.raster.shadow_ms},
                        {"setup", timing.raster.setup_ms},
@@ -156,12 +161,14 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
                        {"noise", timing.develop.noise_ms},
                        {"develop", timing.develop.develop_ms},
                        {"write", timing.write_ms}};
-    record.files = {image, mask};
+    record.files = {write.image, write.mask};
     manifest.record(record);
     // Saved after every shot, so an interrupted run resumes where it stopped.
-    if (!manifest.save(manifest_path, &error)) {
-      log << fmt::format("rigc: error: {}\n", error);
-      return 2;
+    std::string save_error;
+    if (!manifest.save(manifest_path, &save_error)) {
+      log << fmt::format("rigc: error: {}\n", save_error);
+      manifest_failed = true;
+      return;
     }
     ++done;
     if (timings) timings->push_back(timing);
@@ -174,7 +181,54 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
                          timing.total_ms / 1000, timing.subframes,
                          timing.subframes == 1 ? "" : "s");
     }
+  };
+
+  for (int index : shots) {
+    const ir::Shot& shot = scene.shots[index];
+    const std::string key =
+        backends::shot_key(scene, content_hash, shot, "preview", options.scale, options.seed);
+    if (manifest.is_done(shot.name, key, run_dir)) {
+      ShotTiming timing;
+      timing.skipped = true;
+      finish_pending();
+      ++done;
+      if (timings) timings->push_back(timing);
+      if (!options.progress_bar) log << fmt::format("{}: up to date, skipped\n", shot.name);
+      continue;
+    }
+    ShotTiming timing;
+    dslr::DevelopResult result =
+        render_shot(scene, studio, shot, options.scale, options.seed, &timing);
+    finish_pending();
+    if (manifest_failed) return 2;
+    // Only the encoded pixels and the mask are written; the rest is freed before the next shot.
+    result.linear = {};
+    result.depth_m = {};
+    PendingWrite write;
+    write.shot = &shot;
+    write.key = key;
+    write.image = backends::image_relative_path(scene.camera, shot);
+    write.mask = backends::mask_relative_path(shot);
+    write.timing = timing;
+    write.outcome = std::async(
+        std::launch::async,
+        [&scene, &run_dir, image = write.image, mask = write.mask,
+         result = std::move(result)]() -> WriteOutcome {
+          const auto start = Clock::now();
+          WriteOutcome outcome;
+          if (result.encoded.empty()) {
+            outcome.error = "the DSLR model produced no image";
+          } else if (dslr::write_image(run_dir / image, result, scene.camera, &outcome.error)) {
+            dslr::write_mask(run_dir / mask, result.mask, result.width, result.height,
+                             &outcome.error);
+          }
+          outcome.ms = ms_since(start);
+          return outcome;
+        });
+    pending = std::move(write);
   }
+  finish_pending();
+  if (manifest_failed) return 2;
   if (options.progress_bar) log << '\n';
 
   return backends::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);

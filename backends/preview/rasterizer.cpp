@@ -7,6 +7,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -27,6 +28,9 @@ constexpr float kNear = 0.01f;
 // Blender's photometric convention: 1 W of light is 683 lm at 555 nm.
 constexpr float kLumensPerWatt = 683.0f;
 constexpr float kPi = std::numbers::pi_v<float>;
+// Shading normals of a 2 x 2 quad within this angle (2 degrees) of their mean share one sum of
+// the lights.
+constexpr float kQuadNormalCos = 0.99939f;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -247,6 +251,15 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
   return lit / 16;
 }
 
+using Float8 = float __attribute__((vector_size(32)));
+using Int8 = std::int32_t __attribute__((vector_size(32)));
+constexpr Float8 kTexelCentres = {0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f, 7.5f};
+inline bool any(Int8 mask) {
+  std::uint64_t words[4];
+  std::memcpy(words, &mask, sizeof(words));
+  return (words[0] | words[1] | words[2] | words[3]) != 0;
+}
+
 // Shadow casters for one frame: world positions and the triangles over them.
 struct CasterMesh {
   std::vector<Vector3f> positions;
@@ -338,15 +351,24 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     for (std::int32_t i = bins.start[band]; i < bins.start[band + 1]; ++i) {
       const Projected& p = projected[bins.items[i]];
       const int y0 = std::max<int>(row0, p.y0), y1 = std::min<int>(row1 - 1, p.y1);
+      // Eight texels at once from a multiple of eight (the map's size is one): lanes outside
+      // the triangle fail its edge tests.
       for (int y = y0; y <= y1; ++y) {
         const float py = y + 0.5f;
         float* row = map.depth.data() + static_cast<size_t>(y) * size;
-        for (int x = p.x0; x <= p.x1; ++x) {
-          const float px = x + 0.5f;
-          const float w0 = p.w0_plane[0] * px + p.w0_plane[1] * py + p.w0_plane[2];
-          const float w1 = p.w1_plane[0] * px + p.w1_plane[1] * py + p.w1_plane[2];
-          if (w0 < 0 || w1 < 0 || w0 + w1 > 1) continue;
-          row[x] = std::max(row[x], p.key_plane[0] * px + p.key_plane[1] * py + p.key_plane[2]);
+        const float w0_y = p.w0_plane[1] * py, w1_y = p.w1_plane[1] * py;
+        const float key_y = p.key_plane[1] * py;
+        for (int x = p.x0 & ~7; x <= p.x1; x += 8) {
+          const Float8 px = static_cast<float>(x) + kTexelCentres;
+          const Float8 w0 = p.w0_plane[0] * px + w0_y + p.w0_plane[2];
+          const Float8 w1 = p.w1_plane[0] * px + w1_y + p.w1_plane[2];
+          const Int8 inside = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1);
+          if (!any(inside)) continue;
+          const Float8 key = p.key_plane[0] * px + key_y + p.key_plane[2];
+          Float8 current;
+          std::memcpy(&current, row + x, sizeof(current));
+          const Float8 merged = inside & (key > current) ? key : current;
+          std::memcpy(row + x, &merged, sizeof(merged));
         }
       }
     }
@@ -364,7 +386,8 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
                            const CasterMesh& casters, int size) {
   ShadowMap map;
-  map.size = size;
+  map.size = (size + 7) / 8 * 8;  // whole groups of eight texels per row
+  size = map.size;
   if (light.type == ir::LightType::kDirectional) {
     map.orthographic = true;
     map.light_from_world = light_frame(light.direction.cast<float>());
@@ -488,9 +511,9 @@ struct ScreenSetup {
 // Transforms (camera_vertex(t, corner) -> camera space), clips, projects and bins every triangle.
 // Chunks run in parallel and are joined in order, so the result (and any depth tie) matches a
 // serial pass.
-template <typename CameraVertex>
+template <typename CameraVertex, typename Cullable>
 ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
-                         const dslr::Intrinsics& canvas) {
+                         const Cullable& cullable, const dslr::Intrinsics& canvas) {
   ScreenSetup setup;
   const float fx = static_cast<float>(canvas.fx), fy = static_cast<float>(canvas.fy);
   const float cx = static_cast<float>(canvas.cx), cy = static_cast<float>(canvas.cy);
@@ -535,6 +558,8 @@ ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
     for (int t = begin; t < end; ++t) {
       std::array<Vector3f, 3> cam;
       for (int c = 0; c < 3; ++c) cam[c] = camera_vertex(t, c);
+      // Back faces of closed solids: the camera (at the origin) is behind their plane.
+      if (cullable(t) && (cam[1] - cam[0]).cross(cam[2] - cam[0]).dot(cam[0]) >= 0) continue;
       const int in_front = (cam[0].z() >= kNear) + (cam[1].z() >= kNear) + (cam[2].z() >= kNear);
       if (in_front == 0) continue;
       if (in_front == 3) {
@@ -584,54 +609,105 @@ ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
   return setup;
 }
 
+// Four floats or four lane masks: one pixel's four samples, or four pixel centres in a row.
+using Float4 = float __attribute__((vector_size(16)));
+using Int4 = std::int32_t __attribute__((vector_size(16)));
+
+inline Float4 load4(const float* p) {
+  Float4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+inline Int4 load4(const std::int32_t* p) {
+  Int4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+inline void store4(float* p, Float4 v) {
+  std::memcpy(p, &v, sizeof(v));
+}
+inline void store4(std::int32_t* p, Int4 v) {
+  std::memcpy(p, &v, sizeof(v));
+}
+
 // Visibility in tiles with `Samples` samples per pixel (1: the pixel centre; 4: a rotated grid),
-// then resolve(px, py, inv_z[Samples], tri[Samples]) for every pixel (tri -1: nothing there).
-template <int Samples, typename Resolve>
+// then resolve_tile(x0, y0, x1, y1, inv_z, tri) for every tile, with the samples of pixel
+// (px, py) at ((py - y0)·kTileSize + px - x0)·Samples (tri -1: nothing there).
+// Four samples are tested at once: a pixel's four, or four neighbouring pixel centres. Each lane
+// evaluates the planes with the same expression as a scalar pass would, so coverage and depth
+// ties come out the same.
+template <int Samples, typename ResolveTile>
 void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
-                     const Resolve& resolve) {
+                     const ResolveTile& resolve_tile) {
   static_assert(Samples == 1 || Samples == kSamples);
+  static_assert(kTileSize % 4 == 0);
+  // Lane offsets from the pixel (Samples 4) or from the first of four pixels (Samples 1).
+  const Float4 lane_x = Samples == 1 ? Float4{0.5f, 1.5f, 2.5f, 3.5f}
+                                     : Float4{kSampleX[0], kSampleX[1], kSampleX[2], kSampleX[3]};
+  const Float4 lane_y = Samples == 1 ? Float4{0.5f, 0.5f, 0.5f, 0.5f}
+                                     : Float4{kSampleY[0], kSampleY[1], kSampleY[2], kSampleY[3]};
+  constexpr int kStepX = Samples == 1 ? 4 : 1;  // pixels per group of four lanes
   tbb::parallel_for(
       tbb::blocked_range<int>(0, setup.tiles_x * setup.tiles_y, 4),
       [&](const tbb::blocked_range<int>& range) {
-        std::vector<float> sample_inv_z(kTileSize * kTileSize * Samples);
-        std::vector<std::int32_t> sample_tri(kTileSize * kTileSize * Samples);
+        alignas(64) float sample_inv_z[kTileSize * kTileSize * Samples];
+        alignas(64) std::int32_t sample_tri[kTileSize * kTileSize * Samples];
         for (int tile = range.begin(); tile != range.end(); ++tile) {
           const int tx = tile % setup.tiles_x, ty = tile / setup.tiles_x;
           const int x0 = tx * kTileSize, y0 = ty * kTileSize;
           const int x1 = std::min(x0 + kTileSize, canvas.width);
           const int y1 = std::min(y0 + kTileSize, canvas.height);
-          std::fill(sample_inv_z.begin(), sample_inv_z.end(), 0.0f);
-          std::fill(sample_tri.begin(), sample_tri.end(), -1);
+          std::fill(std::begin(sample_inv_z), std::end(sample_inv_z), 0.0f);
+          std::fill(std::begin(sample_tri), std::end(sample_tri), -1);
           const std::int32_t* bin = setup.tile_tris.data();
           for (std::int32_t i = setup.tile_start[tile]; i < setup.tile_start[tile + 1]; ++i) {
             const std::int32_t id = bin[i];
             const ScreenTriangle& s = setup.tris[id];
-            const int px0 = std::max<int>(x0, s.x0), px1 = std::min<int>(x1 - 1, s.x1);
+            // Groups of four pixel centres start at multiples of four inside the tile; lanes
+            // outside the triangle's box fail its edge tests, lanes past the canvas are never
+            // resolved.
+            const int px0 =
+                Samples == 1 ? x0 + ((std::max<int>(x0, s.x0) - x0) & ~3) : std::max<int>(x0, s.x0);
+            const int px1 = std::min<int>(x1 - 1, s.x1);
             const int py0 = std::max<int>(y0, s.y0), py1 = std::min<int>(y1 - 1, s.y1);
+            const Int4 id4 = Int4{} + id;
             for (int py = py0; py <= py1; ++py) {
-              for (int px = px0; px <= px1; ++px) {
+              const Float4 sy = static_cast<float>(py) + lane_y;
+              const Float4 w0_row = s.w0_plane[1] * sy;
+              const Float4 w1_row = s.w1_plane[1] * sy;
+              const Float4 iz_row = s.inv_z_plane[1] * sy;
+              for (int px = px0; px <= px1; px += kStepX) {
+                const Float4 sx = static_cast<float>(px) + lane_x;
+                const Float4 w0 = s.w0_plane[0] * sx + w0_row + s.w0_plane[2];
+                const Float4 w1 = s.w1_plane[0] * sx + w1_row + s.w1_plane[2];
+                const Float4 inv_z = s.inv_z_plane[0] * sx + iz_row + s.inv_z_plane[2];
                 const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
-                for (int k = 0; k < Samples; ++k) {
-                  const float sx = px + (Samples == 1 ? 0.5f : kSampleX[k]);
-                  const float sy = py + (Samples == 1 ? 0.5f : kSampleY[k]);
-                  const float w0 = s.w0_plane[0] * sx + s.w0_plane[1] * sy + s.w0_plane[2];
-                  const float w1 = s.w1_plane[0] * sx + s.w1_plane[1] * sy + s.w1_plane[2];
-                  if (w0 < 0 || w1 < 0 || w0 + w1 > 1) continue;
-                  const float inv_z =
-                      s.inv_z_plane[0] * sx + s.inv_z_plane[1] * sy + s.inv_z_plane[2];
-                  if (inv_z > sample_inv_z[base + k]) {
-                    sample_inv_z[base + k] = inv_z;
-                    sample_tri[base + k] = id;
-                  }
-                }
+                const Float4 nearest = load4(sample_inv_z + base);
+                const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
+                std::uint64_t hit_words[2];
+                std::memcpy(hit_words, &hit, sizeof(hit_words));
+                if (!(hit_words[0] | hit_words[1])) continue;
+                store4(sample_inv_z + base, hit ? inv_z : nearest);
+                store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
               }
             }
           }
-          for (int py = y0; py < y1; ++py) {
-            for (int px = x0; px < x1; ++px) {
-              const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
-              resolve(px, py, &sample_inv_z[base], &sample_tri[base]);
-            }
+          resolve_tile(x0, y0, x1, y1, sample_inv_z, sample_tri);
+        }
+      });
+}
+
+// resolve(px, py, inv_z[Samples], tri[Samples]) for every pixel of every tile.
+template <int Samples, typename Resolve>
+void rasterize_pixels(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
+                      const Resolve& resolve) {
+  rasterize_tiles<Samples>(
+      setup, canvas,
+      [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
+        for (int py = y0; py < y1; ++py) {
+          for (int px = x0; px < x1; ++px) {
+            const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+            resolve(px, py, inv_z + base, tri + base);
           }
         }
       });
@@ -640,7 +716,9 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
 // Where everything is for one frame: the object turned to its angle, the camera.
 struct FrameContext {
   FrameContext(const ir::Scene& scene, const StudioScene& studio, const FrameRequest& request)
-      : object(studio.object), room(studio.studio) {
+      : object(studio.object),
+        room(studio.studio),
+        closed_studio_tris(studio.closed_studio_triangles) {
     const ir::Mat4 world_from_object = ir::world_from_object(scene, request.turntable_angle_rad);
     object_rot = world_from_object.block<3, 3>(0, 0).cast<float>();
     object_t = world_from_object.block<3, 1>(0, 3).cast<float>();
@@ -675,13 +753,14 @@ struct FrameContext {
           }
           return apply(cam_rot, cam_t, room.positions[room.triangles[t - object_tris][c]]);
         },
-        canvas);
+        [&](int t) { return t >= object_tris && t - object_tris < closed_studio_tris; }, canvas);
   }
 
   const Geometry& object;
   const Geometry& room;
   Matrix3f object_rot, cam_rot;
   Vector3f object_t, cam_t, eye;
+  int closed_studio_tris = 0;
   int object_tris = 0, total_tris = 0;
 };
 
@@ -753,35 +832,78 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     lights.emplace_back(light, light.color.cast<float>());
   const float ambient_lx = static_cast<float>(scene.studio.ambient_lx);
 
-  auto shade = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+  // A point on one triangle as the camera sees it: everything shading needs besides the lights.
+  struct SurfacePoint {
+    Vector3f p;          // world
+    Vector3f n;          // unit shading normal, turned towards the viewer
+    Vector3f geometric;  // unit face normal, turned towards the viewer (shadow bias)
+    Vector3f v;          // unit, towards the eye
+    float footprint_m;   // surface size of a pixel, for texture and pattern filtering
+    int material;
+  };
+  auto unit = [](const Vector3f& x) -> Vector3f { return x * (1 / std::sqrt(x.squaredNorm())); };
+  // Barycentrics in the source triangle at (px, py), clamped to it.
+  auto source_bary_at = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+    const Vector3f b = setup.source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
+    return b * (1 / b.sum());
+  };
+  auto surface_at = [&](const ScreenTriangle& s, float px, float py) -> SurfacePoint {
     const int t = s.source;
     const bool is_object = t < object_tris;
     const Geometry& g = is_object ? object : room;
     const int local = is_object ? t : t - object_tris;
     const auto& tri = g.triangles[local];
-    Vector3f b = setup.source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
-    b /= b.sum();
+    const Vector3f b = source_bary_at(s, px, py);
     const Vector3f p_local =
         b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
-    Vector3f n_local =
+    const Vector3f n_local =
         (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
-    const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
-    Vector3f n = (is_object ? Vector3f(object_rot * n_local) : n_local).normalized();
-    const Vector3f v = (eye - p).normalized();
+    SurfacePoint sp;
+    sp.p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
+    sp.n = unit(is_object ? Vector3f(object_rot * n_local) : n_local);
+    sp.v = unit(eye - sp.p);
     // Geometric normal for shadow bias; shading normals are flipped towards the viewer, so
     // back faces of open meshes still shade.
-    Vector3f geometric = g.face_normals[local];
-    if (is_object) geometric = object_rot * geometric;
-    if (geometric.dot(v) < 0) geometric = -geometric;
-    if (n.dot(v) < 0) n = -n;
-
-    const int material_index =
-        is_object ? object.triangle_material[local] : room.triangle_material[local];
-    const ShadedMaterial& material = studio.materials[material_index];
+    sp.geometric = is_object ? Vector3f(object_rot * g.face_normals[local]) : g.face_normals[local];
+    if (sp.geometric.dot(sp.v) < 0) sp.geometric = -sp.geometric;
+    if (sp.n.dot(sp.v) < 0) sp.n = -sp.n;
+    sp.material = g.triangle_material[local];
+    const float depth = (cam_rot * sp.p + cam_t).z();
+    sp.footprint_m = depth / fx / std::max(std::abs(sp.n.dot(sp.v)), 0.2f);
+    return sp;
+  };
+  // The shading normal alone, turned towards the viewer as surface_at turns it.
+  auto normal_at = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+    const int t = s.source;
+    const bool is_object = t < object_tris;
+    const Geometry& g = is_object ? object : room;
+    const int local = is_object ? t : t - object_tris;
+    const auto& tri = g.triangles[local];
+    const Vector3f b = source_bary_at(s, px, py);
+    const Vector3f n_local =
+        (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
+    const Vector3f n = unit(is_object ? Vector3f(object_rot * n_local) : n_local);
+    const Vector3f p_local =
+        b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
+    const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
+    return n.dot(eye - p) < 0 ? Vector3f(-n) : n;
+  };
+  // Base colour x texture x surface pattern at (px, py) on the screen triangle.
+  auto albedo_at = [&](const ScreenTriangle& s, float px, float py, float footprint_m) -> Vector3f {
+    const int t = s.source;
+    const bool is_object = t < object_tris;
+    const Geometry& g = is_object ? object : room;
+    const int local = is_object ? t : t - object_tris;
+    const ShadedMaterial& material = studio.materials[g.triangle_material[local]];
+    const bool textured =
+        material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size());
+    const bool patterned = is_object && material.pattern.kind != ir::PatternKind::kNone &&
+                           material.pattern.contrast > 0;
     Vector3f albedo = material.base_color;
-    const float depth = (cam_rot * p + cam_t).z();
-    const float footprint_m = depth / fx / std::max(std::abs(n.dot(v)), 0.2f);
-    if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size())) {
+    if (!textured && !patterned) return albedo;
+    const auto& tri = g.triangles[local];
+    const Vector3f b = source_bary_at(s, px, py);
+    if (textured) {
       const MipTexture& texture = studio.textures[material.texture];
       auto uv_at = [&](float qx, float qy) {
         Vector3f bq = setup.source_bary(s, screen_bary(s, qx, qy));
@@ -795,82 +917,203 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
       albedo = albedo.cwiseProduct(texture.sample(uv, texels));
     }
-    if (is_object) albedo *= pattern_factor(material.pattern, p_local, footprint_m);
-
+    if (patterned) {
+      const Vector3f p_local =
+          b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
+      albedo *= pattern_factor(material.pattern, p_local, footprint_m);
+    }
+    return albedo;
+  };
+  // The BRDF is linear in the albedo, so the light a surface point sends to the camera is
+  // albedo ⊙ scale + offset: the lights are summed once and the albedo applied per pixel.
+  struct Lighting {
+    Vector3f scale, offset;
+  };
+  auto lighting_at = [&](const SurfacePoint& sp) -> Lighting {
+    const ShadedMaterial& material = studio.materials[sp.material];
     const float metallic = material.metallic;
-    const Vector3f diffuse_albedo = albedo * (1 - metallic);
     // Ambient: a uniform white room of the given illuminance.
-    Vector3f radiance = diffuse_albedo * (ambient_lx / kPi);
-    const float n_dot_v = std::max(n.dot(v), 1e-3f);
+    Vector3f diffuse = Vector3f::Constant(ambient_lx / kPi);
+    Vector3f specular_sum = Vector3f::Zero();
+    const float n_dot_v = std::max(sp.n.dot(sp.v), 1e-3f);
+    const float f0 = 0.04f * (1 - metallic) + metallic;
     for (size_t l = 0; l < lights.size(); ++l) {
       LightSample sample;
-      if (!sample_light(lights[l], p, &sample)) continue;
-      const float n_dot_l = n.dot(sample.to_light);
-      const float geo_dot_l = geometric.dot(sample.to_light);
+      if (!sample_light(lights[l], sp.p, &sample)) continue;
+      const float n_dot_l = sp.n.dot(sample.to_light);
+      const float geo_dot_l = sp.geometric.dot(sample.to_light);
       if (n_dot_l <= 0 || geo_dot_l <= -0.05f) continue;
-      const float visibility = shadow_maps[l].visibility(p, std::max(geo_dot_l, 0.0f));
+      const float visibility = shadow_maps[l].visibility(sp.p, std::max(geo_dot_l, 0.0f));
       if (visibility <= 0) continue;
-      const Vector3f h = (sample.to_light + v).normalized();
+      const Vector3f h = unit(sample.to_light + sp.v);
       float fresnel = 0;
-      const float f0 = 0.04f * (1 - metallic) + metallic;
       const float specular =
-          ggx_specular(n_dot_l, n_dot_v, std::max(n.dot(h), 0.0f), std::max(v.dot(h), 0.0f),
+          ggx_specular(n_dot_l, n_dot_v, std::max(sp.n.dot(h), 0.0f), std::max(sp.v.dot(h), 0.0f),
                        material.roughness, f0, &fresnel);
-      const Vector3f spec_color =
-          metallic > 0 ? Vector3f(Vector3f::Constant(1 - metallic) + albedo * metallic)
-                       : Vector3f::Ones();
-      const Vector3f brdf = diffuse_albedo * ((1 - fresnel) / kPi) + spec_color * specular;
-      radiance += brdf.cwiseProduct(sample.illuminance) * (n_dot_l * visibility);
+      const Vector3f arriving = sample.illuminance * (n_dot_l * visibility);
+      diffuse += arriving * ((1 - fresnel) / kPi);
+      specular_sum += arriving * specular;
     }
-    return radiance;
+    // brdf = albedo·(1 - metallic)·(1 - F)/π + spec_colour·specular, where the specular colour
+    // is white for dielectrics and blends towards the albedo with the metallic factor.
+    return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
+  };
+  auto shade = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+    const SurfacePoint sp = surface_at(s, px, py);
+    const Lighting lighting = lighting_at(sp);
+    return albedo_at(s, px, py, sp.footprint_m).cwiseProduct(lighting.scale) + lighting.offset;
+  };
+
+  // A pixel's samples grouped into surfaces (same object membership, depths within 1 %): each is
+  // shaded once, with the triangle holding most of its samples; only silhouettes blend surfaces.
+  struct PixelSurfaces {
+    int count = 0;
+    std::array<std::int32_t, kSamples> triangle;  // screen triangle shading each surface
+    std::array<int, kSamples> samples;            // samples it covers
+    int object_samples = 0;
+    float nearest = 0;  // largest 1/z
+  };
+  auto group_samples = [&](const float* inv_z, const std::int32_t* tri) {
+    PixelSurfaces out;
+    if (tri[0] >= 0 && tri[0] == tri[1] && tri[0] == tri[2] && tri[0] == tri[3]) {
+      // Inside one triangle, as most pixels are.
+      out.nearest = std::max({inv_z[0], inv_z[1], inv_z[2], inv_z[3]});
+      out.count = 1;
+      out.triangle[0] = tri[0];
+      out.samples[0] = kSamples;
+      out.object_samples = screen_tris[tri[0]].source < object_tris ? kSamples : 0;
+      return out;
+    }
+    std::array<int, kSamples> surface{-1, -1, -1, -1};
+    for (int k = 0; k < kSamples; ++k) {
+      const std::int32_t id = tri[k];
+      out.nearest = std::max(out.nearest, inv_z[k]);
+      if (id < 0 || surface[k] >= 0) continue;
+      const bool on_object = screen_tris[id].source < object_tris;
+      int count = 0;
+      for (int j = k; j < kSamples; ++j) {
+        const std::int32_t other = tri[j];
+        if (other < 0 || surface[j] >= 0) continue;
+        if ((screen_tris[other].source < object_tris) != on_object) continue;
+        if (std::abs(inv_z[j] - inv_z[k]) > 0.01f * inv_z[k]) continue;
+        surface[j] = k;
+        ++count;
+      }
+      int best = k, best_votes = 0;
+      for (int j = k; j < kSamples; ++j) {
+        if (surface[j] != k) continue;
+        int votes = 0;
+        for (int m = k; m < kSamples; ++m) votes += surface[m] == k && tri[m] == tri[j];
+        if (votes > best_votes) {
+          best = j;
+          best_votes = votes;
+        }
+      }
+      if (on_object) out.object_samples += count;
+      out.triangle[out.count] = tri[best];
+      out.samples[out.count++] = count;
+    }
+    return out;
+  };
+  auto write_pixel = [&](int px, int py, const PixelSurfaces& surfaces, const Vector3f& color) {
+    const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
+    frame.rgb[pixel * 3 + 0] = color.x();
+    frame.rgb[pixel * 3 + 1] = color.y();
+    frame.rgb[pixel * 3 + 2] = color.z();
+    if (surfaces.nearest > 0) frame.depth_m[pixel] = 1 / surfaces.nearest;
+    frame.mask[pixel] = surfaces.object_samples * 2 >= kSamples ? 255 : 0;
+  };
+  auto shade_pixel = [&](int px, int py, const PixelSurfaces& surfaces) {
+    Vector3f color = Vector3f::Zero();
+    for (int i = 0; i < surfaces.count; ++i) {
+      color += shade(screen_tris[surfaces.triangle[i]], px + 0.5f, py + 0.5f) *
+               (float(surfaces.samples[i]) / kSamples);
+    }
+    write_pixel(px, py, surfaces, color);
   };
 
   const auto raster_start = Clock::now();
   rasterize_tiles<kSamples>(
-      setup, canvas, [&](int px, int py, const float* inv_z, const std::int32_t* tri) {
-        Vector3f color = Vector3f::Zero();
-        int object_samples = 0;
-        float nearest = 0;
-        // Samples on one surface (same object membership, depths within 1 %) are shaded
-        // once, with the triangle holding most of them; only silhouettes blend surfaces.
-        std::array<int, kSamples> surface{-1, -1, -1, -1};
-        for (int k = 0; k < kSamples; ++k) {
-          const std::int32_t id = tri[k];
-          nearest = std::max(nearest, inv_z[k]);
-          if (id < 0 || surface[k] >= 0) continue;
-          const bool on_object = screen_tris[id].source < object_tris;
-          int count = 0;
-          for (int j = k; j < kSamples; ++j) {
-            const std::int32_t other = tri[j];
-            if (other < 0 || surface[j] >= 0) continue;
-            if ((screen_tris[other].source < object_tris) != on_object) continue;
-            if (std::abs(inv_z[j] - inv_z[k]) > 0.01f * inv_z[k]) {
+      setup, canvas,
+      [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
+        auto at = [&](int px, int py) { return ((py - y0) * kTileSize + (px - x0)) * kSamples; };
+        // 2 x 2 quads inside one surface sum the lights once, at the quad's centre, and take the
+        // albedo (texture, pattern) per pixel: lighting varies slowly across two pixels, the
+        // surface's detail does not. Quads that hold an edge, and odd last rows and columns, are
+        // shaded pixel by pixel.
+        for (int qy = y0; qy < y1; qy += 2) {
+          for (int qx = x0; qx < x1; qx += 2) {
+            const bool whole = qx + 1 < x1 && qy + 1 < y1 && !request.per_pixel_lighting;
+            std::array<PixelSurfaces, 4> quad;
+            bool uniform = whole;
+            for (int i = 0; i < 4 && (whole || i == 0); ++i) {
+              const int px = qx + (i & 1), py = qy + (i >> 1);
+              if (px >= x1 || py >= y1) continue;
+              quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+              uniform = uniform && quad[i].count == 1 && quad[i].samples[0] == kSamples;
+            }
+            if (uniform) {
+              const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
+              const bool on_object = first.source < object_tris;
+              const auto material_of = [&](const ScreenTriangle& t) {
+                return t.source < object_tris ? object.triangle_material[t.source]
+                                              : room.triangle_material[t.source - object_tris];
+              };
+              for (int i = 1; i < 4 && uniform; ++i) {
+                const ScreenTriangle& other = screen_tris[quad[i].triangle[0]];
+                uniform = (other.source < object_tris) == on_object &&
+                          material_of(other) == material_of(first) &&
+                          std::abs(quad[i].nearest - quad[0].nearest) <= 0.01f * quad[0].nearest;
+              }
+            }
+            if (!uniform) {
+              for (int i = 0; i < 4; ++i) {
+                const int px = qx + (i & 1), py = qy + (i >> 1);
+                if (px >= x1 || py >= y1) continue;
+                if (!whole) quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+                shade_pixel(px, py, quad[i]);
+              }
               continue;
             }
-            surface[j] = k;
-            ++count;
-          }
-          int best = k, best_votes = 0;
-          for (int j = k; j < kSamples; ++j) {
-            if (surface[j] != k) continue;
-            int votes = 0;
-            for (int m = k; m < kSamples; ++m) {
-              votes += surface[m] == k && tri[m] == tri[j];
+            const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
+            SurfacePoint centre = surface_at(first, qx + 1.0f, qy + 1.0f);
+            const ShadedMaterial& material = studio.materials[centre.material];
+            const bool textured = material.texture >= 0;
+            bool flat = first.source >= object_tris && !textured;
+            for (int i = 1; i < 4 && flat; ++i) {
+              flat = room.face_normals[screen_tris[quad[i].triangle[0]].source - object_tris].dot(
+                         room.face_normals[first.source - object_tris]) >= kQuadNormalCos;
             }
-            if (votes > best_votes) {
-              best = j;
-              best_votes = votes;
+            if (flat) {
+              // Studio surfaces are plain planes: one colour for a quad within one of them.
+              const Vector3f color = shade(first, qx + 1.0f, qy + 1.0f);
+              for (int i = 0; i < 4; ++i) write_pixel(qx + (i & 1), qy + (i >> 1), quad[i], color);
+              continue;
+            }
+            // Otherwise the lights are summed once, at the quad's centre, when the four pixels'
+            // shading normals agree with its normal (a smooth patch), else per pixel.
+            bool smooth = true;
+            for (int i = 0; i < 4 && smooth; ++i) {
+              smooth = normal_at(screen_tris[quad[i].triangle[0]], qx + (i & 1) + 0.5f,
+                                 qy + (i >> 1) + 0.5f)
+                           .dot(centre.n) >= kQuadNormalCos;
+            }
+            if (smooth) {
+              const Lighting lighting = lighting_at(centre);
+              for (int i = 0; i < 4; ++i) {
+                const int px = qx + (i & 1), py = qy + (i >> 1);
+                const Vector3f albedo = albedo_at(screen_tris[quad[i].triangle[0]], px + 0.5f,
+                                                  py + 0.5f, centre.footprint_m);
+                write_pixel(px, py, quad[i], albedo.cwiseProduct(lighting.scale) + lighting.offset);
+              }
+              continue;
+            }
+            for (int i = 0; i < 4; ++i) {
+              const int px = qx + (i & 1), py = qy + (i >> 1);
+              shade_pixel(px, py, quad[i]);
             }
           }
-          if (on_object) object_samples += count;
-          color += shade(screen_tris[tri[best]], px + 0.5f, py + 0.5f) * (float(count) / kSamples);
         }
-        const size_t pixel = static_cast<size_t>(py) * canvas.width + px;
-        frame.rgb[pixel * 3 + 0] = color.x();
-        frame.rgb[pixel * 3 + 1] = color.y();
-        frame.rgb[pixel * 3 + 2] = color.z();
-        if (nearest > 0) frame.depth_m[pixel] = 1 / nearest;
-        frame.mask[pixel] = object_samples * 2 >= kSamples ? 255 : 0;
       });
   if (timings) {
     timings->raster_ms += ms_since(raster_start);
@@ -901,14 +1144,14 @@ VisibilityBuffer render_visibility(const ir::Scene& scene, const StudioScene& st
   const size_t pixel_count = static_cast<size_t>(buffer.width) * buffer.height;
   buffer.object_triangle.assign(pixel_count, -1);
   buffer.depth_m.assign(pixel_count, std::numeric_limits<float>::infinity());
-  rasterize_tiles<1>(setup, request.canvas,
-                     [&](int px, int py, const float* inv_z, const std::int32_t* tri) {
-                       if (tri[0] < 0) return;
-                       const size_t pixel = static_cast<size_t>(py) * buffer.width + px;
-                       buffer.depth_m[pixel] = 1 / inv_z[0];
-                       const int source = setup.tris[tri[0]].source;
-                       if (source < context.object_tris) buffer.object_triangle[pixel] = source;
-                     });
+  rasterize_pixels<1>(setup, request.canvas,
+                      [&](int px, int py, const float* inv_z, const std::int32_t* tri) {
+                        if (tri[0] < 0) return;
+                        const size_t pixel = static_cast<size_t>(py) * buffer.width + px;
+                        buffer.depth_m[pixel] = 1 / inv_z[0];
+                        const int source = setup.tris[tri[0]].source;
+                        if (source < context.object_tris) buffer.object_triangle[pixel] = source;
+                      });
   return buffer;
 }
 
@@ -920,7 +1163,7 @@ std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene&
   std::vector<float> rgb(static_cast<size_t>(request.canvas.width) * request.canvas.height * 3,
                          0.08f);
   // Face normals lit by a headlight, so the shape reads in the picture.
-  rasterize_tiles<kSamples>(
+  rasterize_pixels<kSamples>(
       setup, request.canvas, [&](int px, int py, const float*, const std::int32_t* tri) {
         Vector3f color = Vector3f::Zero();
         for (int k = 0; k < kSamples; ++k) {

@@ -16,6 +16,9 @@ struct FrameRequest {
   double turntable_angle_rad = 0;
   dslr::Intrinsics canvas;  // undistorted pinhole grid to render
   int shadow_map_size = 2048;
+  // Lights are summed once per 2 x 2 quad inside a surface (albedo stays per pixel); true sums
+  // them for every pixel (tests compare the two).
+  bool per_pixel_lighting = false;
 };
 
 struct RasterTimings {

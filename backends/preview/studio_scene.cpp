@@ -129,7 +129,6 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
     const Vector3f a0 = ring_point(i, z0), a1 = ring_point(i + 1, z0);
     const Vector3f b0 = ring_point(i, z1), b1 = ring_point(i + 1, z1);
     const Vector3f n0(a0.x() / radius, a0.y() / radius, 0), n1(a1.x() / radius, a1.y() / radius, 0);
-    // Side.
     for (const auto& [p, n] : {std::pair{a0, n0}, {a1, n1}, {b1, n1}, {b0, n0}}) {
       g.positions.push_back(p);
       g.normals.push_back(n);
@@ -137,16 +136,40 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
     }
     g.triangles.push_back({base, base + 1, base + 2});
     g.triangles.push_back({base, base + 2, base + 3});
-    // Caps.
-    const auto cap = static_cast<std::uint32_t>(g.positions.size());
-    for (const auto& p : {Vector3f(0, 0, z1), b0, b1, Vector3f(0, 0, z0), a1, a0}) {
-      g.positions.push_back(p);
-      g.normals.push_back(p.z() == z1 ? Vector3f(0, 0, 1) : Vector3f(0, 0, -1));
+    g.triangle_material.insert(g.triangle_material.end(), 2, material);
+  }
+  // Caps as zig-zag strips across the disc rather than fans: compact triangles, so their
+  // screen boxes do not overlap one another (a fan's thin wedges each box half the disc).
+  for (const float z : {z1, z0}) {
+    const auto base = static_cast<std::uint32_t>(g.positions.size());
+    const Vector3f normal(0, 0, z == z1 ? 1.0f : -1.0f);
+    for (int i = 0; i < kSegments; ++i) {
+      g.positions.push_back(ring_point(i, z));
+      g.normals.push_back(normal);
       g.uvs.push_back({0, 0});
     }
-    g.triangles.push_back({cap, cap + 1, cap + 2});
-    g.triangles.push_back({cap + 3, cap + 4, cap + 5});
-    g.triangle_material.insert(g.triangle_material.end(), 4, material);
+    // Walk inwards from both ends of the ring: i runs forwards, j backwards.
+    auto emit = [&](int a, int b, int c) {
+      // Counter-clockwise about the cap's outward normal.
+      if (z == z1) {
+        g.triangles.push_back({base + a, base + b, base + c});
+      } else {
+        g.triangles.push_back({base + a, base + c, base + b});
+      }
+      g.triangle_material.push_back(material);
+    };
+    int i = 0, j = kSegments - 1;
+    bool forward = true;
+    while (j - i >= 2) {
+      if (forward) {
+        emit(j, i, i + 1);
+        ++i;
+      } else {
+        emit(j, i, j - 1);
+        --j;
+      }
+      forward = !forward;
+    }
   }
 }
 
@@ -276,6 +299,7 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   // The stand under the disc.
   add_cylinder(out.studio, std::min(0.04f, radius / 2), 0.0f,
                top - static_cast<float>(studio.turntable.thickness_m), table_material);
+  out.closed_studio_triangles = static_cast<int>(out.studio.triangles.size());
   add_quad(out.studio, Vector3f(-6, -6, 0), Vector3f(12, 0, 0), Vector3f(0, 12, 0), floor_material);
   if (studio.backdrop.green_screen) {
     const int backdrop_material = add_material(studio.backdrop.color, 0.95f);

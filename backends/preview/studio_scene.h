@@ -56,6 +56,9 @@ struct StudioScene {
   // Triangles that cast shadows, as indices into the object's vertices followed by the studio's
   // (studio vertex i is number object.positions.size() + i).
   std::vector<std::array<std::uint32_t, 3>> shadow_casters;
+  // The first `closed_studio_triangles` studio triangles bound solids (turntable, stand): their
+  // back faces are hidden by their front faces, so the camera may skip them.
+  int closed_studio_triangles = 0;
 };
 
 StudioScene prepare_studio_scene(const ir::Scene& scene);
