@@ -58,7 +58,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
   FrameRequest request;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
-  request.shadow_map_size = std::clamp(geometry.width * 3 / 4, 512, 2048);
+  request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);
   const int subframes = motion_blur_subframes(scene, studio, shot, scale);
   RasterTimings raster;
   dslr::LinearFrame frame;
