@@ -671,6 +671,38 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
             const int px1 = std::min<int>(x1 - 1, s.x1);
             const int py0 = std::max<int>(y0, s.y0), py1 = std::min<int>(y1 - 1, s.y1);
             const Int4 id4 = Int4{} + id;
+            // A triangle that covers the whole box of samples (the studio's big ones) needs only
+            // the depth test: the planes are affine, so the box's corners decide, with a margin
+            // for rounding.
+            bool covers_box = false;
+            {
+              constexpr float kMargin = 1e-4f;
+              const float bx0 = px0 + (Samples == 1 ? 0.5f : 0.125f);
+              const float bx1 = px1 + (Samples == 1 ? 0.5f + kStepX - 1 : 0.875f);
+              const float by0 = py0 + (Samples == 1 ? 0.5f : 0.125f);
+              const float by1 = py1 + (Samples == 1 ? 0.5f : 0.875f);
+              const Float4 cx = {bx0, bx1, bx0, bx1}, cy = {by0, by0, by1, by1};
+              const Float4 w0 = s.w0_plane[0] * cx + s.w0_plane[1] * cy + s.w0_plane[2];
+              const Float4 w1 = s.w1_plane[0] * cx + s.w1_plane[1] * cy + s.w1_plane[2];
+              const Int4 inside = (w0 >= kMargin) & (w1 >= kMargin) & (w0 + w1 <= 1 - kMargin);
+              covers_box = inside[0] && inside[1] && inside[2] && inside[3];
+            }
+            if (covers_box) {
+              for (int py = py0; py <= py1; ++py) {
+                const Float4 sy = static_cast<float>(py) + lane_y;
+                const Float4 iz_row = s.inv_z_plane[1] * sy;
+                for (int px = px0; px <= px1; px += kStepX) {
+                  const Float4 sx = static_cast<float>(px) + lane_x;
+                  const Float4 inv_z = s.inv_z_plane[0] * sx + iz_row + s.inv_z_plane[2];
+                  const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+                  const Float4 nearest = load4(sample_inv_z + base);
+                  const Int4 hit = inv_z > nearest;
+                  store4(sample_inv_z + base, hit ? inv_z : nearest);
+                  store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
+                }
+              }
+              continue;
+            }
             for (int py = py0; py <= py1; ++py) {
               const Float4 sy = static_cast<float>(py) + lane_y;
               const Float4 w0_row = s.w0_plane[1] * sy;
@@ -847,13 +879,16 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const Vector3f b = setup.source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
     return b * (1 / b.sum());
   };
-  auto surface_at = [&](const ScreenTriangle& s, float px, float py) -> SurfacePoint {
+  // `on_plane`: barycentrics unclamped, so points past the triangle's edges stay on its plane.
+  auto surface_at = [&](const ScreenTriangle& s, float px, float py,
+                        bool on_plane = false) -> SurfacePoint {
     const int t = s.source;
     const bool is_object = t < object_tris;
     const Geometry& g = is_object ? object : room;
     const int local = is_object ? t : t - object_tris;
     const auto& tri = g.triangles[local];
-    const Vector3f b = source_bary_at(s, px, py);
+    const Vector3f b =
+        on_plane ? setup.source_bary(s, screen_bary(s, px, py)) : source_bary_at(s, px, py);
     const Vector3f p_local =
         b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
     const Vector3f n_local =
@@ -958,6 +993,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // is white for dielectrics and blends towards the albedo with the metallic factor.
     return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
   };
+  // A plain studio plane's radiance at (px, py), which may lie outside the triangle.
+  auto shade_on_plane = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+    const SurfacePoint sp = surface_at(s, px, py, true);
+    const Lighting lighting = lighting_at(sp);
+    return studio.materials[sp.material].base_color.cwiseProduct(lighting.scale) + lighting.offset;
+  };
   auto shade = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
     const SurfacePoint sp = surface_at(s, px, py);
     const Lighting lighting = lighting_at(sp);
@@ -1033,6 +1074,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   };
 
   const auto raster_start = Clock::now();
+  // The studio is planes of one plain colour: over a 4 x 4 block within one plane the light
+  // varies smoothly (soft shadows included), so it is summed at the block's corners and
+  // interpolated, corners shared between blocks.
+  constexpr int kBlock = 4;
+  constexpr int kCorners = kTileSize / kBlock + 1;
+  const bool use_blocks = !request.per_pixel_lighting;
   rasterize_tiles<kSamples>(
       setup, canvas,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
@@ -1041,76 +1088,139 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         // albedo (texture, pattern) per pixel: lighting varies slowly across two pixels, the
         // surface's detail does not. Quads that hold an edge, and odd last rows and columns, are
         // shaded pixel by pixel.
-        for (int qy = y0; qy < y1; qy += 2) {
-          for (int qx = x0; qx < x1; qx += 2) {
-            const bool whole = qx + 1 < x1 && qy + 1 < y1 && !request.per_pixel_lighting;
-            std::array<PixelSurfaces, 4> quad;
-            bool uniform = whole;
-            for (int i = 0; i < 4 && (whole || i == 0); ++i) {
-              const int px = qx + (i & 1), py = qy + (i >> 1);
-              if (px >= x1 || py >= y1) continue;
-              quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
-              uniform = uniform && quad[i].count == 1 && quad[i].samples[0] == kSamples;
-            }
-            if (uniform) {
-              const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
-              const bool on_object = first.source < object_tris;
-              const auto material_of = [&](const ScreenTriangle& t) {
-                return t.source < object_tris ? object.triangle_material[t.source]
-                                              : room.triangle_material[t.source - object_tris];
-              };
-              for (int i = 1; i < 4 && uniform; ++i) {
-                const ScreenTriangle& other = screen_tris[quad[i].triangle[0]];
-                uniform = (other.source < object_tris) == on_object &&
-                          material_of(other) == material_of(first) &&
-                          std::abs(quad[i].nearest - quad[0].nearest) <= 0.01f * quad[0].nearest;
-              }
-            }
-            if (!uniform) {
-              for (int i = 0; i < 4; ++i) {
-                const int px = qx + (i & 1), py = qy + (i >> 1);
-                if (px >= x1 || py >= y1) continue;
-                if (!whole) quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
-                shade_pixel(px, py, quad[i]);
-              }
-              continue;
-            }
+        auto resolve_quad = [&](int qx, int qy) {
+          const bool whole = qx + 1 < x1 && qy + 1 < y1 && !request.per_pixel_lighting;
+          std::array<PixelSurfaces, 4> quad;
+          bool uniform = whole;
+          for (int i = 0; i < 4 && (whole || i == 0); ++i) {
+            const int px = qx + (i & 1), py = qy + (i >> 1);
+            if (px >= x1 || py >= y1) return;
+            quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+            uniform = uniform && quad[i].count == 1 && quad[i].samples[0] == kSamples;
+          }
+          if (uniform) {
             const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
-            SurfacePoint centre = surface_at(first, qx + 1.0f, qy + 1.0f);
-            const ShadedMaterial& material = studio.materials[centre.material];
-            const bool textured = material.texture >= 0;
-            bool flat = first.source >= object_tris && !textured;
-            for (int i = 1; i < 4 && flat; ++i) {
-              flat = room.face_normals[screen_tris[quad[i].triangle[0]].source - object_tris].dot(
-                         room.face_normals[first.source - object_tris]) >= kQuadNormalCos;
+            const bool on_object = first.source < object_tris;
+            const auto material_of = [&](const ScreenTriangle& t) {
+              return t.source < object_tris ? object.triangle_material[t.source]
+                                            : room.triangle_material[t.source - object_tris];
+            };
+            for (int i = 1; i < 4 && uniform; ++i) {
+              const ScreenTriangle& other = screen_tris[quad[i].triangle[0]];
+              uniform = (other.source < object_tris) == on_object &&
+                        material_of(other) == material_of(first) &&
+                        std::abs(quad[i].nearest - quad[0].nearest) <= 0.01f * quad[0].nearest;
             }
-            if (flat) {
-              // Studio surfaces are plain planes: one colour for a quad within one of them.
-              const Vector3f color = shade(first, qx + 1.0f, qy + 1.0f);
-              for (int i = 0; i < 4; ++i) write_pixel(qx + (i & 1), qy + (i >> 1), quad[i], color);
-              continue;
-            }
-            // Otherwise the lights are summed once, at the quad's centre, when the four pixels'
-            // shading normals agree with its normal (a smooth patch), else per pixel.
-            bool smooth = true;
-            for (int i = 0; i < 4 && smooth; ++i) {
-              smooth = normal_at(screen_tris[quad[i].triangle[0]], qx + (i & 1) + 0.5f,
-                                 qy + (i >> 1) + 0.5f)
-                           .dot(centre.n) >= kQuadNormalCos;
-            }
-            if (smooth) {
-              const Lighting lighting = lighting_at(centre);
-              for (int i = 0; i < 4; ++i) {
-                const int px = qx + (i & 1), py = qy + (i >> 1);
-                const Vector3f albedo = albedo_at(screen_tris[quad[i].triangle[0]], px + 0.5f,
-                                                  py + 0.5f, centre.footprint_m);
-                write_pixel(px, py, quad[i], albedo.cwiseProduct(lighting.scale) + lighting.offset);
-              }
-              continue;
-            }
+          }
+          if (!uniform) {
             for (int i = 0; i < 4; ++i) {
               const int px = qx + (i & 1), py = qy + (i >> 1);
+              if (px >= x1 || py >= y1) return;
+              if (!whole) quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
               shade_pixel(px, py, quad[i]);
+            }
+            return;
+          }
+          const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
+          SurfacePoint centre = surface_at(first, qx + 1.0f, qy + 1.0f);
+          const ShadedMaterial& material = studio.materials[centre.material];
+          const bool textured = material.texture >= 0;
+          bool flat = first.source >= object_tris && !textured;
+          for (int i = 1; i < 4 && flat; ++i) {
+            flat = room.face_normals[screen_tris[quad[i].triangle[0]].source - object_tris].dot(
+                       room.face_normals[first.source - object_tris]) >= kQuadNormalCos;
+          }
+          if (flat) {
+            // Studio surfaces are plain planes: one colour for a quad within one of them.
+            const Vector3f color = shade(first, qx + 1.0f, qy + 1.0f);
+            for (int i = 0; i < 4; ++i) write_pixel(qx + (i & 1), qy + (i >> 1), quad[i], color);
+            return;
+          }
+          // Otherwise the lights are summed once, at the quad's centre, when the four pixels'
+          // shading normals agree with its normal (a smooth patch), else per pixel.
+          bool smooth = true;
+          for (int i = 0; i < 4 && smooth; ++i) {
+            smooth = normal_at(screen_tris[quad[i].triangle[0]], qx + (i & 1) + 0.5f,
+                               qy + (i >> 1) + 0.5f)
+                         .dot(centre.n) >= kQuadNormalCos;
+          }
+          if (smooth) {
+            const Lighting lighting = lighting_at(centre);
+            for (int i = 0; i < 4; ++i) {
+              const int px = qx + (i & 1), py = qy + (i >> 1);
+              const Vector3f albedo = albedo_at(screen_tris[quad[i].triangle[0]], px + 0.5f,
+                                                py + 0.5f, centre.footprint_m);
+              write_pixel(px, py, quad[i], albedo.cwiseProduct(lighting.scale) + lighting.offset);
+            }
+            return;
+          }
+          for (int i = 0; i < 4; ++i) {
+            const int px = qx + (i & 1), py = qy + (i >> 1);
+            shade_pixel(px, py, quad[i]);
+          }
+        };
+        // Corner radiance cache of the tile's blocks (NaN: not computed yet).
+        std::array<Vector3f, kCorners * kCorners> corner_color;
+        std::array<std::int32_t, kCorners * kCorners> corner_plane;
+        corner_plane.fill(-1);
+        for (int by = y0; by < y1; by += kBlock) {
+          for (int bx = x0; bx < x1; bx += kBlock) {
+            bool flat_block = use_blocks && bx + kBlock <= x1 && by + kBlock <= y1;
+            std::array<PixelSurfaces, kBlock * kBlock> block;
+            int plane_triangle = -1;  // the screen triangle that stands for the block's plane
+            for (int i = 0; i < kBlock * kBlock && flat_block; ++i) {
+              const int px = bx + i % kBlock, py = by + i / kBlock;
+              block[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+              const PixelSurfaces& b = block[i];
+              if (b.count != 1 || b.samples[0] != kSamples) {
+                flat_block = false;
+                break;
+              }
+              const ScreenTriangle& t = screen_tris[b.triangle[0]];
+              if (t.source < object_tris) {
+                flat_block = false;
+                break;
+              }
+              if (i == 0) {
+                plane_triangle = b.triangle[0];
+                const int material = room.triangle_material[t.source - object_tris];
+                flat_block = studio.materials[material].texture < 0;
+                continue;
+              }
+              const int first = screen_tris[plane_triangle].source - object_tris;
+              const int local = t.source - object_tris;
+              flat_block =
+                  room.triangle_material[local] == room.triangle_material[first] &&
+                  room.face_normals[local].dot(room.face_normals[first]) >= kQuadNormalCos &&
+                  std::abs(b.nearest - block[0].nearest) <= 0.02f * block[0].nearest;
+            }
+            if (!flat_block) {
+              for (int qy = by; qy < std::min(y1, by + kBlock); qy += 2) {
+                for (int qx = bx; qx < std::min(x1, bx + kBlock); qx += 2) resolve_quad(qx, qy);
+              }
+              continue;
+            }
+            // Radiance at the block's corners, on the plane (unclamped barycentrics reach
+            // past the triangle's edges along the plane).
+            const ScreenTriangle& plane = screen_tris[plane_triangle];
+            std::array<Vector3f, 4> corner;
+            for (int k = 0; k < 4; ++k) {
+              const int cx = (bx - x0) / kBlock + (k & 1), cy = (by - y0) / kBlock + (k >> 1);
+              const int slot = cy * kCorners + cx;
+              if (corner_plane[slot] != plane.source) {
+                const float px = static_cast<float>(bx + kBlock * (k & 1));
+                const float py = static_cast<float>(by + kBlock * (k >> 1));
+                corner_color[slot] = shade_on_plane(plane, px, py);
+                corner_plane[slot] = plane.source;
+              }
+              corner[k] = corner_color[slot];
+            }
+            for (int i = 0; i < kBlock * kBlock; ++i) {
+              const int px = bx + i % kBlock, py = by + i / kBlock;
+              const float fx = (i % kBlock + 0.5f) / kBlock, fy = (i / kBlock + 0.5f) / kBlock;
+              const Vector3f color = (1 - fy) * ((1 - fx) * corner[0] + fx * corner[1]) +
+                                     fy * ((1 - fx) * corner[2] + fx * corner[3]);
+              write_pixel(px, py, block[i], color);
             }
           }
         }
