@@ -42,7 +42,7 @@ constexpr double kDenseRadius = 4.5, kRingRatio = 1.3;
 // resolution and upsampled (the blur this adds is taken out of the discs, see depth_of_field),
 // and the gather costs a sixteenth (a quarter of the pixels, a quarter of
 // the taps each). At full resolution, out-of-focus backgrounds are most of the frame.
-constexpr float kCoarseRadiusPx = 3.0f;
+constexpr float kCoarseRadiusPx = 5.0f;
 
 struct TapSet {
   // Sorted by distance; structure of arrays for the gather loop.
