@@ -73,32 +73,33 @@ Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
          (at(x0, y0 + 1) * (1 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
 }
 
-std::uint32_t hash3(std::int32_t x, std::int32_t y, std::int32_t z, std::uint32_t seed) {
-  std::uint32_t h = seed * 0x9E3779B9u;
-  h ^= static_cast<std::uint32_t>(x) * 0x85EBCA6Bu;
-  h = (h ^ (h >> 13)) * 0xC2B2AE35u;
-  h ^= static_cast<std::uint32_t>(y) * 0x27D4EB2Fu;
-  h = (h ^ (h >> 15)) * 0x165667B1u;
-  h ^= static_cast<std::uint32_t>(z) * 0x9E3779B1u;
-  h = (h ^ (h >> 16)) * 0x85EBCA77u;
-  return h ^ (h >> 13);
-}
-
-// Smooth value noise in [0, 1] on a unit lattice.
+// Smooth value noise in [0, 1] on a unit lattice. The eight corner hashes are computed together
+// (one 8-lane register); a 32-bit integer hash of the corner's lattice coordinates and the seed.
 float value_noise(const Vector3f& p, std::uint32_t seed) {
+  using U32x8 = std::uint32_t __attribute__((vector_size(32)));
   const float fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
-  const auto ix = static_cast<std::int32_t>(fx), iy = static_cast<std::int32_t>(fy),
-             iz = static_cast<std::int32_t>(fz);
+  const auto ix = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx)),
+             iy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy)),
+             iz = static_cast<std::uint32_t>(static_cast<std::int32_t>(fz));
   auto fade = [](float t) { return t * t * (3 - 2 * t); };
   const float tx = fade(p.x() - fx), ty = fade(p.y() - fy), tz = fade(p.z() - fz);
-  auto value = [&](int dx, int dy, int dz) {
-    return (hash3(ix + dx, iy + dy, iz + dz, seed) & 0xFFFFFF) / float(0xFFFFFF);
-  };
+  // Corner k is (k & 1, (k >> 1) & 1, k >> 2).
+  const U32x8 x = U32x8{0, 1, 0, 1, 0, 1, 0, 1} + ix;
+  const U32x8 y = U32x8{0, 0, 1, 1, 0, 0, 1, 1} + iy;
+  const U32x8 z = U32x8{0, 0, 0, 0, 1, 1, 1, 1} + iz;
+  U32x8 h = U32x8{} + seed * 0x9E3779B9u;
+  h ^= x * 0x85EBCA6Bu;
+  h = (h ^ (h >> 13)) * 0xC2B2AE35u;
+  h ^= y * 0x27D4EB2Fu;
+  h = (h ^ (h >> 15)) * 0x165667B1u;
+  h ^= z * 0x9E3779B1u;
+  h = (h ^ (h >> 16)) * 0x85EBCA77u;
+  h ^= h >> 13;
+  float value[8];
+  for (int k = 0; k < 8; ++k) value[k] = (h[k] & 0xFFFFFF) / float(0xFFFFFF);
   auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
-  return lerp(
-      lerp(lerp(value(0, 0, 0), value(1, 0, 0), tx), lerp(value(0, 1, 0), value(1, 1, 0), tx), ty),
-      lerp(lerp(value(0, 0, 1), value(1, 0, 1), tx), lerp(value(0, 1, 1), value(1, 1, 1), tx), ty),
-      tz);
+  return lerp(lerp(lerp(value[0], value[1], tx), lerp(value[2], value[3], tx), ty),
+              lerp(lerp(value[4], value[5], tx), lerp(value[6], value[7], tx), ty), tz);
 }
 
 void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const Vector3f& edge_v,
