@@ -19,17 +19,29 @@ double exposure_scale(const ir::Camera& camera) {
   return camera.shutter_s * camera.iso * kExposureQ / (78.0 * n * n);
 }
 
-std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance) {
+namespace {
+
+void expose_into(const ir::Camera& camera, const float* radiance, float* signal, std::size_t n) {
   const float scale = static_cast<float>(exposure_scale(camera));
-  std::vector<float> signal(radiance.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, radiance.size(), 1 << 16),
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 16),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i < range.end(); ++i) {
                         const float v = radiance[i] * scale;
                         signal[i] = v > 0 && v < std::numeric_limits<float>::infinity() ? v : 0;
                       }
                     });
+}
+
+}  // namespace
+
+std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance) {
+  std::vector<float> signal(radiance.size());
+  expose_into(camera, radiance.data(), signal.data(), radiance.size());
   return signal;
+}
+
+void expose_in_place(const ir::Camera& camera, std::vector<float>& radiance) {
+  expose_into(camera, radiance.data(), radiance.data(), radiance.size());
 }
 
 double motion_blur_length_px(double angular_velocity_rad_s, double shutter_s,

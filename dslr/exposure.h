@@ -20,6 +20,8 @@ double exposure_scale(const ir::Camera& camera);
 // Radiance (cd/m²) times exposure_scale. No clipping here (the sensor clips), but negative and
 // non-finite radiance (a renderer's stray NaN) becomes 0 so it cannot spread through the blurs.
 std::vector<float> expose(const ir::Camera& camera, const std::vector<float>& radiance);
+// The same in place.
+void expose_in_place(const ir::Camera& camera, std::vector<float>& radiance);
 
 // Length in pixels of the motion blur of a point at R⊥ metres from the turntable axis (the
 // component of its motion parallel to the sensor) and depth Z: ω·t·R⊥·f_px / Z.

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -231,16 +232,32 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // below it. The output elsewhere is left as it is.
   auto active = [&](std::size_t t) { return needed_tiles == nullptr || (*needed_tiles)[t]; };
   std::vector<float> tile_min(tile_max.size(), static_cast<float>(kMaxCocRadiusPx));
+  // The radius falls towards the focus distance and grows away from it on both sides, so a
+  // tile's depth range gives its smallest and largest disc without a radius per pixel.
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
+    const float inf = std::numeric_limits<float>::infinity();
+    std::vector<float> near(tiles_x), far(tiles_x);
     for (int ty = r.begin(); ty < r.end(); ++ty) {
+      std::fill(near.begin(), near.end(), inf);
+      std::fill(far.begin(), far.end(), 0.0f);
       for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
-        for (int x = 0; x < w; ++x) {
-          const float z = depth_m[static_cast<std::size_t>(y) * w + x];
-          const float radius = radius_at(z > 0 ? z : std::numeric_limits<float>::infinity());
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + x / kTile;
-          tile_max[t] = std::max(tile_max[t], radius);
-          tile_min[t] = std::min(tile_min[t], radius);
+        const float* row = &depth_m[static_cast<std::size_t>(y) * w];
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          float lo = near[tx], hi = far[tx];
+          for (int x = tx * kTile; x < std::min(w, (tx + 1) * kTile); ++x) {
+            const float z = row[x] > 0 ? row[x] : inf;  // unknown depth: background
+            lo = std::min(lo, z);
+            hi = std::max(hi, z);
+          }
+          near[tx] = lo, far[tx] = hi;
         }
+      }
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        const float r_near = radius_at(near[tx]), r_far = radius_at(far[tx]);
+        tile_max[t] = std::max(r_near, r_far);
+        tile_min[t] =
+            near[tx] <= focus && focus <= far[tx] ? radius_at(focus) : std::min(r_near, r_far);
       }
     }
   });
@@ -285,7 +302,13 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
   }
   Intrinsics half;
-  std::vector<float> half_out;
+  // The half-size frames of the levels below, kept by the thread between frames (a fresh
+  // buffer costs its zeroing and page faults on every shot).
+  struct LevelBuffers {
+    std::vector<float> rgb, depth, out;
+  };
+  thread_local std::array<LevelBuffers, kMaxCoarseLevel + 1> level_buffers;
+  std::vector<float>& half_out = level_buffers[level + 1 <= kMaxCoarseLevel ? level + 1 : 0].out;
   if (any_coarse) {
     half.width = (w + 1) / 2;
     half.height = (h + 1) / 2;
@@ -293,8 +316,10 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     half.fy = canvas.fy / 2;
     half.cx = canvas.cx / 2;
     half.cy = canvas.cy / 2;
-    std::vector<float> half_rgb(3 * static_cast<std::size_t>(half.width) * half.height);
-    std::vector<float> half_depth(static_cast<std::size_t>(half.width) * half.height);
+    std::vector<float>& half_rgb = level_buffers[level + 1].rgb;
+    std::vector<float>& half_depth = level_buffers[level + 1].depth;
+    half_rgb.resize(3 * static_cast<std::size_t>(half.width) * half.height);
+    half_depth.resize(static_cast<std::size_t>(half.width) * half.height);
     tbb::parallel_for(0, half.height, [&](int hy) {
       for (int hx = 0; hx < half.width; ++hx) {
         float sum[3] = {0, 0, 0}, nearest = std::numeric_limits<float>::infinity();

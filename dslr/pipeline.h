@@ -20,5 +20,8 @@ int output_bits(const ir::Camera& camera);
 // On a malformed frame (buffer sizes that do not match) the result is empty and `error` says why.
 DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
                             const ShotParams& shot, double scale, std::string* error = nullptr);
+// The same, taking the frame's buffers as working memory (no copy of a full-size frame).
+DevelopResult develop_frame(const ir::Camera& camera, LinearFrame&& frame, const ShotParams& shot,
+                            double scale, std::string* error = nullptr);
 
 }  // namespace rigc::dslr

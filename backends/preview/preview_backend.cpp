@@ -85,7 +85,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
   params.focus_distance_m = shot.focus_distance_m;
   params.shot_index = shot.index;
   params.seed = seed;
-  dslr::DevelopResult result = dslr::develop_frame(scene.camera, frame, params, scale);
+  dslr::DevelopResult result = dslr::develop_frame(scene.camera, std::move(frame), params, scale);
   if (timing) {
     timing->raster = raster;
     timing->develop = result.timings;
