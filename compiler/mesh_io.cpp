@@ -584,10 +584,13 @@ class GltfLoader {
   int default_material() {
     if (default_material_ < 0) {
       ir::Material mat;
+      // A primitive without a material: a plain grey dielectric, as Blender's importer and the
+      // other formats give it. (glTF's own default is white metal, which photographs almost
+      // black under studio lights: no scan is made of that.)
       mat.name = "default";
-      mat.base_color = Vector3d(1, 1, 1);  // glTF's default material: white, rough 1, metal 1
-      mat.roughness = 1.0;
-      mat.metallic = 1.0;
+      mat.base_color = Vector3d(0.8, 0.8, 0.8);
+      mat.roughness = 0.8;
+      mat.metallic = 0.0;
       out_->materials.push_back(mat);
       default_material_ = static_cast<int>(out_->materials.size() - 1);
     }

@@ -247,7 +247,9 @@ TEST(MeshIoGltf, ConvertsYUpToZUpAndAppliesNodeTransforms) {
   // Counter-clockwise seen from glTF +Z, which is RigC -Y.
   EXPECT_TRUE(m.mesh.normals[0].isApprox(Vector3f(0, -1, 0))) << m.mesh.normals[0].transpose();
   EXPECT_TRUE(m.mesh.uvs.empty());
-  ASSERT_EQ(m.materials.size(), 1u);  // glTF's default material
+  ASSERT_EQ(m.materials.size(), 1u);  // no material in the file: RigC's grey dielectric
+  EXPECT_EQ(m.materials[0].metallic, 0.0);
+  EXPECT_NEAR(m.materials[0].base_color.x(), 0.8, 1e-9);
 }
 
 TEST(MeshIoGltf, MirroringNodeKeepsWindingConsistent) {
