@@ -234,6 +234,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   std::vector<float> tile_min(tile_max.size(), static_cast<float>(kMaxCocRadiusPx));
   // The radius falls towards the focus distance and grows away from it on both sides, so a
   // tile's depth range gives its smallest and largest disc without a radius per pixel.
+  std::vector<float> tile_near(tile_max.size()), tile_far(tile_max.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     const float inf = std::numeric_limits<float>::infinity();
     std::vector<float> near(tiles_x), far(tiles_x);
@@ -254,6 +255,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       }
       for (int tx = 0; tx < tiles_x; ++tx) {
         const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        tile_near[t] = near[tx];
+        tile_far[t] = far[tx];
         const float r_near = radius_at(near[tx]), r_far = radius_at(far[tx]);
         tile_max[t] = std::max(r_near, r_far);
         tile_min[t] =
@@ -268,10 +271,15 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       const float m = tile_max[static_cast<std::size_t>(ty) * tiles_x + tx];
       reach_max = std::max(reach_max, m);
       const int span = static_cast<int>(std::ceil(m / kTile));
+      // A disc reaches the pixels it is in front of (or level with); behind a pixel only that
+      // pixel's own disc gathers. So a tile wholly behind another tile does not widen its reach
+      // (the background next to a sharp object leaves the object's taps few).
+      const float source_near = tile_near[static_cast<std::size_t>(ty) * tiles_x + tx];
       for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
         for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
-          float& r = reach[static_cast<std::size_t>(sy) * tiles_x + sx];
-          r = std::max(r, m);
+          const std::size_t target = static_cast<std::size_t>(sy) * tiles_x + sx;
+          if (source_near > tile_far[target] * (1 + kSameDepth)) continue;
+          reach[target] = std::max(reach[target], m);
         }
       }
     }
