@@ -3,9 +3,14 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 namespace rigc::dslr {
@@ -79,18 +84,6 @@ const std::array<float, 65536>& normal_table() {
   return table;
 }
 
-// Poisson sample by inversion from a uniform in [0, 1); for small means only.
-double poisson_small(double mean, double u) {
-  double p = std::exp(-mean), cumulative = p;
-  int k = 0;
-  while (u > cumulative && k < 200) {
-    ++k;
-    p *= mean / k;
-    cumulative += p;
-  }
-  return k;
-}
-
 std::uint64_t stream_key(std::uint64_t seed, std::uint64_t stream) {
   return splitmix64(seed ^ splitmix64(stream));
 }
@@ -99,6 +92,85 @@ enum Stream : std::uint64_t { kPrnuDsnu = 1, kReadNormal = 2, kShotNormal = 3, k
 
 // Below this mean the Gaussian approximation of the Poisson law is visibly skewed.
 constexpr double kExactPoissonBelow = 30;
+
+constexpr int kNoiseLanes = 8;
+using U32x8 = std::uint32_t __attribute__((vector_size(32)));
+using I32x8 = std::int32_t __attribute__((vector_size(32)));
+using F32x8 = float __attribute__((vector_size(32)));
+constexpr U32x8 kLaneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
+
+// A 32-bit integer hash with good avalanche (Wellons' "lowbias32"), on eight lanes.
+inline U32x8 hash32(U32x8 x) {
+  x ^= x >> 16;
+  x *= 0x7FEB352Du;
+  x ^= x >> 15;
+  x *= 0x846CA68Bu;
+  x ^= x >> 16;
+  return x;
+}
+
+inline F32x8 lookup(const float* table, U32x8 index) {
+#if defined(__AVX2__)
+  I32x8 signed_index;
+  std::memcpy(&signed_index, &index, sizeof(index));
+  const __m256 gathered = _mm256_i32gather_ps(table, reinterpret_cast<__m256i&>(signed_index), 4);
+  F32x8 out;
+  std::memcpy(&out, &gathered, sizeof(out));
+  return out;
+#else
+  F32x8 out;
+  for (int k = 0; k < kNoiseLanes; ++k) out[k] = table[index[k]];
+  return out;
+#endif
+}
+
+inline F32x8 sqrt8(F32x8 x) {
+#if defined(__AVX__)
+  return reinterpret_cast<F32x8>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+#else
+  for (int k = 0; k < kNoiseLanes; ++k) x[k] = std::sqrt(x[k]);
+  return x;
+#endif
+}
+
+inline F32x8 floor8(F32x8 x) {
+#if defined(__AVX__)
+  return reinterpret_cast<F32x8>(_mm256_floor_ps(reinterpret_cast<__m256>(x)));
+#else
+  for (int k = 0; k < kNoiseLanes; ++k) x[k] = std::floor(x[k]);
+  return x;
+#endif
+}
+
+// e^-x for 0 <= x < 80 on eight lanes: 2^t split into 2^n (exponent bits) and 2^f (its Taylor
+// polynomial of degree 6 on [0, 1), relative error below 2e-5).
+inline F32x8 exp_negative8(F32x8 x) {
+  const F32x8 t = x * -1.44269504f;  // -x·log2(e), in (-116, 0]
+  const F32x8 n = floor8(t);
+  const F32x8 f = t - n;
+  F32x8 poly = F32x8{} + 1.535336188e-4f;
+  poly = poly * f + 1.339887440e-3f;
+  poly = poly * f + 9.618437357e-3f;
+  poly = poly * f + 5.550332471e-2f;
+  poly = poly * f + 2.402264791e-1f;
+  poly = poly * f + 6.931472028e-1f;
+  poly = poly * f + 1.0f;
+  const I32x8 exponent = (__builtin_convertvector(n, I32x8) + 127) << 23;
+  F32x8 scale;
+  std::memcpy(&scale, &exponent, sizeof(scale));
+  return poly * scale;
+}
+
+inline bool any_lane(I32x8 mask) {
+#if defined(__AVX__)
+  const __m256i bits = reinterpret_cast<__m256i>(mask);
+  return !_mm256_testz_si256(bits, bits);
+#else
+  std::uint64_t words[4];
+  std::memcpy(words, &mask, sizeof(words));
+  return (words[0] | words[1] | words[2] | words[3]) != 0;
+#endif
+}
 
 }  // namespace
 
@@ -134,35 +206,69 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
   const std::uint64_t shot_seed = splitmix64(seed ^ splitmix64(0x5A07ull + shot_index));
   const auto& normal = normal_table();
   const std::uint64_t fixed_key = stream_key(fixed_seed, kPrnuDsnu);
-  const std::uint64_t read_key = stream_key(shot_seed, kReadNormal);
   const std::uint64_t shot_key = stream_key(shot_seed, kShotNormal);
   const std::uint64_t uniform_key = stream_key(shot_seed, kShotUniform);
 
+  // Per value (pixel p, channel c: value 3p + c) four normals: PRNU and DSNU from the camera's
+  // fixed stream, read and shot noise from the shot's. A 32-bit hash of the value's index gives
+  // two 16-bit table indices, and eight values go through together (one 8-lane register).
+  const std::uint32_t fixed_key32 = static_cast<std::uint32_t>(fixed_key ^ (fixed_key >> 32));
+  const std::uint32_t shot_key32 = static_cast<std::uint32_t>(shot_key ^ (shot_key >> 32));
+  const std::size_t values = 3 * pixels;
+  const float* table = normal.data();
+  // Below kExactPoissonBelow electrons the Gaussian stands in badly: those values take an
+  // exact Poisson draw.
+  const std::uint32_t uniform_key32 = static_cast<std::uint32_t>(uniform_key ^ (uniform_key >> 32));
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, pixels, 4096),
+      tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
       [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t p = range.begin(); p < range.end(); ++p) {
-          // Each hash gives four 16-bit normals: PRNU x3 and DSNU x3 take two.
-          const std::uint64_t fixed_a = splitmix64((2 * p) ^ fixed_key);
-          const std::uint64_t fixed_b = splitmix64((2 * p + 1) ^ fixed_key);
-          const std::uint64_t read_bits = splitmix64(p ^ read_key);
-          const std::uint64_t shot_bits = splitmix64(p ^ shot_key);
-          for (int c = 0; c < 3; ++c) {
-            float& v = signal[3 * p + c];
-            const float prnu = normal[(fixed_a >> (16 * c)) & 0xFFFF];
-            const float dsnu =
-                c == 0 ? normal[fixed_a >> 48] : normal[(fixed_b >> (16 * c)) & 0xFFFF];
-            const float mean = std::max(0.0f, v * fwc_f * (1 + prnu_f * prnu)) + dark_f;
-            float electrons;
-            if (mean < kExactPoissonBelow) {
-              const std::uint64_t u = splitmix64((3 * p + c) ^ uniform_key);
-              electrons =
-                  static_cast<float>(poisson_small(mean, static_cast<double>(u >> 11) * 0x1.0p-53));
-            } else {
-              electrons = mean + std::sqrt(mean) * normal[(shot_bits >> (16 * c)) & 0xFFFF];
+        for (std::size_t group = range.begin(); group < range.end(); ++group) {
+          const std::size_t first = group * kNoiseLanes;
+          const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
+          const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
+          const U32x8 fixed_bits = hash32(index ^ fixed_key32);
+          const U32x8 shot_bits = hash32(index ^ shot_key32);
+          const F32x8 prnu = lookup(table, fixed_bits & 0xFFFF);
+          const F32x8 dsnu = lookup(table, fixed_bits >> 16);
+          const F32x8 read = lookup(table, shot_bits & 0xFFFF);
+          const F32x8 shot = lookup(table, shot_bits >> 16);
+          float* v = signal.data() + first;
+          F32x8 x = {};
+          if (count == kNoiseLanes) {
+            std::memcpy(&x, v, sizeof(x));
+          } else {
+            std::memcpy(&x, v, count * sizeof(float));
+          }
+          const F32x8 zero = {};
+          F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
+          mean = (mean > zero ? mean : zero) + dark_f;
+          const I32x8 small = mean < static_cast<float>(kExactPoissonBelow);
+          F32x8 photons = mean + sqrt8(mean) * shot;
+          if (any_lane(small)) {
+            // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
+            // all lanes at once, from a third hash as the uniform.
+            const U32x8 uniform_bits = hash32(index ^ uniform_key32);
+            const F32x8 u = __builtin_convertvector(uniform_bits >> 8, F32x8) * 0x1.0p-24f;
+            const F32x8 clamped_mean = small ? mean : zero;
+            F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;
+            I32x8 going = small & (u > cumulative);
+            for (int step = 1; step <= 200 && any_lane(going); ++step) {
+              p = p * clamped_mean / static_cast<float>(step);
+              cumulative += p;
+              k = going ? k + 1.0f : k;
+              going = going & (u > cumulative);
             }
-            electrons += read_f * normal[(read_bits >> (16 * c)) & 0xFFFF] + dsnu_f * dsnu;
-            v = std::clamp(std::floor(electrons * dn_per_e + 0.5f), dn_low, dn_high) * per_dn;
+            photons = small ? k : photons;
+          }
+          const F32x8 electrons = photons + read_f * read + dsnu_f * dsnu;
+          F32x8 dn = floor8(electrons * dn_per_e + 0.5f);
+          dn = dn < dn_low ? F32x8{} + dn_low : dn;
+          dn = dn > dn_high ? F32x8{} + dn_high : dn;
+          const F32x8 out = dn * per_dn;
+          if (count == kNoiseLanes) {
+            std::memcpy(v, &out, sizeof(out));
+          } else {
+            std::memcpy(v, &out, count * sizeof(float));
           }
         }
       });

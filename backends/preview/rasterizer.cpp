@@ -1,5 +1,9 @@
 #include "backends/preview/rasterizer.h"
 
+#if defined(__SSE4_1__)
+#include <immintrin.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -260,9 +264,14 @@ using Float8 = float __attribute__((vector_size(32)));
 using Int8 = std::int32_t __attribute__((vector_size(32)));
 constexpr Float8 kTexelCentres = {0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f, 7.5f};
 inline bool any(Int8 mask) {
+#if defined(__AVX__)
+  const __m256i bits = reinterpret_cast<__m256i>(mask);
+  return !_mm256_testz_si256(bits, bits);
+#else
   std::uint64_t words[4];
   std::memcpy(words, &mask, sizeof(words));
   return (words[0] | words[1] | words[2] | words[3]) != 0;
+#endif
 }
 
 // Shadow casters for one frame: world positions and the triangles over them.
@@ -635,6 +644,17 @@ inline void store4(std::int32_t* p, Int4 v) {
   std::memcpy(p, &v, sizeof(v));
 }
 
+inline bool any(Int4 mask) {
+#if defined(__SSE4_1__)
+  const __m128i bits = reinterpret_cast<__m128i>(mask);
+  return !_mm_testz_si128(bits, bits);
+#else
+  std::uint64_t words[2];
+  std::memcpy(words, &mask, sizeof(words));
+  return (words[0] | words[1]) != 0;
+#endif
+}
+
 // Visibility in tiles with `Samples` samples per pixel (1: the pixel centre; 4: a rotated grid),
 // then resolve_tile(x0, y0, x1, y1, inv_z, tri) for every tile, with the samples of pixel
 // (px, py) at ((py - y0)·kTileSize + px - x0)·Samples (tri -1: nothing there).
@@ -721,9 +741,7 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                 const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
                 const Float4 nearest = load4(sample_inv_z + base);
                 const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-                std::uint64_t hit_words[2];
-                std::memcpy(hit_words, &hit, sizeof(hit_words));
-                if (!(hit_words[0] | hit_words[1])) continue;
+                if (!any(hit)) continue;
                 store4(sample_inv_z + base, hit ? inv_z : nearest);
                 store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
               }
