@@ -1191,7 +1191,32 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             bool flat_block = use_blocks && bx + kBlock <= x1 && by + kBlock <= y1;
             std::array<PixelSurfaces, kBlock * kBlock> block;
             int plane_triangle = -1;  // the screen triangle that stands for the block's plane
-            for (int i = 0; i < kBlock * kBlock && flat_block; ++i) {
+            // Most blocks lie inside one studio triangle: every sample holds the same id.
+            bool one_triangle = flat_block;
+            const std::int32_t first_id = flat_block ? tri[at(bx, by)] : -1;
+            for (int row = 0; row < kBlock && one_triangle; ++row) {
+              const std::int32_t* ids = tri + at(bx, by + row);
+              std::int32_t differ = 0;
+              for (int k = 0; k < kBlock * kSamples; ++k) differ |= ids[k] ^ first_id;
+              one_triangle = differ == 0;
+            }
+            if (one_triangle && first_id >= 0 && screen_tris[first_id].source >= object_tris &&
+                studio.materials[room.triangle_material[screen_tris[first_id].source - object_tris]]
+                        .texture < 0) {
+              for (int i = 0; i < kBlock * kBlock; ++i) {
+                const float* z = inv_z + at(bx + i % kBlock, by + i / kBlock);
+                PixelSurfaces& b = block[i];
+                b.count = 1;
+                b.triangle[0] = first_id;
+                b.samples[0] = kSamples;
+                b.object_samples = 0;
+                b.nearest = std::max({z[0], z[1], z[2], z[3]});
+              }
+              plane_triangle = first_id;
+            } else {
+              one_triangle = false;
+            }
+            for (int i = 0; i < kBlock * kBlock && flat_block && !one_triangle; ++i) {
               const int px = bx + i % kBlock, py = by + i / kBlock;
               block[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
               const PixelSurfaces& b = block[i];
