@@ -8,6 +8,7 @@
 #include "backends/common/colmap_text.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
+#include "compiler/primitives.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "tests/test_support.h"
@@ -214,6 +215,25 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
   EXPECT_LT(difference / sum, 0.01);                      // on average within 1 %
   EXPECT_LT(relative[relative.size() * 99 / 100], 0.08);  // 99 % of pixels within 8 %
   EXPECT_GT(difference, 0.0) << "the two paths should not be the same code";
+}
+
+// Back faces are skipped only for meshes that bound a solid wound outwards.
+TEST(Preview, ClosedOutwardMeshesAreRecognised) {
+  const ir::Mesh box = make_primitive(PrimitiveKind::kBox, 1, 0);
+  const ir::Mesh statue = make_primitive(PrimitiveKind::kStatue, 4, 7);
+  for (const ir::Mesh* mesh : {&box, &statue}) {
+    auto triangles = mesh->triangles;
+    EXPECT_TRUE(is_closed_outward(mesh->positions, triangles));
+    auto open = triangles;
+    open.pop_back();
+    EXPECT_FALSE(is_closed_outward(mesh->positions, open));  // a hole
+    auto inside_out = triangles;
+    for (auto& t : inside_out) std::swap(t[1], t[2]);
+    EXPECT_FALSE(is_closed_outward(mesh->positions, inside_out));
+    auto mixed = triangles;
+    std::swap(mixed[0][1], mixed[0][2]);  // one face wound the other way
+    EXPECT_FALSE(is_closed_outward(mesh->positions, mixed));
+  }
 }
 
 TEST(Preview, SameSeedGivesIdenticalImagesOtherSeedDiffers) {

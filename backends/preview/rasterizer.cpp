@@ -278,6 +278,7 @@ inline bool any(Int8 mask) {
 struct CasterMesh {
   std::vector<Vector3f> positions;
   const std::vector<std::array<std::uint32_t, 3>>* triangles = nullptr;
+  std::size_t first_closed = 0;  // triangles from here on bound solids: back faces skipped
 };
 
 void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
@@ -330,6 +331,15 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
           }
           const float area = edge(s[0], s[1], s[2].x(), s[2].y());
           if (behind || std::abs(area) < 1e-12f) continue;
+          if (t >= casters.first_closed) {
+            // A solid's faces turned away from the light are behind its lit faces.
+            const Vector3f& a = casters.positions[tris[t][0]];
+            const Vector3f normal =
+                (casters.positions[tris[t][1]] - a).cross(casters.positions[tris[t][2]] - a);
+            const Vector3f towards =
+                map.orthographic ? Vector3f(map.light_from_world.row(2)) : Vector3f(a - map.origin);
+            if (normal.dot(towards) >= 0) continue;
+          }
           const float min_x = std::min({s[0].x(), s[1].x(), s[2].x()});
           const float max_x = std::max({s[0].x(), s[1].x(), s[2].x()});
           const float min_y = std::min({s[0].y(), s[1].y(), s[2].y()});
@@ -773,7 +783,8 @@ struct FrameContext {
   FrameContext(const ir::Scene& scene, const StudioScene& studio, const FrameRequest& request)
       : object(studio.object),
         room(studio.studio),
-        closed_studio_tris(studio.closed_studio_triangles) {
+        closed_studio_tris(studio.closed_studio_triangles),
+        object_closed(studio.object_closed) {
     const ir::Mat4 world_from_object = ir::world_from_object(scene, request.turntable_angle_rad);
     object_rot = world_from_object.block<3, 3>(0, 0).cast<float>();
     object_t = world_from_object.block<3, 1>(0, 3).cast<float>();
@@ -808,7 +819,10 @@ struct FrameContext {
           }
           return apply(cam_rot, cam_t, room.positions[room.triangles[t - object_tris][c]]);
         },
-        [&](int t) { return t >= object_tris && t - object_tris < closed_studio_tris; }, canvas);
+        [&](int t) {
+          return t < object_tris ? object_closed : t - object_tris < closed_studio_tris;
+        },
+        canvas);
   }
 
   const Geometry& object;
@@ -816,6 +830,7 @@ struct FrameContext {
   Matrix3f object_rot, cam_rot;
   Vector3f object_t, cam_t, eye;
   int closed_studio_tris = 0;
+  bool object_closed = false;
   int object_tris = 0, total_tris = 0;
 };
 
@@ -850,6 +865,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   auto shadow_start = Clock::now();
   CasterMesh casters;
   casters.triangles = &studio.shadow_casters;
+  casters.first_closed = studio.first_closed_caster;
   casters.positions.resize(object.positions.size() + room.positions.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, object.positions.size(), 8192),
                     [&](const tbb::blocked_range<size_t>& range) {

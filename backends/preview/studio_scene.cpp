@@ -1,6 +1,9 @@
 #include "backends/preview/studio_scene.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -242,6 +245,48 @@ void Geometry::compute_face_normals() {
   }
 }
 
+bool is_closed_outward(const std::vector<Vector3f>& positions,
+                       const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  if (triangles.empty()) return false;
+  // Vertices at the same position are one corner of the solid (meshes split them for normals
+  // and texture seams): number them by position.
+  std::vector<std::uint32_t> order(positions.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto key = [&](std::uint32_t i) {
+    const Vector3f& p = positions[i];
+    return std::array<float, 3>{p.x(), p.y(), p.z()};
+  };
+  tbb::parallel_sort(order.begin(), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+  std::vector<std::uint32_t> corner(positions.size());
+  std::uint32_t corners = 0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    if (i > 0 && key(order[i]) != key(order[i - 1])) ++corners;
+    corner[order[i]] = corners;
+  }
+  // Every edge must be shared by exactly two triangles that run along it in opposite directions:
+  // sorted by (smaller corner, larger corner, direction), the edges then come in such pairs.
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * triangles.size());
+  double volume = 0;
+  for (const auto& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t a = corner[t[k]], b = corner[t[(k + 1) % 3]];
+      if (a == b) return false;  // a degenerate triangle
+      edges.push_back(std::min(a, b) << 33 | std::max(a, b) << 1 | (a > b ? 1 : 0));
+    }
+    volume += positions[t[0]].cast<double>().dot(
+        positions[t[1]].cast<double>().cross(positions[t[2]].cast<double>()));
+  }
+  if (!(volume > 0)) return false;  // open, inside out, or flat
+  tbb::parallel_sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size(); i += 2) {
+    if (i + 1 >= edges.size() || (edges[i] ^ edges[i + 1]) != 1) return false;
+    if (i + 2 < edges.size() && edges[i + 2] >> 1 == edges[i] >> 1) return false;  // 3 or more
+  }
+  return true;
+}
+
 StudioScene prepare_studio_scene(const ir::Scene& scene) {
   StudioScene out;
   for (const auto& texture : scene.textures) out.textures.push_back(build_mips(texture));
@@ -315,11 +360,13 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   out.object.compute_face_normals();
   out.studio.compute_face_normals();
   const auto studio_base = static_cast<std::uint32_t>(out.object.positions.size());
+  out.object_closed = is_closed_outward(out.object.positions, out.object.triangles);
   for (size_t t = 0; t < out.object.triangles.size(); ++t) {
     if (out.materials[out.object.triangle_material[t]].casts_shadow) {
       out.shadow_casters.push_back(out.object.triangles[t]);
     }
   }
+  out.first_closed_caster = out.object_closed ? 0 : out.shadow_casters.size();
   for (size_t t = 0; t < out.studio.triangles.size(); ++t) {
     if (!out.materials[out.studio.triangle_material[t]].casts_shadow) continue;
     const auto& tri = out.studio.triangles[t];

@@ -59,7 +59,16 @@ struct StudioScene {
   // The first `closed_studio_triangles` studio triangles bound solids (turntable, stand): their
   // back faces are hidden by their front faces, so the camera may skip them.
   int closed_studio_triangles = 0;
+  // The object's mesh bounds a solid with its faces wound outwards (every directed edge once,
+  // its reverse once, positive volume): its back faces can be skipped too.
+  bool object_closed = false;
+  // Shadow casters from this index on bound closed solids (all of them when the object does).
+  std::size_t first_closed_caster = 0;
 };
+
+// Whether the triangles bound a solid, consistently wound with the normals outwards.
+bool is_closed_outward(const std::vector<Eigen::Vector3f>& positions,
+                       const std::vector<std::array<std::uint32_t, 3>>& triangles);
 
 StudioScene prepare_studio_scene(const ir::Scene& scene);
 
