@@ -1,17 +1,19 @@
 #include "dslr/sensor.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#if defined(__AVX__)
+#if defined(__AVX2__)
 #include <immintrin.h>
 #endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+
+#include "dslr/simd.h"
 
 namespace rigc::dslr {
 
@@ -94,9 +96,9 @@ enum Stream : std::uint64_t { kPrnuDsnu = 1, kReadNormal = 2, kShotNormal = 3, k
 constexpr double kExactPoissonBelow = 30;
 
 constexpr int kNoiseLanes = 8;
-using U32x8 = std::uint32_t __attribute__((vector_size(32)));
-using I32x8 = std::int32_t __attribute__((vector_size(32)));
-using F32x8 = float __attribute__((vector_size(32)));
+using simd::F32x8;
+using simd::I32x8;
+using simd::U32x8;
 constexpr U32x8 kLaneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
 
 // A 32-bit integer hash with good avalanche (Wellons' "lowbias32"), on eight lanes.
@@ -124,29 +126,11 @@ inline F32x8 lookup(const float* table, U32x8 index) {
 #endif
 }
 
-inline F32x8 sqrt8(F32x8 x) {
-#if defined(__AVX__)
-  return reinterpret_cast<F32x8>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
-#else
-  for (int k = 0; k < kNoiseLanes; ++k) x[k] = std::sqrt(x[k]);
-  return x;
-#endif
-}
-
-inline F32x8 floor8(F32x8 x) {
-#if defined(__AVX__)
-  return reinterpret_cast<F32x8>(_mm256_floor_ps(reinterpret_cast<__m256>(x)));
-#else
-  for (int k = 0; k < kNoiseLanes; ++k) x[k] = std::floor(x[k]);
-  return x;
-#endif
-}
-
 // e^-x for 0 <= x < 80 on eight lanes: 2^t split into 2^n (exponent bits) and 2^f (its Taylor
 // polynomial of degree 6 on [0, 1), relative error below 2e-5).
 inline F32x8 exp_negative8(F32x8 x) {
   const F32x8 t = x * -1.44269504f;  // -x·log2(e), in (-116, 0]
-  const F32x8 n = floor8(t);
+  const F32x8 n = simd::floor(t);
   const F32x8 f = t - n;
   F32x8 poly = F32x8{} + 1.535336188e-4f;
   poly = poly * f + 1.339887440e-3f;
@@ -159,17 +143,6 @@ inline F32x8 exp_negative8(F32x8 x) {
   F32x8 scale;
   std::memcpy(&scale, &exponent, sizeof(scale));
   return poly * scale;
-}
-
-inline bool any_lane(I32x8 mask) {
-#if defined(__AVX__)
-  const __m256i bits = reinterpret_cast<__m256i>(mask);
-  return !_mm256_testz_si256(bits, bits);
-#else
-  std::uint64_t words[4];
-  std::memcpy(words, &mask, sizeof(words));
-  return (words[0] | words[1] | words[2] | words[3]) != 0;
-#endif
 }
 
 }  // namespace
@@ -243,8 +216,8 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
           mean = (mean > zero ? mean : zero) + dark_f;
           const I32x8 small = mean < static_cast<float>(kExactPoissonBelow);
-          F32x8 photons = mean + sqrt8(mean) * shot;
-          if (any_lane(small)) {
+          F32x8 photons = mean + simd::sqrt(mean) * shot;
+          if (simd::any(small)) {
             // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
             // all lanes at once, from a third hash as the uniform.
             const U32x8 uniform_bits = hash32(index ^ uniform_key32);
@@ -252,7 +225,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
             const F32x8 clamped_mean = small ? mean : zero;
             F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;
             I32x8 going = small & (u > cumulative);
-            for (int step = 1; step <= 200 && any_lane(going); ++step) {
+            for (int step = 1; step <= 200 && simd::any(going); ++step) {
               p = p * clamped_mean / static_cast<float>(step);
               cumulative += p;
               k = going ? k + 1.0f : k;
@@ -261,7 +234,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
             photons = small ? k : photons;
           }
           const F32x8 electrons = photons + read_f * read + dsnu_f * dsnu;
-          F32x8 dn = floor8(electrons * dn_per_e + 0.5f);
+          F32x8 dn = simd::floor(electrons * dn_per_e + 0.5f);
           dn = dn < dn_low ? F32x8{} + dn_low : dn;
           dn = dn > dn_high ? F32x8{} + dn_high : dn;
           const F32x8 out = dn * per_dn;

@@ -1,9 +1,5 @@
 #include "backends/preview/rasterizer.h"
 
-#if defined(__SSE4_1__)
-#include <immintrin.h>
-#endif
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -14,6 +10,8 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+
+#include "dslr/simd.h"
 
 namespace rigc::preview {
 namespace {
@@ -260,19 +258,9 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
   return lit / 16;
 }
 
-using Float8 = float __attribute__((vector_size(32)));
-using Int8 = std::int32_t __attribute__((vector_size(32)));
+using Float8 = simd::F32x8;
+using Int8 = simd::I32x8;
 constexpr Float8 kTexelCentres = {0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f, 7.5f};
-inline bool any(Int8 mask) {
-#if defined(__AVX__)
-  const __m256i bits = reinterpret_cast<__m256i>(mask);
-  return !_mm256_testz_si256(bits, bits);
-#else
-  std::uint64_t words[4];
-  std::memcpy(words, &mask, sizeof(words));
-  return (words[0] | words[1] | words[2] | words[3]) != 0;
-#endif
-}
 
 // Shadow casters for one frame: world positions and the triangles over them.
 struct CasterMesh {
@@ -387,7 +375,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
           const Float8 w0 = p.w0_plane[0] * px + w0_y + p.w0_plane[2];
           const Float8 w1 = p.w1_plane[0] * px + w1_y + p.w1_plane[2];
           const Int8 inside = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1);
-          if (!any(inside)) continue;
+          if (!simd::any(inside)) continue;
           const Float8 key = p.key_plane[0] * px + key_y + p.key_plane[2];
           Float8 current;
           std::memcpy(&current, row + x, sizeof(current));
@@ -634,8 +622,8 @@ ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
 }
 
 // Four floats or four lane masks: one pixel's four samples, or four pixel centres in a row.
-using Float4 = float __attribute__((vector_size(16)));
-using Int4 = std::int32_t __attribute__((vector_size(16)));
+using Float4 = simd::F32x4;
+using Int4 = simd::I32x4;
 
 inline Float4 load4(const float* p) {
   Float4 v;
@@ -652,17 +640,6 @@ inline void store4(float* p, Float4 v) {
 }
 inline void store4(std::int32_t* p, Int4 v) {
   std::memcpy(p, &v, sizeof(v));
-}
-
-inline bool any(Int4 mask) {
-#if defined(__SSE4_1__)
-  const __m128i bits = reinterpret_cast<__m128i>(mask);
-  return !_mm_testz_si128(bits, bits);
-#else
-  std::uint64_t words[2];
-  std::memcpy(words, &mask, sizeof(words));
-  return (words[0] | words[1]) != 0;
-#endif
 }
 
 // Visibility in tiles with `Samples` samples per pixel (1: the pixel centre; 4: a rotated grid),
@@ -751,7 +728,7 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                 const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
                 const Float4 nearest = load4(sample_inv_z + base);
                 const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-                if (!any(hit)) continue;
+                if (!simd::any(hit)) continue;
                 store4(sample_inv_z + base, hit ? inv_z : nearest);
                 store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
               }
