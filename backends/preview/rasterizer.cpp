@@ -860,11 +860,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                          std::pow(caster_center.z() - object_t.z() +
                                       static_cast<float>(scene.studio.turntable.thickness_m),
                                   2.0f)));
-  std::vector<ShadowMap> shadow_maps;
-  for (const auto& light : scene.studio.lights) {
-    shadow_maps.push_back(
-        build_shadow_map(light, caster_center, caster_radius, casters, request.shadow_map_size));
-  }
+  // The lights' maps together: each map's passes have serial joins that leave a core idle.
+  std::vector<ShadowMap> shadow_maps(scene.studio.lights.size());
+  tbb::parallel_for(std::size_t{0}, shadow_maps.size(), [&](std::size_t l) {
+    shadow_maps[l] = build_shadow_map(scene.studio.lights[l], caster_center, caster_radius, casters,
+                                      request.shadow_map_size);
+  });
   if (timings) timings->shadow_ms += ms_since(shadow_start);
 
   // Transform, clip and project every triangle; bin into tiles.
