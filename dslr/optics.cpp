@@ -51,8 +51,14 @@ struct TapSet {
   std::vector<float> distance;
   std::vector<float> area;      // pixels this tap stands for
   std::vector<float> inv_soft;  // 1 / width of the coverage ramp at the disc edge
-  // For a gather radius ceil(R): how many leading taps a disc of radius R can cover.
-  std::vector<int> count_for_radius;
+  // For a radius of q/4 pixels: how many leading taps a disc that large can cover (the rest
+  // weigh nothing). Quarter steps: a disc of 1.1 px needs 9 taps, not the 21 of a 2 px one.
+  std::vector<int> count_for_quarter;
+  int taps_for(float radius) const {
+    const int q = std::min(static_cast<int>(std::ceil(radius * 4)),
+                           static_cast<int>(count_for_quarter.size()) - 1);
+    return count_for_quarter[std::max(q, 0)];
+  }
 };
 
 const TapSet& tap_set() {
@@ -93,10 +99,10 @@ const TapSet& tap_set() {
       s.area.push_back(t.area);
       s.inv_soft.push_back(t.inv_soft);
     }
-    s.count_for_radius.assign(kMaxCocRadiusPx + 2, 0);
-    for (int radius = 0; radius < static_cast<int>(s.count_for_radius.size()); ++radius) {
+    s.count_for_quarter.assign(4 * (kMaxCocRadiusPx + 1) + 1, 0);
+    for (int q = 0; q < static_cast<int>(s.count_for_quarter.size()); ++q) {
       for (int t = 0; t < static_cast<int>(taps.size()); ++t) {
-        if (taps[t].distance - 0.5f / taps[t].inv_soft < radius) s.count_for_radius[radius] = t + 1;
+        if (taps[t].distance - 0.5f / taps[t].inv_soft < q / 4.0f) s.count_for_quarter[q] = t + 1;
       }
     }
     return s;
@@ -392,9 +398,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     if (active(t) && !coarse[t]) fine_reach_max = std::max(fine_reach_max, reach[t]);
   }
   const TapSet& set = tap_set();
-  const int max_taps =
-      set.count_for_radius[std::min<int>(static_cast<int>(std::ceil(fine_reach_max)),
-                                         static_cast<int>(set.count_for_radius.size()) - 1)];
+  const int max_taps = set.taps_for(fine_reach_max);
   int tap_extent = 0;
   for (int t = 0; t < max_taps; ++t) {
     tap_extent = std::max({tap_extent, std::abs(set.dx[t]), std::abs(set.dy[t])});
@@ -492,9 +496,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             }
             continue;
           }
-          const int tap_count = set.count_for_radius[std::min<int>(
-              static_cast<int>(std::ceil(radius)),
-              static_cast<int>(set.count_for_radius.size()) - 1)];
+          const int tap_count = set.taps_for(radius);
           for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; x += kLanes) {
               gather_group(pl, set, tap_count, pl.index(x, y), sums);
