@@ -75,9 +75,13 @@ const std::vector<std::uint16_t>& srgb_table(int bits) {
     }
     return table;
   };
-  static const std::vector<std::uint16_t> table8 = build(16, 255);
+  // Each built on first use: the 16-bit one is a million pow() calls an 8-bit run never needs.
+  if (bits == 8) {
+    static const std::vector<std::uint16_t> table8 = build(16, 255);
+    return table8;
+  }
   static const std::vector<std::uint16_t> table16 = build(20, 65535);
-  return bits == 8 ? table8 : table16;
+  return table16;
 }
 
 }  // namespace
