@@ -217,6 +217,32 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
   EXPECT_GT(difference, 0.0) << "the two paths should not be the same code";
 }
 
+// Every pixel is written, also in the odd last column and row of a canvas (quads and blocks
+// that the canvas cuts): in the paper scene every ray meets the studio, so no depth stays
+// infinite.
+TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
+  ir::Scene scene =
+      compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
+  ASSERT_FALSE(scene.shots.empty());
+  const StudioScene studio = prepare_studio_scene(scene);
+  for (bool per_pixel : {false, true}) {
+    FrameRequest request;
+    request.world_from_camera = scene.shots[0].world_from_camera;
+    request.turntable_angle_rad = scene.shots[0].turntable_angle_rad;
+    request.canvas = dslr::sensor_intrinsics(scene.camera, 0.05);
+    request.canvas.width = 271;  // odd, and not a multiple of the 32-pixel tiles
+    request.canvas.height = 181;
+    request.canvas.cx = request.canvas.width / 2.0;
+    request.canvas.cy = request.canvas.height / 2.0;
+    request.shadow_map_size = 512;
+    request.per_pixel_lighting = per_pixel;
+    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    int unwritten = 0;
+    for (float z : frame.depth_m) unwritten += !std::isfinite(z);
+    EXPECT_EQ(unwritten, 0) << (per_pixel ? "per-pixel lighting" : "quad lighting");
+  }
+}
+
 // Back faces are skipped only for meshes that bound a solid wound outwards.
 TEST(Preview, ClosedOutwardMeshesAreRecognised) {
   const ir::Mesh box = make_primitive(PrimitiveKind::kBox, 1, 0);

@@ -1111,7 +1111,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           bool uniform = whole;
           for (int i = 0; i < 4 && (whole || i == 0); ++i) {
             const int px = qx + (i & 1), py = qy + (i >> 1);
-            if (px >= x1 || py >= y1) return;
+            if (px >= x1 || py >= y1) continue;
             quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
             uniform = uniform && quad[i].count == 1 && quad[i].samples[0] == kSamples;
           }
@@ -1132,7 +1132,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           if (!uniform) {
             for (int i = 0; i < 4; ++i) {
               const int px = qx + (i & 1), py = qy + (i >> 1);
-              if (px >= x1 || py >= y1) return;
+              if (px >= x1 || py >= y1) continue;
               if (!whole) quad[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
               shade_pixel(px, py, quad[i]);
             }
