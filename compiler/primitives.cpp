@@ -9,6 +9,8 @@
 #include <thread>
 #include <vector>
 
+#include "compiler/hash.h"
+
 namespace rigc {
 namespace {
 
@@ -35,13 +37,7 @@ int clamp_detail(int detail) {
 // Deterministic noise: integer hashing only, so the same seed gives the same shape everywhere.
 
 std::uint32_t hash_u32(std::uint32_t x) {
-  // lowbias32 (Chris Wellons): a good 32-bit integer finaliser.
-  x ^= x >> 16;
-  x *= 0x7feb352dU;
-  x ^= x >> 15;
-  x *= 0x846ca68bU;
-  x ^= x >> 16;
-  return x;
+  return lowbias32(x);
 }
 
 std::uint32_t hash_lattice(std::int32_t x, std::int32_t y, std::int32_t z, std::uint32_t seed) {

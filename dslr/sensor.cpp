@@ -13,6 +13,7 @@
 #include <cstring>
 #include <numbers>
 
+#include "compiler/hash.h"
 #include "dslr/simd.h"
 
 namespace rigc::dslr {
@@ -90,7 +91,8 @@ std::uint64_t stream_key(std::uint64_t seed, std::uint64_t stream) {
   return splitmix64(seed ^ splitmix64(stream));
 }
 
-enum Stream : std::uint64_t { kPrnuDsnu = 1, kReadNormal = 2, kShotNormal = 3, kShotUniform = 4 };
+// Read noise and shot noise share the shot-normal stream (two 16-bit halves of one hash).
+enum Stream : std::uint64_t { kPrnuDsnu = 1, kShotNormal = 3, kShotUniform = 4 };
 
 // Below this mean the Gaussian approximation of the Poisson law is visibly skewed.
 constexpr double kExactPoissonBelow = 30;
@@ -100,16 +102,6 @@ using simd::F32x8;
 using simd::I32x8;
 using simd::U32x8;
 constexpr U32x8 kLaneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
-
-// A 32-bit integer hash with good avalanche (Wellons' "lowbias32"), on eight lanes.
-inline U32x8 hash32(U32x8 x) {
-  x ^= x >> 16;
-  x *= 0x7FEB352Du;
-  x ^= x >> 15;
-  x *= 0x846CA68Bu;
-  x ^= x >> 16;
-  return x;
-}
 
 inline F32x8 lookup(const float* table, U32x8 index) {
 #if defined(__AVX2__)
@@ -199,8 +191,8 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           const std::size_t first = group * kNoiseLanes;
           const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
           const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
-          const U32x8 fixed_bits = hash32(index ^ fixed_key32);
-          const U32x8 shot_bits = hash32(index ^ shot_key32);
+          const U32x8 fixed_bits = lowbias32(index ^ fixed_key32);
+          const U32x8 shot_bits = lowbias32(index ^ shot_key32);
           const F32x8 prnu = lookup(table, fixed_bits & 0xFFFF);
           const F32x8 dsnu = lookup(table, fixed_bits >> 16);
           const F32x8 read = lookup(table, shot_bits & 0xFFFF);
@@ -220,7 +212,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           if (simd::any(small)) {
             // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
             // all lanes at once, from a third hash as the uniform.
-            const U32x8 uniform_bits = hash32(index ^ uniform_key32);
+            const U32x8 uniform_bits = lowbias32(index ^ uniform_key32);
             const F32x8 u = __builtin_convertvector(uniform_bits >> 8, F32x8) * 0x1.0p-24f;
             const F32x8 clamped_mean = small ? mean : zero;
             F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "dslr/simd.h"
+
 namespace rigc::preview {
 namespace {
 
@@ -79,7 +81,7 @@ Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
 // Smooth value noise in [0, 1] on a unit lattice. The eight corner hashes are computed together
 // (one 8-lane register); a 32-bit integer hash of the corner's lattice coordinates and the seed.
 float value_noise(const Vector3f& p, std::uint32_t seed) {
-  using U32x8 = std::uint32_t __attribute__((vector_size(32)));
+  using simd::U32x8;
   const float fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
   const auto ix = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx)),
              iy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy)),
