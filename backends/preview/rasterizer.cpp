@@ -755,6 +755,21 @@ void rasterize_pixels(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
       });
 }
 
+// The mesh triangle a screen triangle came from: object triangles first, then the studio's.
+struct SourceTriangle {
+  const Geometry& g;
+  int local;  // index in g
+  bool is_object;
+  const std::array<std::uint32_t, 3>& corners() const { return g.triangles[local]; }
+  int material() const { return g.triangle_material[local]; }
+  // A per-vertex attribute at barycentrics b.
+  template <typename T>
+  T at(const std::vector<T>& values, const Vector3f& b) const {
+    const auto& c = corners();
+    return b.x() * values[c[0]] + b.y() * values[c[1]] + b.z() * values[c[2]];
+  }
+};
+
 // Where everything is for one frame: the object turned to its angle, the camera.
 struct FrameContext {
   FrameContext(const ir::Scene& scene, const StudioScene& studio, const FrameRequest& request)
@@ -891,6 +906,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     int material;
   };
   auto unit = [](const Vector3f& x) -> Vector3f { return x * (1 / std::sqrt(x.squaredNorm())); };
+  auto source_of = [&](const ScreenTriangle& s) -> SourceTriangle {
+    const bool is_object = s.source < object_tris;
+    return {is_object ? object : room, is_object ? s.source : s.source - object_tris, is_object};
+  };
   // Barycentrics in the source triangle at (px, py), clamped to it.
   auto source_bary_at = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
     const Vector3f b = setup.source_bary(s, screen_bary(s, px, py)).cwiseMax(0.0f);
@@ -899,69 +918,56 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // `on_plane`: barycentrics unclamped, so points past the triangle's edges stay on its plane.
   auto surface_at = [&](const ScreenTriangle& s, float px, float py,
                         bool on_plane = false) -> SurfacePoint {
-    const int t = s.source;
-    const bool is_object = t < object_tris;
-    const Geometry& g = is_object ? object : room;
-    const int local = is_object ? t : t - object_tris;
-    const auto& tri = g.triangles[local];
+    const SourceTriangle source = source_of(s);
+    const bool is_object = source.is_object;
     const Vector3f b =
         on_plane ? setup.source_bary(s, screen_bary(s, px, py)) : source_bary_at(s, px, py);
-    const Vector3f p_local =
-        b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
-    const Vector3f n_local =
-        (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
+    const Vector3f p_local = source.at(source.g.positions, b);
+    const Vector3f n_local = source.at(source.g.normals, b);
     SurfacePoint sp;
     sp.p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
     sp.n = unit(is_object ? Vector3f(object_rot * n_local) : n_local);
     sp.v = unit(eye - sp.p);
     // Geometric normal for shadow bias; shading normals are flipped towards the viewer, so
     // back faces of open meshes still shade.
-    sp.geometric = is_object ? Vector3f(object_rot * g.face_normals[local]) : g.face_normals[local];
+    const Vector3f& face_normal = source.g.face_normals[source.local];
+    sp.geometric = is_object ? Vector3f(object_rot * face_normal) : face_normal;
     if (sp.geometric.dot(sp.v) < 0) sp.geometric = -sp.geometric;
     if (sp.n.dot(sp.v) < 0) sp.n = -sp.n;
-    sp.material = g.triangle_material[local];
+    sp.material = source.material();
     const float depth = (cam_rot * sp.p + cam_t).z();
     sp.footprint_m = depth / fx / std::max(std::abs(sp.n.dot(sp.v)), 0.2f);
     return sp;
   };
   // The shading normal alone, turned towards the viewer as surface_at turns it.
   auto normal_at = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
-    const int t = s.source;
-    const bool is_object = t < object_tris;
-    const Geometry& g = is_object ? object : room;
-    const int local = is_object ? t : t - object_tris;
-    const auto& tri = g.triangles[local];
+    const SourceTriangle source = source_of(s);
+    const bool is_object = source.is_object;
     const Vector3f b = source_bary_at(s, px, py);
-    const Vector3f n_local =
-        (b.x() * g.normals[tri[0]] + b.y() * g.normals[tri[1]] + b.z() * g.normals[tri[2]]);
+    const Vector3f n_local = source.at(source.g.normals, b);
     const Vector3f n = unit(is_object ? Vector3f(object_rot * n_local) : n_local);
-    const Vector3f p_local =
-        b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
+    const Vector3f p_local = source.at(source.g.positions, b);
     const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
     return n.dot(eye - p) < 0 ? Vector3f(-n) : n;
   };
   // Base colour x texture x surface pattern at (px, py) on the screen triangle.
   auto albedo_at = [&](const ScreenTriangle& s, float px, float py, float footprint_m) -> Vector3f {
-    const int t = s.source;
-    const bool is_object = t < object_tris;
-    const Geometry& g = is_object ? object : room;
-    const int local = is_object ? t : t - object_tris;
-    const ShadedMaterial& material = studio.materials[g.triangle_material[local]];
+    const SourceTriangle source = source_of(s);
+    const bool is_object = source.is_object;
+    const ShadedMaterial& material = studio.materials[source.material()];
     const bool textured =
         material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size());
     const bool patterned = is_object && material.pattern.kind != ir::PatternKind::kNone &&
                            material.pattern.contrast > 0;
     Vector3f albedo = material.base_color;
     if (!textured && !patterned) return albedo;
-    const auto& tri = g.triangles[local];
     const Vector3f b = source_bary_at(s, px, py);
     if (textured) {
       const MipTexture& texture = studio.textures[material.texture];
       auto uv_at = [&](float qx, float qy) {
-        Vector3f bq = setup.source_bary(s, screen_bary(s, qx, qy));
-        return Vector2f(bq.x() * g.uvs[tri[0]] + bq.y() * g.uvs[tri[1]] + bq.z() * g.uvs[tri[2]]);
+        return source.at(source.g.uvs, setup.source_bary(s, screen_bary(s, qx, qy)));
       };
-      const Vector2f uv = b.x() * g.uvs[tri[0]] + b.y() * g.uvs[tri[1]] + b.z() * g.uvs[tri[2]];
+      const Vector2f uv = source.at(source.g.uvs, b);
       const Vector2f du = uv_at(px + 1, py) - uv_at(px, py);
       const Vector2f dv = uv_at(px, py + 1) - uv_at(px, py);
       const float texels =
@@ -970,9 +976,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       albedo = albedo.cwiseProduct(texture.sample(uv, texels));
     }
     if (patterned) {
-      const Vector3f p_local =
-          b.x() * g.positions[tri[0]] + b.y() * g.positions[tri[1]] + b.z() * g.positions[tri[2]];
-      albedo *= pattern_factor(material.pattern, p_local, footprint_m);
+      albedo *= pattern_factor(material.pattern, source.at(source.g.positions, b), footprint_m);
     }
     return albedo;
   };
@@ -1009,6 +1013,16 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // brdf = albedo·(1 - metallic)·(1 - F)/π + spec_colour·specular, where the specular colour
     // is white for dielectrics and blends towards the albedo with the metallic factor.
     return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
+  };
+  // Studio triangles without a texture: one colour over a plane, lit smoothly.
+  auto plain_studio = [&](const ScreenTriangle& t) {
+    return t.source >= object_tris && studio.materials[source_of(t).material()].texture < 0;
+  };
+  // Two studio triangles of one material on one plane (their face normals agree).
+  auto same_studio_plane = [&](const ScreenTriangle& a, const ScreenTriangle& b) {
+    const SourceTriangle sa = source_of(a), sb = source_of(b);
+    return sa.material() == sb.material() &&
+           room.face_normals[sa.local].dot(room.face_normals[sb.local]) >= kQuadNormalCos;
   };
   // A plain studio plane's radiance at (px, py), which may lie outside the triangle.
   auto shade_on_plane = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
@@ -1118,14 +1132,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           if (uniform) {
             const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
             const bool on_object = first.source < object_tris;
-            const auto material_of = [&](const ScreenTriangle& t) {
-              return t.source < object_tris ? object.triangle_material[t.source]
-                                            : room.triangle_material[t.source - object_tris];
-            };
             for (int i = 1; i < 4 && uniform; ++i) {
               const ScreenTriangle& other = screen_tris[quad[i].triangle[0]];
               uniform = (other.source < object_tris) == on_object &&
-                        material_of(other) == material_of(first) &&
+                        source_of(other).material() == source_of(first).material() &&
                         std::abs(quad[i].nearest - quad[0].nearest) <= 0.01f * quad[0].nearest;
             }
           }
@@ -1141,15 +1151,15 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           const ScreenTriangle& first = screen_tris[quad[0].triangle[0]];
           SurfacePoint centre = surface_at(first, qx + 1.0f, qy + 1.0f);
           const ShadedMaterial& material = studio.materials[centre.material];
-          const bool textured = material.texture >= 0;
-          bool flat = first.source >= object_tris && !textured;
+          bool flat = plain_studio(first);
           for (int i = 1; i < 4 && flat; ++i) {
-            flat = room.face_normals[screen_tris[quad[i].triangle[0]].source - object_tris].dot(
-                       room.face_normals[first.source - object_tris]) >= kQuadNormalCos;
+            flat = same_studio_plane(screen_tris[quad[i].triangle[0]], first);
           }
           if (flat) {
             // Studio surfaces are plain planes: one colour for a quad within one of them.
-            const Vector3f color = shade(first, qx + 1.0f, qy + 1.0f);
+            const Lighting lighting = lighting_at(centre);
+            const Vector3f color =
+                material.base_color.cwiseProduct(lighting.scale) + lighting.offset;
             for (int i = 0; i < 4; ++i) write_pixel(qx + (i & 1), qy + (i >> 1), quad[i], color);
             return;
           }
@@ -1194,9 +1204,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               for (int k = 0; k < kBlock * kSamples; ++k) differ |= ids[k] ^ first_id;
               one_triangle = differ == 0;
             }
-            if (one_triangle && first_id >= 0 && screen_tris[first_id].source >= object_tris &&
-                studio.materials[room.triangle_material[screen_tris[first_id].source - object_tris]]
-                        .texture < 0) {
+            if (one_triangle && first_id >= 0 && plain_studio(screen_tris[first_id])) {
               for (int i = 0; i < kBlock * kBlock; ++i) {
                 const float* z = inv_z + at(bx + i % kBlock, by + i / kBlock);
                 PixelSurfaces& b = block[i];
@@ -1219,22 +1227,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                 break;
               }
               const ScreenTriangle& t = screen_tris[b.triangle[0]];
-              if (t.source < object_tris) {
-                flat_block = false;
-                break;
-              }
               if (i == 0) {
                 plane_triangle = b.triangle[0];
-                const int material = room.triangle_material[t.source - object_tris];
-                flat_block = studio.materials[material].texture < 0;
+                flat_block = plain_studio(t);
                 continue;
               }
-              const int first = screen_tris[plane_triangle].source - object_tris;
-              const int local = t.source - object_tris;
-              flat_block =
-                  room.triangle_material[local] == room.triangle_material[first] &&
-                  room.face_normals[local].dot(room.face_normals[first]) >= kQuadNormalCos &&
-                  std::abs(b.nearest - block[0].nearest) <= 0.02f * block[0].nearest;
+              flat_block = plain_studio(t) && same_studio_plane(t, screen_tris[plane_triangle]) &&
+                           std::abs(b.nearest - block[0].nearest) <= 0.02f * block[0].nearest;
             }
             if (!flat_block) {
               for (int qy = by; qy < std::min(y1, by + kBlock); qy += 2) {
