@@ -54,9 +54,15 @@ std::string check_frame(const LinearFrame& frame) {
 // its page faults on every shot.
 thread_local std::vector<float> spare_buffer;
 
+// The stages after the frame's checks, on `work`: the frame's radiance, copied or taken from it
+// (the frame's own rgb is not read).
 DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, std::vector<float> work,
-                      const ShotParams& shot, double scale, StageClock& clock,
-                      DevelopResult result) {
+                      const ShotParams& shot, double scale) {
+  DevelopResult result;
+  StageClock clock;
+  expose_in_place(camera, work);
+  result.timings.exposure_ms = clock.lap_ms();
+
   const Intrinsics canvas = frame.intrinsics();
   const Intrinsics sensor = sensor_intrinsics(camera, scale);
   std::vector<float> scratch = std::move(spare_buffer);
@@ -98,29 +104,21 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, std::v
 
 DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
                             const ShotParams& shot, double scale, std::string* error) {
-  DevelopResult result;
   if (std::string problem = check_frame(frame); !problem.empty()) {
     if (error != nullptr) *error = problem;
-    return result;
+    return {};
   }
-  StageClock clock;
-  std::vector<float> work = expose(camera, frame.rgb);
-  result.timings.exposure_ms = clock.lap_ms();
-  return develop(camera, frame, std::move(work), shot, scale, clock, std::move(result));
+  return develop(camera, frame, frame.rgb, shot, scale);
 }
 
 DevelopResult develop_frame(const ir::Camera& camera, LinearFrame&& frame, const ShotParams& shot,
                             double scale, std::string* error) {
-  DevelopResult result;
   if (std::string problem = check_frame(frame); !problem.empty()) {
     if (error != nullptr) *error = problem;
-    return result;
+    return {};
   }
-  StageClock clock;
-  std::vector<float> work = std::move(frame.rgb);
-  expose_in_place(camera, work);
-  result.timings.exposure_ms = clock.lap_ms();
-  return develop(camera, frame, std::move(work), shot, scale, clock, std::move(result));
+  std::vector<float> radiance = std::move(frame.rgb);
+  return develop(camera, frame, std::move(radiance), shot, scale);
 }
 
 }  // namespace rigc::dslr
