@@ -321,8 +321,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   struct LevelBuffers {
     std::vector<float> rgb, depth, out;
   };
-  thread_local std::array<LevelBuffers, kMaxCoarseLevel + 1> level_buffers;
-  std::vector<float>& half_out = level_buffers[level + 1 <= kMaxCoarseLevel ? level + 1 : 0].out;
+  // Entry k holds level k's input and output (entry 0, the canvas's, stays unused).
+  thread_local std::array<LevelBuffers, kMaxCoarseLevel + 2> level_buffers;
+  std::vector<float>& half_out = level_buffers[level + 1].out;
   if (any_coarse) {
     half.width = (w + 1) / 2;
     half.height = (h + 1) / 2;

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
-#include <memory>
 #include <optional>
 #include <ostream>
 
