@@ -1313,9 +1313,15 @@ std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene&
   const ScreenSetup setup = context.setup(request.canvas);
   std::vector<float> rgb(static_cast<size_t>(request.canvas.width) * request.canvas.height * 3,
                          0.08f);
-  // Face normals lit by a headlight, so the shape reads in the picture.
+  // Face normals lit by a headlight, so the shape reads in the picture. The view direction is
+  // the pixel's own ray: one per face (its centroid's) striped planes made of thin triangles.
+  const dslr::Intrinsics& canvas = request.canvas;
+  const Matrix3f world_from_camera_rot = context.cam_rot.transpose();
   rasterize_pixels<kSamples>(
-      setup, request.canvas, [&](int px, int py, const float*, const std::int32_t* tri) {
+      setup, canvas, [&](int px, int py, const float*, const std::int32_t* tri) {
+        const Vector3f ray(static_cast<float>((px + 0.5 - canvas.cx) / canvas.fx),
+                           static_cast<float>((py + 0.5 - canvas.cy) / canvas.fy), 1.0f);
+        const Vector3f view = (world_from_camera_rot * ray).normalized();
         Vector3f color = Vector3f::Zero();
         for (int k = 0; k < kSamples; ++k) {
           if (tri[k] < 0) {
@@ -1326,7 +1332,6 @@ std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene&
           const Vector3f a = context.world_vertex(t, 0), b = context.world_vertex(t, 1),
                          c = context.world_vertex(t, 2);
           const Vector3f normal = (b - a).cross(c - a).normalized();
-          const Vector3f view = (context.eye - (a + b + c) / 3).normalized();
           const float light = 0.35f + 0.65f * std::abs(normal.dot(view));
           const Vector3f base = t < context.object_tris && t < static_cast<int>(face_colors.size())
                                     ? face_colors[t]
@@ -1334,7 +1339,7 @@ std::vector<float> render_face_colors(const ir::Scene& scene, const StudioScene&
           color += base * light;
         }
         color /= kSamples;
-        const size_t pixel = (static_cast<size_t>(py) * request.canvas.width + px) * 3;
+        const size_t pixel = (static_cast<size_t>(py) * canvas.width + px) * 3;
         rgb[pixel] = color.x();
         rgb[pixel + 1] = color.y();
         rgb[pixel + 2] = color.z();
