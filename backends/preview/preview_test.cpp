@@ -180,11 +180,15 @@ TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
       << "still " << still << " moving " << moving << " expected blur " << expected;
 }
 
+// The paper's capture (scenes/paper-turntable.yaml): statue, speckle, soft shadows, green screen.
+ir::Scene paper_scene() {
+  return compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
+}
+
 // Lights summed once per 2 x 2 quad (the default) against every pixel: on the paper's statue,
 // with its speckle pattern, soft shadows and a green screen, the radiance must agree closely.
 TEST(Preview, QuadLightingMatchesPerPixelLighting) {
-  ir::Scene scene =
-      compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
+  const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
   FrameRequest request;
@@ -221,8 +225,7 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
 // that the canvas cuts): in the paper scene every ray meets the studio, so no depth stays
 // infinite.
 TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
-  ir::Scene scene =
-      compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
+  const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
   for (bool per_pixel : {false, true}) {
@@ -246,8 +249,7 @@ TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
 // Coverage pictures shade a plane evenly: a studio plane is split into long thin triangles (the
 // turntable's caps), and shading each with its own centroid's view direction drew stripes.
 TEST(Preview, FaceColourPicturesShadePlanesEvenly) {
-  ir::Scene scene =
-      compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
+  const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
   FrameRequest request;
