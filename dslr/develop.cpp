@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "compiler/color.h"
+#include "dslr/buffer_pool.h"
 
 namespace rigc::dslr {
 
@@ -91,7 +92,7 @@ std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
   const std::vector<std::uint16_t>& table = srgb_table(bits);
   const float last = static_cast<float>(table.size() - 1);
   const float g[3] = {float(gains[0] * last), float(gains[1] * last), float(gains[2] * last)};
-  std::vector<std::uint16_t> out(linear.size());
+  std::vector<std::uint16_t> out = take_words(linear.size());  // every value is written
   const std::size_t n = linear.size() / 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {

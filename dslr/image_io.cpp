@@ -7,6 +7,8 @@
 #include <cmath>
 #include <system_error>
 
+#include "dslr/buffer_pool.h"
+
 namespace rigc::dslr {
 
 namespace fs = std::filesystem;
@@ -93,13 +95,15 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
   }
 
   if (eight_bits) {
-    std::vector<std::uint8_t> pixels(values);
+    std::vector<std::uint8_t> pixels = take_bytes(values);  // every value is written
     const int shift = result.bits == 8 ? 0 : 1;
     for (std::size_t i = 0; i < values; ++i) {
       pixels[i] = static_cast<std::uint8_t>(shift ? (result.encoded[i] * 255u + 32767u) / 65535u
                                                   : result.encoded[i]);
     }
-    return write_atomically(path, spec, pixels.data(), error);
+    const bool written = write_atomically(path, spec, pixels.data(), error);
+    recycle(std::move(pixels));
+    return written;
   }
   return write_atomically(path, spec, result.encoded.data(), error);
 }

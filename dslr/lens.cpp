@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "dslr/buffer_pool.h"
+
 namespace rigc::dslr {
 
 Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale) {
@@ -193,8 +195,9 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
   out.rgb = std::move(storage);
   out.rgb.resize(3 * n);
   const bool has_depth = !depth_m.empty(), has_mask = !mask.empty();
-  if (has_depth) out.depth_m.resize(n);
-  if (has_mask) out.mask.resize(n);
+  // Every pixel is written below.
+  if (has_depth) out.depth_m = take_floats(n);
+  if (has_mask) out.mask = take_bytes(n);
 
   const bool distort = camera.effects.distortion && !camera.distortion.is_zero();
   const double vignetting = camera.effects.vignetting ? std::clamp(camera.vignetting, 0.0, 1.0) : 0;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <string>
 
+#include "dslr/buffer_pool.h"
 #include "dslr/develop.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
@@ -50,14 +51,11 @@ std::string check_frame(const LinearFrame& frame) {
   return {};
 }
 
-// Full-frame buffers a thread keeps between frames: a fresh 240 MB vector costs its zeroing and
-// its page faults on every shot.
-thread_local std::vector<float> spare_buffer;
-
 // The stages after the frame's checks, on `work`: the frame's radiance, copied or taken from it
-// (the frame's own rgb is not read).
-DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, std::vector<float> work,
-                      const ShotParams& shot, double scale) {
+// (the frame's own rgb is not read). `owned` (the frame itself, or null when it is the caller's):
+// its depth and mask go back to the buffer pool once the sensor grid has its own.
+DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, LinearFrame* owned,
+                      std::vector<float> work, const ShotParams& shot, double scale) {
   DevelopResult result;
   StageClock clock;
   expose_in_place(camera, work);
@@ -65,7 +63,7 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, std::v
 
   const Intrinsics canvas = frame.intrinsics();
   const Intrinsics sensor = sensor_intrinsics(camera, scale);
-  std::vector<float> scratch = std::move(spare_buffer);
+  std::vector<float> scratch = take_floats(work.size());
   if (camera.effects.depth_of_field && !frame.depth_m.empty()) {
     apply_depth_of_field(camera, shot.focus_distance_m, canvas, work, frame.depth_m, scratch);
     work.swap(scratch);
@@ -77,7 +75,11 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, std::v
 
   SensorImage image =
       warp_to_sensor(camera, sensor, canvas, work, frame.depth_m, frame.mask, std::move(scratch));
-  spare_buffer = std::move(work);
+  recycle(std::move(work));
+  if (owned != nullptr) {
+    recycle(std::move(owned->depth_m));
+    recycle(std::move(owned->mask));
+  }
   result.timings.distortion_ms = clock.lap_ms();
 
   apply_sensor(camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index);
@@ -108,7 +110,9 @@ DevelopResult develop_frame(const ir::Camera& camera, const LinearFrame& frame,
     if (error != nullptr) *error = problem;
     return {};
   }
-  return develop(camera, frame, frame.rgb, shot, scale);
+  std::vector<float> work = take_floats(frame.rgb.size());
+  std::copy(frame.rgb.begin(), frame.rgb.end(), work.begin());
+  return develop(camera, frame, nullptr, std::move(work), shot, scale);
 }
 
 DevelopResult develop_frame(const ir::Camera& camera, LinearFrame&& frame, const ShotParams& shot,
@@ -118,7 +122,7 @@ DevelopResult develop_frame(const ir::Camera& camera, LinearFrame&& frame, const
     return {};
   }
   std::vector<float> radiance = std::move(frame.rgb);
-  return develop(camera, frame, std::move(radiance), shot, scale);
+  return develop(camera, frame, &frame, std::move(radiance), shot, scale);
 }
 
 }  // namespace rigc::dslr

@@ -15,6 +15,7 @@
 #include "backends/common/manifest.h"
 #include "backends/common/run_folder.h"
 #include "backends/common/transforms_json.h"
+#include "dslr/buffer_pool.h"
 #include "dslr/exposure.h"
 #include "dslr/image_io.h"
 #include "dslr/lens.h"
@@ -200,9 +201,10 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
         render_shot(scene, studio, shot, options.scale, options.seed, &timing);
     finish_pending();
     if (manifest_failed) return 2;
-    // Only the encoded pixels and the mask are written; the rest is freed before the next shot.
-    result.linear = {};
-    result.depth_m = {};
+    // Only the encoded pixels and the mask are written; the rest goes back to the pool for the
+    // next shot.
+    dslr::recycle(std::move(result.linear));
+    dslr::recycle(std::move(result.depth_m));
     PendingWrite write;
     write.shot = &shot;
     write.key = key;
@@ -212,7 +214,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     write.outcome = std::async(
         std::launch::async,
         [&scene, &run_dir, image = write.image, mask = write.mask,
-         result = std::move(result)]() -> WriteOutcome {
+         result = std::move(result)]() mutable -> WriteOutcome {
           const auto start = Clock::now();
           WriteOutcome outcome;
           if (result.encoded.empty()) {
@@ -221,6 +223,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
             dslr::write_mask(run_dir / mask, result.mask, result.width, result.height,
                              &outcome.error);
           }
+          dslr::recycle(std::move(result.encoded));
+          dslr::recycle(std::move(result.mask));
           outcome.ms = ms_since(start);
           return outcome;
         });

@@ -9,6 +9,7 @@
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "compiler/primitives.h"
+#include "dslr/buffer_pool.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "tests/test_support.h"
@@ -244,6 +245,37 @@ TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
     for (float z : frame.depth_m) unwritten += !std::isfinite(z);
     EXPECT_EQ(unwritten, 0) << (per_pixel ? "per-pixel lighting" : "quad lighting");
   }
+}
+
+// Frames take reused buffers from the pool, whose contents are left over from another shot:
+// poisoned ones must come back fully overwritten (no NaN radiance, masks 0 or 255, depth set).
+TEST(Preview, ReusedBuffersAreFullyOverwritten) {
+  const ir::Scene scene = paper_scene();
+  const StudioScene studio = prepare_studio_scene(scene);
+  FrameRequest request;
+  request.world_from_camera = scene.shots[0].world_from_camera;
+  request.turntable_angle_rad = scene.shots[0].turntable_angle_rad;
+  request.canvas = dslr::sensor_intrinsics(scene.camera, 0.05);
+  request.canvas.width = 1201;  // odd, so that the pool's 1 MB floor holds even for the mask
+  request.canvas.height = 901;
+  request.canvas.cx = request.canvas.width / 2.0;
+  request.canvas.cy = request.canvas.height / 2.0;
+  request.shadow_map_size = 512;
+  const size_t n = static_cast<size_t>(request.canvas.width) * request.canvas.height;
+  dslr::release_pooled_buffers();
+  dslr::recycle(std::vector<float>(3 * n, std::numeric_limits<float>::quiet_NaN()));
+  dslr::recycle(std::vector<float>(n, std::numeric_limits<float>::quiet_NaN()));
+  dslr::recycle(std::vector<std::uint8_t>(n, 77));
+  ASSERT_GT(dslr::pooled_bytes(), 16 * n);
+  const dslr::LinearFrame frame = render_frame(scene, studio, request);
+  EXPECT_EQ(dslr::pooled_bytes(), 0u) << "the frame should have taken the poisoned buffers";
+  int bad_rgb = 0, bad_mask = 0, bad_depth = 0;
+  for (float v : frame.rgb) bad_rgb += !std::isfinite(v);
+  for (std::uint8_t m : frame.mask) bad_mask += m != 0 && m != 255;
+  for (float z : frame.depth_m) bad_depth += !(z > 0);
+  EXPECT_EQ(bad_rgb, 0);
+  EXPECT_EQ(bad_mask, 0);
+  EXPECT_EQ(bad_depth, 0);
 }
 
 // Coverage pictures shade a plane evenly: a studio plane is split into long thin triangles (the

@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 
+#include "dslr/buffer_pool.h"
 #include "dslr/simd.h"
 
 namespace rigc::preview {
@@ -839,9 +840,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   frame.cx = canvas.cx;
   frame.cy = canvas.cy;
   const size_t pixel_count = static_cast<size_t>(canvas.width) * canvas.height;
-  frame.rgb.assign(pixel_count * 3, 0.0f);
-  frame.depth_m.assign(pixel_count, std::numeric_limits<float>::infinity());
-  frame.mask.assign(pixel_count, 0);
+  // Reused buffers: the resolve pass writes every pixel of all three.
+  frame.rgb = dslr::take_floats(pixel_count * 3);
+  frame.depth_m = dslr::take_floats(pixel_count);
+  frame.mask = dslr::take_bytes(pixel_count);
 
   const FrameContext context(scene, studio, request);
   const Matrix3f& object_rot = context.object_rot;
@@ -1092,7 +1094,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     frame.rgb[pixel * 3 + 0] = color.x();
     frame.rgb[pixel * 3 + 1] = color.y();
     frame.rgb[pixel * 3 + 2] = color.z();
-    if (surfaces.nearest > 0) frame.depth_m[pixel] = 1 / surfaces.nearest;
+    frame.depth_m[pixel] =
+        surfaces.nearest > 0 ? 1 / surfaces.nearest : std::numeric_limits<float>::infinity();
     frame.mask[pixel] = surfaces.object_samples * 2 >= kSamples ? 255 : 0;
   };
   auto shade_pixel = [&](int px, int py, const PixelSurfaces& surfaces) {

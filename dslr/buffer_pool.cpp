@@ -1,0 +1,138 @@
+#include "dslr/buffer_pool.h"
+
+#include <algorithm>
+#include <mutex>
+#include <type_traits>
+
+namespace rigc::dslr {
+namespace {
+
+// Below this a fresh vector is cheap (glibc reuses its heap), so pooling only adds bookkeeping.
+constexpr std::size_t kMinPooledBytes = std::size_t{1} << 20;
+// About two full-resolution frames of floats plus their masks and depths: what one shot in
+// flight and one being written hold between them.
+constexpr std::size_t kMaxPooledBytes = std::size_t{800} << 20;
+
+template <typename T>
+struct Shelf {
+  std::vector<std::vector<T>> buffers;
+};
+
+struct Pool {
+  std::mutex mutex;
+  Shelf<float> floats;
+  Shelf<std::uint8_t> bytes;
+  Shelf<std::uint16_t> words;
+  std::size_t held_bytes = 0;
+
+  template <typename T>
+  Shelf<T>& shelf() {
+    if constexpr (std::is_same_v<T, float>) return floats;
+    if constexpr (std::is_same_v<T, std::uint8_t>) return bytes;
+    if constexpr (std::is_same_v<T, std::uint16_t>) return words;
+  }
+};
+
+Pool& pool() {
+  static Pool instance;
+  return instance;
+}
+
+template <typename T>
+std::size_t bytes_of(const std::vector<T>& buffer) {
+  return buffer.capacity() * sizeof(T);
+}
+
+template <typename T>
+std::vector<T> take(std::size_t size) {
+  std::vector<T> out;
+  if (size * sizeof(T) >= kMinPooledBytes) {
+    Pool& p = pool();
+    std::lock_guard lock(p.mutex);
+    auto& buffers = p.shelf<T>().buffers;
+    // The smallest buffer that holds `size` without growing.
+    auto best = buffers.end();
+    for (auto it = buffers.begin(); it != buffers.end(); ++it) {
+      if (it->capacity() >= size && (best == buffers.end() || it->capacity() < best->capacity())) {
+        best = it;
+      }
+    }
+    if (best != buffers.end()) {
+      out = std::move(*best);
+      buffers.erase(best);
+      p.held_bytes -= bytes_of(out);
+    }
+  }
+  // Only the part past the old size is written (value-initialised) here.
+  out.resize(size);
+  return out;
+}
+
+template <typename T>
+void give_back(std::vector<T>&& buffer) {
+  std::vector<T> local = std::move(buffer);
+  const std::size_t bytes = bytes_of(local);
+  if (bytes < kMinPooledBytes) return;
+  Pool& p = pool();
+  std::vector<std::vector<T>> evicted;  // freed outside the lock
+  {
+    std::lock_guard lock(p.mutex);
+    if (bytes > kMaxPooledBytes) return;
+    auto& buffers = p.shelf<T>().buffers;
+    // Room is made by dropping this type's smallest buffers first; if that is not enough the
+    // newcomer is dropped instead.
+    std::sort(buffers.begin(), buffers.end(),
+              [](const auto& a, const auto& b) { return a.capacity() > b.capacity(); });
+    while (p.held_bytes + bytes > kMaxPooledBytes && !buffers.empty()) {
+      p.held_bytes -= bytes_of(buffers.back());
+      evicted.push_back(std::move(buffers.back()));
+      buffers.pop_back();
+    }
+    if (p.held_bytes + bytes > kMaxPooledBytes) return;
+    p.held_bytes += bytes;
+    buffers.push_back(std::move(local));
+  }
+}
+
+}  // namespace
+
+std::vector<float> take_floats(std::size_t size) {
+  return take<float>(size);
+}
+std::vector<std::uint8_t> take_bytes(std::size_t size) {
+  return take<std::uint8_t>(size);
+}
+std::vector<std::uint16_t> take_words(std::size_t size) {
+  return take<std::uint16_t>(size);
+}
+void recycle(std::vector<float>&& buffer) {
+  give_back(std::move(buffer));
+}
+void recycle(std::vector<std::uint8_t>&& buffer) {
+  give_back(std::move(buffer));
+}
+void recycle(std::vector<std::uint16_t>&& buffer) {
+  give_back(std::move(buffer));
+}
+
+std::size_t pooled_bytes() {
+  Pool& p = pool();
+  std::lock_guard lock(p.mutex);
+  return p.held_bytes;
+}
+
+void release_pooled_buffers() {
+  Pool& p = pool();
+  Shelf<float> floats;
+  Shelf<std::uint8_t> bytes;
+  Shelf<std::uint16_t> words;
+  {
+    std::lock_guard lock(p.mutex);
+    std::swap(floats, p.floats);
+    std::swap(bytes, p.bytes);
+    std::swap(words, p.words);
+    p.held_bytes = 0;
+  }
+}
+
+}  // namespace rigc::dslr

@@ -1,0 +1,29 @@
+// Frame-sized buffers kept between shots. A full-resolution frame is 240 MB of floats; a fresh
+// vector of that size costs a serial memset and, since glibc hands blocks that large straight to
+// mmap, ~60 000 page faults on every shot. Buffers handed back here are reused as they are.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace rigc::dslr {
+
+// A vector of exactly `size` elements. Its contents are UNSPECIFIED (a reused buffer keeps what
+// it held): the caller writes every element it reads.
+std::vector<float> take_floats(std::size_t size);
+std::vector<std::uint8_t> take_bytes(std::size_t size);
+std::vector<std::uint16_t> take_words(std::size_t size);
+
+// Hands a buffer back for a later take_*(). Small buffers are simply freed, and the pool keeps
+// a bounded number of bytes, so it never holds more than a frame's working set.
+void recycle(std::vector<float>&& buffer);
+void recycle(std::vector<std::uint8_t>&& buffer);
+void recycle(std::vector<std::uint16_t>&& buffer);
+
+// Bytes the pool holds now (for tests and the memory report).
+std::size_t pooled_bytes();
+// Frees everything the pool holds.
+void release_pooled_buffers();
+
+}  // namespace rigc::dslr
