@@ -1,6 +1,6 @@
 // Frame-sized buffers kept between shots. A full-resolution frame is 240 MB of floats; a fresh
-// vector of that size costs a serial memset and, since glibc hands blocks that large straight to
-// mmap, ~60 000 page faults on every shot. Buffers handed back here are reused as they are.
+// vector of that size is zeroed by one thread (and, unless keep_freed_memory() holds the heap,
+// faulted in page by page) on every shot. Buffers handed back here are reused as they are.
 #pragma once
 
 #include <cstddef>

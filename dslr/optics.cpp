@@ -1,7 +1,6 @@
 #include "dslr/optics.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -44,6 +43,11 @@ constexpr double kDenseRadius = 4.5, kRingRatio = 1.3;
 // and the gather costs a sixteenth (a quarter of the pixels, a quarter of
 // the taps each). At full resolution, out-of-focus backgrounds are most of the frame.
 constexpr float kCoarseRadiusPx = 5.0f;
+// A tile whose every reachable pixel lies within this fraction of the brightest value there (per
+// channel) is copied instead of gathered: any blur of it is a weighted mean of those pixels, so it
+// moves by less than this. Smooth backdrops (a green screen) are most of a frame's big discs;
+// 0.4 % is under the sensor's shot noise at any ISO and under one 8-bit sRGB code in light tones.
+constexpr float kFlatTolerance = 0.004f;
 
 struct TapSet {
   // Sorted by distance; structure of arrays for the gather loop.
@@ -241,26 +245,44 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // The radius falls towards the focus distance and grows away from it on both sides, so a
   // tile's depth range gives its smallest and largest disc without a radius per pixel.
   std::vector<float> tile_near(tile_max.size()), tile_far(tile_max.size());
+  // Each tile's smallest and largest value per channel (3 + 3 per tile), for the flat test.
+  std::vector<float> tile_range(6 * tile_max.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     const float inf = std::numeric_limits<float>::infinity();
-    std::vector<float> near(tiles_x), far(tiles_x);
+    std::vector<float> near(tiles_x), far(tiles_x), range(6 * tiles_x);
     for (int ty = r.begin(); ty < r.end(); ++ty) {
       std::fill(near.begin(), near.end(), inf);
       std::fill(far.begin(), far.end(), 0.0f);
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        std::fill_n(&range[6 * tx], 3, inf);
+        std::fill_n(&range[6 * tx + 3], 3, -inf);
+      }
       for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
         const float* row = &depth_m[static_cast<std::size_t>(y) * w];
+        const float* colour = &rgb[3 * static_cast<std::size_t>(y) * w];
         for (int tx = 0; tx < tiles_x; ++tx) {
           float lo = near[tx], hi = far[tx];
+          float c_lo[3] = {range[6 * tx], range[6 * tx + 1], range[6 * tx + 2]};
+          float c_hi[3] = {range[6 * tx + 3], range[6 * tx + 4], range[6 * tx + 5]};
           for (int x = tx * kTile; x < std::min(w, (tx + 1) * kTile); ++x) {
             const float z = row[x] > 0 ? row[x] : inf;  // unknown depth: background
             lo = std::min(lo, z);
             hi = std::max(hi, z);
+            for (int c = 0; c < 3; ++c) {
+              c_lo[c] = std::min(c_lo[c], colour[3 * x + c]);
+              c_hi[c] = std::max(c_hi[c], colour[3 * x + c]);
+            }
           }
           near[tx] = lo, far[tx] = hi;
+          for (int c = 0; c < 3; ++c) {
+            range[6 * tx + c] = c_lo[c];
+            range[6 * tx + 3 + c] = c_hi[c];
+          }
         }
       }
       for (int tx = 0; tx < tiles_x; ++tx) {
         const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        std::copy_n(&range[6 * tx], 6, &tile_range[6 * t]);
         tile_near[t] = near[tx];
         tile_far[t] = far[tx];
         const float r_near = radius_at(near[tx]), r_far = radius_at(far[tx]);
@@ -294,6 +316,36 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     std::copy(rgb.begin(), rgb.end(), out.begin());
     return;
   }
+
+  // Flat tiles: every pixel a tap of theirs can reach is within kFlatTolerance of the others,
+  // so the gather could not change them beyond that. They keep their values (reach 0.5).
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
+    for (int ty = r.begin(); ty < r.end(); ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        if (reach[t] <= 0.5f || !active(t)) continue;
+        const int span = static_cast<int>(std::ceil((reach[t] + 1) / kTile));
+        float lo[3], hi[3];
+        for (int c = 0; c < 3; ++c) {
+          lo[c] = tile_range[6 * t + c];
+          hi[c] = tile_range[6 * t + 3 + c];
+        }
+        for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
+          for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
+            const float* source = &tile_range[6 * (static_cast<std::size_t>(sy) * tiles_x + sx)];
+            for (int c = 0; c < 3; ++c) {
+              lo[c] = std::min(lo[c], source[c]);
+              hi[c] = std::max(hi[c], source[3 + c]);
+            }
+          }
+        }
+        const float peak = std::max({hi[0], hi[1], hi[2]});
+        bool flat = peak > 0;
+        for (int c = 0; c < 3; ++c) flat = flat && hi[c] - lo[c] <= kFlatTolerance * peak;
+        if (flat) reach[t] = 0.5f;
+      }
+    }
+  });
 
   // Coarse tiles: every pixel whose disc can reach them (and they themselves) blur by
   // kCoarseRadiusPx or more. Their result comes from the same gather on a half-size frame.
@@ -373,21 +425,43 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   }
   // Bilinear from the half-size result: full pixel centre x + 0.5 sits at half x (x + 0.5) / 2.
   auto upsample_tile = [&](int x0, int x1, int y0, int y1) {
+    // Each column's two half-size neighbours and weight, the same on every row of the tile.
+    std::array<int, kTile> column;
+    std::array<float, kTile> column_weight;
+    for (int x = x0; x < x1; ++x) {
+      const float hx = std::clamp((x + 0.5f) / 2 - 0.5f, 0.0f, half.width - 1.0f);
+      column[x - x0] = std::min(static_cast<int>(hx), half.width - 2);
+      column_weight[x - x0] = hx - column[x - x0];
+    }
+    const int first = column[0], count = column[x1 - 1 - x0] + 2 - first;
+    // A whole tile away from the frame's edges: its columns follow the fixed pattern below.
+    const bool interior = x1 - x0 == kTile && x0 >= 2 && first == x0 / 2 - 1 &&
+                          column[kTile - 1] == x0 / 2 + kTile / 2 - 1 && count == kTile / 2 + 2;
+    std::array<float, 3 * (kTile / 2 + 3)> blended;  // this row's vertical blend, from `first`
     for (int y = y0; y < y1; ++y) {
       const float hy = std::clamp((y + 0.5f) / 2 - 0.5f, 0.0f, half.height - 1.0f);
       const int iy = std::min(static_cast<int>(hy), half.height - 2);
       const float fy = hy - iy;
-      for (int x = x0; x < x1; ++x) {
-        const float hx = std::clamp((x + 0.5f) / 2 - 0.5f, 0.0f, half.width - 1.0f);
-        const int ix = std::min(static_cast<int>(hx), half.width - 2);
-        const float fx = hx - ix;
-        const float* a = &half_out[3 * (static_cast<std::size_t>(iy) * half.width + ix)];
-        const float* b = a + 3 * static_cast<std::size_t>(half.width);
-        float* dst = &out[3 * (static_cast<std::size_t>(y) * w + x)];
-        for (int c = 0; c < 3; ++c) {
-          dst[c] =
-              (1 - fy) * ((1 - fx) * a[c] + fx * a[3 + c]) + fy * ((1 - fx) * b[c] + fx * b[3 + c]);
+      const float* a = &half_out[3 * (static_cast<std::size_t>(iy) * half.width + first)];
+      const float* b = a + 3 * static_cast<std::size_t>(half.width);
+      for (int k = 0; k < 3 * count; ++k) blended[k] = a[k] + fy * (b[k] - a[k]);
+      float* dst = &out[3 * (static_cast<std::size_t>(y) * w + x0)];
+      if (interior) {
+        // Pixel x0 + 2k sits a quarter of a half pixel left of half pixel x0/2 + k, pixel
+        // x0 + 2k + 1 a quarter right: fixed weights, no per-pixel lookups.
+        for (int k = 0; k < kTile / 2; ++k) {
+          const float* v = &blended[3 * k];
+          for (int c = 0; c < 3; ++c) {
+            dst[6 * k + c] = 0.25f * v[c] + 0.75f * v[3 + c];
+            dst[6 * k + 3 + c] = 0.75f * v[3 + c] + 0.25f * v[6 + c];
+          }
         }
+        continue;
+      }
+      for (int x = 0; x < x1 - x0; ++x) {
+        const float* v = &blended[3 * (column[x] - first)];
+        const float fx = column_weight[x];
+        for (int c = 0; c < 3; ++c) dst[3 * x + c] = v[c] + fx * (v[3 + c] - v[c]);
       }
     }
   };
@@ -408,10 +482,11 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   const int strip_rows = std::max(2 * kTile, (4 * pad + kTile - 1) / kTile * kTile);
   const int strips = (h + strip_rows - 1) / strip_rows;
   const float inf = std::numeric_limits<float>::infinity();
-  tbb::enumerable_thread_specific<Planes> scratch;
+  // Each thread's strip planes, kept between frames.
+  thread_local Planes thread_planes;
 
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& r) {
-    Planes& pl = scratch.local();
+    Planes& pl = thread_planes;
     GroupSums sums;
     for (int strip = r.begin(); strip < r.end(); ++strip) {
       const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
@@ -448,10 +523,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       const int plane_rows = sy1 - sy0 + 2 * pad;
       const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
       for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
-        plane->resize(size);
+        if (plane->size() < size) plane->resize(size);
       }
-      // Padding (rows outside the image, columns left and right of it) holds no energy and
-      // sits in front of everything; the image's own pixels are all written below.
+      // Only the columns the gathered tiles' taps read are filled: their tiles' span widened
+      // by the padding (the rest of the planes is never read).
+      int span_x0 = w, span_x1 = 0;
+      for (int ty = ty0; ty < ty1; ++ty) {
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+          if (!active(t) || coarse[t] || reach[t] <= 0.5f) continue;
+          span_x0 = std::min(span_x0, tx * kTile);
+          span_x1 = std::max(span_x1, (tx + 1) * kTile);
+        }
+      }
+      const int fill_x0 = std::max(-pad, span_x0 - pad);
+      const int fill_x1 = std::min(w + pad + kTile, span_x1 + pad);
+      // Padding (outside the image) holds no energy and sits in front of everything.
       auto clear_span = [&](std::size_t begin, std::size_t end) {
         for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.inv_area}) {
           std::fill(plane->begin() + begin, plane->begin() + end, 0.0f);
@@ -459,28 +546,31 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         std::fill(pl.z.begin() + begin, pl.z.begin() + end, -inf);
         std::fill(pl.radius.begin() + begin, pl.radius.begin() + end, 0.5f);
       };
-      const int image_row0 = std::max(0, sy0 - pad), image_row1 = std::min(h, sy1 + pad);
-      for (int row = 0; row < plane_rows; ++row) {
-        const int y = sy0 - pad + row;
-        const std::size_t begin = static_cast<std::size_t>(row) * pl.stride;
-        if (y < image_row0 || y >= image_row1) {
-          clear_span(begin, begin + pl.stride);
-        } else {
-          clear_span(begin, begin + pad);
-          clear_span(begin + pad + w, begin + pl.stride);
+      for (int y = sy0 - pad; y < sy1 + pad; ++y) {
+        const std::size_t row_begin = pl.index(0, y);  // x = 0 of this row in the planes
+        if (y < 0 || y >= h) {
+          clear_span(row_begin + fill_x0, row_begin + fill_x1);
+          continue;
         }
-      }
-      for (int y = image_row0; y < image_row1; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t p = static_cast<std::size_t>(y) * w + x, i = pl.index(x, y);
+        if (fill_x0 < 0) clear_span(row_begin + fill_x0, row_begin);
+        if (fill_x1 > w) clear_span(row_begin + w, row_begin + fill_x1);
+        const std::size_t image_row = static_cast<std::size_t>(y) * w;
+        float* r = &pl.r[row_begin];
+        float* g = &pl.g[row_begin];
+        float* b = &pl.b[row_begin];
+        float* zs = &pl.z[row_begin];
+        float* radii = &pl.radius[row_begin];
+        float* inv_area = &pl.inv_area[row_begin];
+        for (int x = std::max(0, fill_x0); x < std::min(w, fill_x1); ++x) {
+          const std::size_t p = image_row + x;
           const float z = depth_m[p] > 0 ? depth_m[p] : inf;
           const float radius = radius_at(z);
-          pl.r[i] = rgb[3 * p];
-          pl.g[i] = rgb[3 * p + 1];
-          pl.b[i] = rgb[3 * p + 2];
-          pl.z[i] = z;
-          pl.radius[i] = radius;
-          pl.inv_area[i] = 1 / (std::numbers::pi_v<float> * radius * radius);
+          r[x] = rgb[3 * p];
+          g[x] = rgb[3 * p + 1];
+          b[x] = rgb[3 * p + 2];
+          zs[x] = z;
+          radii[x] = radius;
+          inv_area[x] = 1 / (std::numbers::pi_v<float> * radius * radius);
         }
       }
       for (int ty = ty0; ty < ty1; ++ty) {

@@ -163,6 +163,45 @@ TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {
   }
 }
 
+// Tiles whose whole neighbourhood is flat are copied rather than gathered. A faint texture (2 %
+// stripes) on a far backdrop must still be blurred, and a smooth ramp, which a blur leaves as it
+// is, must stay within the flat tolerance of itself.
+TEST(DslrDepthOfField, FaintTextureIsBlurredAndSmoothRampsKeepTheirValues) {
+  ir::Camera camera = canon_6d();
+  camera.aperture_f_number = 2.8;
+  camera.effects.depth_of_field = true;
+  const Intrinsics canvas = sensor_intrinsics(camera, 0.25);
+  LinearFrame striped = flat_frame(canvas, 0, 3.0f), ramp = flat_frame(canvas, 0, 3.0f);
+  const int w = canvas.width, h = canvas.height;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x);
+      for (int c = 0; c < 3; ++c) {
+        striped.rgb[p + c] = 500 * (1 + 0.02f * ((x / 4) % 2));
+        ramp.rgb[p + c] = 500 + 0.1f * x + 0.05f * y;  // 0.02 % of the value per pixel
+      }
+    }
+  }
+  std::vector<float> out;
+  apply_depth_of_field(camera, kFocus, canvas, striped.rgb, striped.depth_m, out);
+  double lo = 1e9, hi = 0;
+  for (int x = w / 2; x < w / 2 + 16; ++x) {
+    const float v = out[3 * (static_cast<std::size_t>(h / 2) * w + x)];
+    lo = std::min<double>(lo, v);
+    hi = std::max<double>(hi, v);
+  }
+  EXPECT_LT(hi - lo, 0.2 * 0.02 * 500) << "the stripes' 2 % contrast should mostly blur away";
+  apply_depth_of_field(camera, kFocus, canvas, ramp.rgb, ramp.depth_m, out);
+  double worst = 0;
+  for (int y = h / 4; y < 3 * h / 4; ++y) {
+    for (int x = w / 4; x < 3 * w / 4; ++x) {
+      const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x);
+      worst = std::max(worst, std::abs(out[p] - ramp.rgb[p]) / double(ramp.rgb[p]));
+    }
+  }
+  EXPECT_LT(worst, 0.004);
+}
+
 TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
   ir::Camera camera = canon_6d();
   camera.aperture_f_number = 2.8;

@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <mutex>
 #include <numbers>
 
 #include "compiler/hash.h"
@@ -94,8 +96,9 @@ std::uint64_t stream_key(std::uint64_t seed, std::uint64_t stream) {
 // Read noise and shot noise share the shot-normal stream (two 16-bit halves of one hash).
 enum Stream : std::uint64_t { kPrnuDsnu = 1, kShotNormal = 3, kShotUniform = 4 };
 
-// Below this mean the Gaussian approximation of the Poisson law is visibly skewed.
-constexpr double kExactPoissonBelow = 30;
+// Below this mean even the skew-corrected Gaussian (see apply_sensor) departs from the Poisson
+// law: its discreteness and its mass at zero matter there.
+constexpr double kExactPoissonBelow = 12;
 
 constexpr int kNoiseLanes = 8;
 using simd::F32x8;
@@ -137,6 +140,59 @@ inline F32x8 exp_negative8(F32x8 x) {
   return poly * scale;
 }
 
+// The camera's fixed pattern (PRNU and DSNU normals per value) as signed bytes, z·32 (|z| below
+// 4): the same in every shot, so it is drawn once per run instead of two table gathers per value
+// and shot. One pattern is kept: a run has one camera and one resolution.
+constexpr float kPatternStep = 1.0f / 32;
+
+struct FixedPattern {
+  std::uint32_t key = 0;
+  std::size_t values = 0;
+  std::vector<std::int8_t> prnu, dsnu;  // padded to a multiple of kNoiseLanes
+};
+
+std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t values,
+                                                  const float* table) {
+  static std::mutex mutex;
+  static std::shared_ptr<const FixedPattern> kept;
+  std::lock_guard lock(mutex);
+  if (kept && kept->key == key && kept->values == values) return kept;
+  kept.reset();  // freed before the new one is drawn
+  auto pattern = std::make_shared<FixedPattern>();
+  pattern->key = key;
+  pattern->values = values;
+  const std::size_t groups = (values + kNoiseLanes - 1) / kNoiseLanes;
+  pattern->prnu.resize(groups * kNoiseLanes);
+  pattern->dsnu.resize(groups * kNoiseLanes);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, groups, 4096),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t group = range.begin(); group < range.end(); ++group) {
+          const std::size_t first = group * kNoiseLanes;
+          const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
+          const U32x8 bits = lowbias32(index ^ key);
+          const F32x8 prnu = lookup(table, bits & 0xFFFF) / kPatternStep;
+          const F32x8 dsnu = lookup(table, bits >> 16) / kPatternStep;
+          for (int k = 0; k < kNoiseLanes; ++k) {
+            pattern->prnu[first + k] =
+                static_cast<std::int8_t>(std::clamp(std::lround(prnu[k]), -127l, 127l));
+            pattern->dsnu[first + k] =
+                static_cast<std::int8_t>(std::clamp(std::lround(dsnu[k]), -127l, 127l));
+          }
+        }
+      });
+  kept = std::move(pattern);
+  return kept;
+}
+
+using I8x8 = std::int8_t __attribute__((vector_size(8)));
+
+inline F32x8 load_pattern(const std::int8_t* p) {
+  I8x8 bytes;
+  std::memcpy(&bytes, p, sizeof(bytes));
+  return __builtin_convertvector(bytes, F32x8) * kPatternStep;
+}
+
 }  // namespace
 
 std::uint64_t hash64(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
@@ -174,13 +230,19 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
   const std::uint64_t shot_key = stream_key(shot_seed, kShotNormal);
   const std::uint64_t uniform_key = stream_key(shot_seed, kShotUniform);
 
-  // Per value (pixel p, channel c: value 3p + c) four normals: PRNU and DSNU from the camera's
-  // fixed stream, read and shot noise from the shot's. A 32-bit hash of the value's index gives
-  // two 16-bit table indices, and eight values go through together (one 8-lane register).
+  // Per value (pixel p, channel c: value 3p + c): PRNU and DSNU from the camera's fixed pattern,
+  // and one normal from the shot's stream for shot and read noise together: the sum of two
+  // independent normals of variances mean and read² is one normal of variance mean + read².
+  // A 32-bit hash of the value's index gives the table index, and eight values go through
+  // together (one 8-lane register).
   const std::uint32_t fixed_key32 = static_cast<std::uint32_t>(fixed_key ^ (fixed_key >> 32));
   const std::uint32_t shot_key32 = static_cast<std::uint32_t>(shot_key ^ (shot_key >> 32));
   const std::size_t values = 3 * pixels;
   const float* table = normal.data();
+  const std::shared_ptr<const FixedPattern> pattern = fixed_pattern(fixed_key32, values, table);
+  const std::int8_t* prnu_pattern = pattern->prnu.data();
+  const std::int8_t* dsnu_pattern = pattern->dsnu.data();
+  const float read_variance = read_f * read_f;
   // Below kExactPoissonBelow electrons the Gaussian stands in badly: those values take an
   // exact Poisson draw.
   const std::uint32_t uniform_key32 = static_cast<std::uint32_t>(uniform_key ^ (uniform_key >> 32));
@@ -191,12 +253,10 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           const std::size_t first = group * kNoiseLanes;
           const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
           const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
-          const U32x8 fixed_bits = lowbias32(index ^ fixed_key32);
           const U32x8 shot_bits = lowbias32(index ^ shot_key32);
-          const F32x8 prnu = lookup(table, fixed_bits & 0xFFFF);
-          const F32x8 dsnu = lookup(table, fixed_bits >> 16);
-          const F32x8 read = lookup(table, shot_bits & 0xFFFF);
-          const F32x8 shot = lookup(table, shot_bits >> 16);
+          const F32x8 prnu = load_pattern(prnu_pattern + first);
+          const F32x8 dsnu = load_pattern(dsnu_pattern + first);
+          const F32x8 temporal = lookup(table, shot_bits & 0xFFFF);
           float* v = signal.data() + first;
           F32x8 x = {};
           if (count == kNoiseLanes) {
@@ -208,24 +268,29 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
           mean = (mean > zero ? mean : zero) + dark_f;
           const I32x8 small = mean < static_cast<float>(kExactPoissonBelow);
-          F32x8 photons = mean + simd::sqrt(mean) * shot;
+          // Cornish-Fisher: the Poisson part's third cumulant (= mean) gives the sum a skew,
+          // mean / (6 s²)·(z² - 1) with s² = mean + read², which a plain Gaussian lacks.
+          const F32x8 variance = mean + read_variance;
+          const F32x8 skew = mean / (6 * variance);
+          F32x8 electrons =
+              mean + simd::sqrt(variance) * temporal + skew * (temporal * temporal - 1);
           if (simd::any(small)) {
             // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
-            // all lanes at once, from a third hash as the uniform.
+            // all lanes at once, from a second hash as the uniform, plus the read noise.
             const U32x8 uniform_bits = lowbias32(index ^ uniform_key32);
             const F32x8 u = __builtin_convertvector(uniform_bits >> 8, F32x8) * 0x1.0p-24f;
             const F32x8 clamped_mean = small ? mean : zero;
             F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;
             I32x8 going = small & (u > cumulative);
             for (int step = 1; step <= 200 && simd::any(going); ++step) {
-              p = p * clamped_mean / static_cast<float>(step);
+              p = p * clamped_mean * (1.0f / static_cast<float>(step));
               cumulative += p;
               k = going ? k + 1.0f : k;
               going = going & (u > cumulative);
             }
-            photons = small ? k : photons;
+            electrons = small ? k + read_f * temporal : electrons;
           }
-          const F32x8 electrons = photons + read_f * read + dsnu_f * dsnu;
+          electrons += dsnu_f * dsnu;
           F32x8 dn = simd::floor(electrons * dn_per_e + 0.5f);
           dn = dn < dn_low ? F32x8{} + dn_low : dn;
           dn = dn > dn_high ? F32x8{} + dn_high : dn;

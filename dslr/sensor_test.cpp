@@ -103,6 +103,31 @@ TEST(DslrNoise, SmallSignalsArePoisson) {
   EXPECT_NEAR(static_cast<double>(zeros) / linear.size(), std::exp(-5.0), 0.002);
 }
 
+TEST(DslrNoise, ModerateSignalsKeepThePoissonSkew) {
+  // 20 electrons: drawn from a skew-corrected Gaussian, whose variance and third moment must
+  // still be the Poisson law's (mean 20, variance 20, skewness 1/sqrt(20) = 0.224).
+  ir::Camera camera = noisy_6d(6400);
+  camera.noise.read_noise_high_iso_e = 0.01;
+  camera.noise.prnu = 0;
+  camera.noise.dsnu_e = 0;
+  const double fwc = 79546.0 / 64;
+  const std::vector<float> linear = flat_patch(camera, 20 / fwc).linear;
+  double sum = 0, sum2 = 0, sum3 = 0;
+  for (float v : linear) sum += v * fwc;
+  const double mean = sum / linear.size();
+  for (float v : linear) {
+    const double d = v * fwc - mean;
+    sum2 += d * d;
+    sum3 += d * d * d;
+  }
+  const double variance = sum2 / linear.size();
+  const double skewness = sum3 / linear.size() / std::pow(variance, 1.5);
+  EXPECT_NEAR(mean, 20, 0.1);
+  // The ADC's steps (0.3 electrons here) add 1/12 of a step squared.
+  EXPECT_NEAR(variance, 20, 0.6);
+  EXPECT_NEAR(skewness, 1 / std::sqrt(20.0), 0.04);
+}
+
 TEST(DslrNoise, ClipsAtFullWell) {
   const DevelopResult r = flat_patch(noisy_6d(100), 3.0);
   for (float v : r.linear) ASSERT_EQ(v, 1.0f);

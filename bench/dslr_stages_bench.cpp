@@ -1,0 +1,160 @@
+// Each stage of a full-resolution preview shot on its own (Google Benchmark), on a real frame of
+// the paper scene: where the issue #3 budget (10 s for 18 shots at 5472 x 3648) goes.
+// Usage: dslr_stages_bench [--scale F] [benchmark flags]   (default scale 1: full resolution)
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "backends/common/allocator.h"
+#include "backends/preview/rasterizer.h"
+#include "backends/preview/studio_scene.h"
+#include "compiler/frontend.h"
+#include "dslr/buffer_pool.h"
+#include "dslr/develop.h"
+#include "dslr/exposure.h"
+#include "dslr/lens.h"
+#include "dslr/optics.h"
+#include "dslr/sensor.h"
+
+namespace {
+
+double g_scale = 1.0;
+
+struct Fixture {
+  rigc::ir::Scene scene;
+  rigc::preview::StudioScene studio;
+  rigc::preview::FrameRequest request;
+  rigc::dslr::LinearFrame frame;  // radiance after exposure
+  rigc::dslr::Intrinsics sensor;
+};
+
+Fixture& fixture() {
+  static Fixture f = [] {
+    Fixture out;
+    std::ifstream in("scenes/paper-turntable.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    rigc::DiagnosticEngine diag;
+    auto scene =
+        rigc::compile_scene_text(text.str(), "scenes/paper-turntable.yaml", "scenes", diag);
+    if (!scene) std::exit(1);
+    out.scene = *scene;
+    out.studio = rigc::preview::prepare_studio_scene(out.scene);
+    const auto& shot = out.scene.shots[3];
+    out.request.world_from_camera = shot.world_from_camera;
+    out.request.turntable_angle_rad = shot.turntable_angle_rad;
+    const auto geometry = rigc::dslr::render_geometry_for(out.scene.camera, g_scale);
+    out.request.canvas = geometry;
+    out.request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);
+    out.frame = rigc::preview::render_frame(out.scene, out.studio, out.request);
+    rigc::dslr::expose_in_place(out.scene.camera, out.frame.rgb);
+    out.sensor = rigc::dslr::sensor_intrinsics(out.scene.camera, g_scale);
+    return out;
+  }();
+  return f;
+}
+
+void BM_RenderFrame(benchmark::State& state) {
+  Fixture& f = fixture();
+  rigc::preview::RasterTimings timings;
+  for (auto _ : state) {
+    rigc::dslr::LinearFrame frame =
+        rigc::preview::render_frame(f.scene, f.studio, f.request, &timings);
+    benchmark::DoNotOptimize(frame.rgb.data());
+    rigc::dslr::recycle(std::move(frame.rgb));
+    rigc::dslr::recycle(std::move(frame.depth_m));
+    rigc::dslr::recycle(std::move(frame.mask));
+  }
+  state.counters["shadow_ms"] = timings.shadow_ms;
+  state.counters["setup_ms"] = timings.setup_ms;
+  state.counters["raster_ms"] = timings.raster_ms;
+}
+
+void BM_Exposure(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> work = f.frame.rgb;
+  for (auto _ : state) rigc::dslr::expose_in_place(f.scene.camera, work);
+}
+
+void BM_DepthOfField(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> out(f.frame.rgb.size());
+  const double focus = f.scene.shots[3].focus_distance_m;
+  for (auto _ : state) {
+    rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
+                                     f.frame.depth_m, out);
+  }
+}
+
+void BM_Diffraction(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> work = f.frame.rgb, scratch(work.size());
+  for (auto _ : state) {
+    rigc::dslr::apply_diffraction(f.scene.camera, f.frame.intrinsics(), work, scratch);
+  }
+}
+
+void BM_DistortionVignetting(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> storage(f.frame.rgb.size());
+  for (auto _ : state) {
+    auto image =
+        rigc::dslr::warp_to_sensor(f.scene.camera, f.sensor, f.frame.intrinsics(), f.frame.rgb,
+                                   f.frame.depth_m, f.frame.mask, std::move(storage));
+    storage = std::move(image.rgb);
+    rigc::dslr::recycle(std::move(image.depth_m));
+    rigc::dslr::recycle(std::move(image.mask));
+  }
+}
+
+void BM_SensorNoise(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> work(3 * static_cast<size_t>(f.sensor.width) * f.sensor.height);
+  std::copy_n(f.frame.rgb.begin(), work.size(), work.begin());
+  int shot = 0;
+  for (auto _ : state) {
+    rigc::dslr::apply_sensor(f.scene.camera, f.sensor.width, f.sensor.height, work, 7, ++shot);
+  }
+}
+
+void BM_WhiteBalanceAndEncode(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> linear(3 * static_cast<size_t>(f.sensor.width) * f.sensor.height);
+  std::copy_n(f.frame.rgb.begin(), linear.size(), linear.begin());
+  std::vector<std::uint8_t> mask(linear.size() / 3);
+  std::copy_n(f.frame.mask.begin(), mask.size(), mask.begin());
+  for (auto _ : state) {
+    const auto gains = rigc::dslr::white_balance_gains(f.scene.camera, linear, mask);
+    auto encoded = rigc::dslr::encode_srgb(linear, gains, 8);
+    benchmark::DoNotOptimize(encoded.data());
+    rigc::dslr::recycle(std::move(encoded));
+  }
+}
+
+BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Exposure)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DepthOfField)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Diffraction)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DistortionVignetting)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SensorNoise)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_WhiteBalanceAndEncode)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  rigc::keep_freed_memory();
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (!std::strcmp(argv[i], "--scale")) {
+      g_scale = std::atof(argv[i + 1]);
+      for (int j = i; j + 2 <= argc; ++j) argv[j] = argv[j + 2];
+      argc -= 2;
+      break;
+    }
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  return 0;
+}
