@@ -1,6 +1,9 @@
 #include "dslr/buffer_pool.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <mutex>
 #include <type_traits>
 
@@ -43,6 +46,28 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
   return buffer.capacity() * sizeof(T);
 }
 
+// Asks the kernel to back [data, data + bytes) with huge pages where it can (THP in "madvise"
+// mode, Debian's default); a hint only, so a refusal changes nothing but speed.
+void advise_huge_pages(const void* data, std::size_t bytes) {
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+  const std::uintptr_t begin =
+      (reinterpret_cast<std::uintptr_t>(data) + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHugePage - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
+template <typename T>
+void resize_huge(std::vector<T>& buffer, std::size_t size) {
+  if (size > buffer.capacity() && size * sizeof(T) >= kMinPooledBytes) {
+    std::vector<T> bigger;
+    bigger.reserve(size);  // allocated, not yet touched: the advice applies to its first faults
+    advise_huge_pages(bigger.data(), size * sizeof(T));
+    bigger.assign(buffer.begin(), buffer.end());
+    buffer.swap(bigger);
+  }
+  buffer.resize(size);
+}
+
 template <typename T>
 std::vector<T> take(std::size_t size) {
   std::vector<T> out;
@@ -64,7 +89,7 @@ std::vector<T> take(std::size_t size) {
     }
   }
   // Only the part past the old size is written (value-initialised) here.
-  out.resize(size);
+  resize_huge(out, size);
   return out;
 }
 
@@ -113,6 +138,19 @@ void recycle(std::vector<std::uint8_t>&& buffer) {
 }
 void recycle(std::vector<std::uint16_t>&& buffer) {
   give_back(std::move(buffer));
+}
+
+void resize_frame_buffer(std::vector<float>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
+}
+void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
+}
+void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
+}
+void resize_frame_buffer(std::vector<std::uint16_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
 }
 
 std::size_t pooled_bytes() {

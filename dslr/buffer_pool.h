@@ -21,6 +21,13 @@ void recycle(std::vector<float>&& buffer);
 void recycle(std::vector<std::uint8_t>&& buffer);
 void recycle(std::vector<std::uint16_t>&& buffer);
 
+// Resizes `buffer` to `size`; new memory is asked for in transparent huge pages (2 MB), so a
+// first frame faults in 120 pages instead of 60 000 per 240 MB. Existing values are kept.
+void resize_frame_buffer(std::vector<float>& buffer, std::size_t size);
+void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size);
+void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size);
+void resize_frame_buffer(std::vector<std::uint16_t>& buffer, std::size_t size);
+
 // Bytes the pool holds now (for tests and the memory report).
 std::size_t pooled_bytes();
 // Frees everything the pool holds.

@@ -10,6 +10,8 @@
 #include <limits>
 #include <numbers>
 
+#include "dslr/buffer_pool.h"
+
 // The 32-byte vectors of the gather are only passed between functions inlined into the AVX2 and
 // the default clone of one function, so GCC's note on their ABI without AVX does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -215,7 +217,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                     std::vector<float>& out, int level, const std::vector<char>* needed_tiles) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
-  out.resize(rgb.size());
+  resize_frame_buffer(out, rgb.size());
   const double f = camera.focal_length_m, f_number = camera.aperture_f_number;
   if (depth_m.size() != n || !(focus_distance_m > f) || !(f > 0)) {
     std::copy(rgb.begin(), rgb.end(), out.begin());
@@ -385,8 +387,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     half.cy = canvas.cy / 2;
     std::vector<float>& half_rgb = level_buffers[level + 1].rgb;
     std::vector<float>& half_depth = level_buffers[level + 1].depth;
-    half_rgb.resize(3 * static_cast<std::size_t>(half.width) * half.height);
-    half_depth.resize(static_cast<std::size_t>(half.width) * half.height);
+    resize_frame_buffer(half_rgb, 3 * static_cast<std::size_t>(half.width) * half.height);
+    resize_frame_buffer(half_depth, static_cast<std::size_t>(half.width) * half.height);
     tbb::parallel_for(0, half.height, [&](int hy) {
       for (int hx = 0; hx < half.width; ++hx) {
         float sum[3] = {0, 0, 0}, nearest = std::numeric_limits<float>::infinity();
@@ -523,7 +525,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       const int plane_rows = sy1 - sy0 + 2 * pad;
       const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
       for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
-        if (plane->size() < size) plane->resize(size);
+        if (plane->size() < size) resize_frame_buffer(*plane, size);
       }
       // Only the columns the gathered tiles' taps read are filled: their tiles' span widened
       // by the padding (the rest of the planes is never read).

@@ -16,6 +16,7 @@
 #include <numbers>
 
 #include "compiler/hash.h"
+#include "dslr/buffer_pool.h"
 #include "dslr/simd.h"
 
 namespace rigc::dslr {
@@ -144,6 +145,7 @@ inline F32x8 exp_negative8(F32x8 x) {
 // 4): the same in every shot, so it is drawn once per run instead of two table gathers per value
 // and shot. One pattern is kept: a run has one camera and one resolution.
 constexpr float kPatternStep = 1.0f / 32;
+using I8x8 = std::int8_t __attribute__((vector_size(8)));
 
 struct FixedPattern {
   std::uint32_t key = 0;
@@ -162,30 +164,30 @@ std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t
   pattern->key = key;
   pattern->values = values;
   const std::size_t groups = (values + kNoiseLanes - 1) / kNoiseLanes;
-  pattern->prnu.resize(groups * kNoiseLanes);
-  pattern->dsnu.resize(groups * kNoiseLanes);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, groups, 4096),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t group = range.begin(); group < range.end(); ++group) {
-          const std::size_t first = group * kNoiseLanes;
-          const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
-          const U32x8 bits = lowbias32(index ^ key);
-          const F32x8 prnu = lookup(table, bits & 0xFFFF) / kPatternStep;
-          const F32x8 dsnu = lookup(table, bits >> 16) / kPatternStep;
-          for (int k = 0; k < kNoiseLanes; ++k) {
-            pattern->prnu[first + k] =
-                static_cast<std::int8_t>(std::clamp(std::lround(prnu[k]), -127l, 127l));
-            pattern->dsnu[first + k] =
-                static_cast<std::int8_t>(std::clamp(std::lround(dsnu[k]), -127l, 127l));
-          }
-        }
-      });
+  resize_frame_buffer(pattern->prnu, groups * kNoiseLanes);
+  resize_frame_buffer(pattern->dsnu, groups * kNoiseLanes);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t group = range.begin(); group < range.end(); ++group) {
+                        const std::size_t first = group * kNoiseLanes;
+                        const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
+                        const U32x8 bits = lowbias32(index ^ key);
+                        auto quantise = [](F32x8 z) {
+                          F32x8 steps = simd::floor(z * (1 / kPatternStep) + 0.5f);
+                          steps = steps < -127.0f ? F32x8{} - 127.0f : steps;
+                          steps = steps > 127.0f ? F32x8{} + 127.0f : steps;
+                          return __builtin_convertvector(__builtin_convertvector(steps, I32x8),
+                                                         I8x8);
+                        };
+                        const I8x8 prnu = quantise(lookup(table, bits & 0xFFFF));
+                        const I8x8 dsnu = quantise(lookup(table, bits >> 16));
+                        std::memcpy(&pattern->prnu[first], &prnu, sizeof(prnu));
+                        std::memcpy(&pattern->dsnu[first], &dsnu, sizeof(dsnu));
+                      }
+                    });
   kept = std::move(pattern);
   return kept;
 }
-
-using I8x8 = std::int8_t __attribute__((vector_size(8)));
 
 inline F32x8 load_pattern(const std::int8_t* p) {
   I8x8 bytes;
