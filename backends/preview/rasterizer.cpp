@@ -356,7 +356,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     for (int b = projected[t].y0 / kBandRows; b <= projected[t].y1 / kBandRows; ++b) fn(b);
   });
   const float empty = -std::numeric_limits<float>::infinity();
-  map.depth.resize(static_cast<size_t>(size) * size);
+  map.depth = dslr::take_floats(static_cast<size_t>(size) * size);  // every band fills its rows
   tbb::parallel_for(0, bands, [&](int band) {
     const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
     float* key_rows = map.depth.data() + static_cast<size_t>(row0) * size;
@@ -879,6 +879,14 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                                   2.0f)));
   // The lights' maps together: each map's passes have serial joins that leave a core idle.
   std::vector<ShadowMap> shadow_maps(scene.studio.lights.size());
+  // The maps' depth buffers (16 MB each at full resolution) go back to the pool for the next
+  // frame's maps, whichever way this function returns.
+  struct RecycleMaps {
+    std::vector<ShadowMap>& maps;
+    ~RecycleMaps() {
+      for (ShadowMap& map : maps) dslr::recycle(std::move(map.depth));
+    }
+  } recycle_maps{shadow_maps};
   tbb::parallel_for(std::size_t{0}, shadow_maps.size(), [&](std::size_t l) {
     shadow_maps[l] = build_shadow_map(scene.studio.lights[l], caster_center, caster_radius, casters,
                                       request.shadow_map_size);
