@@ -292,17 +292,57 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             row_gain[a] = static_cast<float>((1 - tb) * map.gain[k0] + tb * map.gain[k1]);
             row_valid[a] = map.valid[k0] && map.valid[k1];
           }
-          for (int i = 0; i < sensor.width; ++i) {
-            const std::size_t o = row + i;
-            const int a = i / kMapStep;
-            const float ta = (i - a * kMapStep + 0.5f) / kMapStep;
-            float uc, vc, gain;
-            if (row_valid[a] && row_valid[a + 1]) {
-              uc = row_u[a] + ta * (row_u[a + 1] - row_u[a]);
-              vc = row_v[a] + ta * (row_v[a + 1] - row_v[a]);
-              gain = row_gain[a] + ta * (row_gain[a + 1] - row_gain[a]);
+          // Bilinear from the canvas at (uc, vc), scaled by the vignetting gain; depth and mask
+          // from the nearest canvas pixel. Away from the canvas's border the four taps need no
+          // clamping.
+          auto sample = [&](std::size_t o, float uc, float vc, float gain) {
+            const float fu = std::floor(uc), fv = std::floor(vc);
+            const float au = uc - fu, av = vc - fv;
+            const int iu = static_cast<int>(fu), iv = static_cast<int>(fv);
+            const float *p00, *p10, *p01, *p11;
+            int ni, nj;
+            if (iu >= 0 && iv >= 0 && iu + 1 < cw && iv + 1 < ch) {
+              p00 = &rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
+              p10 = p00 + 3;
+              p01 = p00 + 3 * static_cast<std::size_t>(cw);
+              p11 = p01 + 3;
+              ni = iu + (au >= 0.5f);
+              nj = iv + (av >= 0.5f);
             } else {
+              const int i0 = std::clamp(iu, 0, cw - 1), i1 = std::clamp(iu + 1, 0, cw - 1);
+              const int j0 = std::clamp(iv, 0, ch - 1), j1 = std::clamp(iv + 1, 0, ch - 1);
+              p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
+              p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
+              p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
+              p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
+              ni = std::clamp(iu + (au >= 0.5f), 0, cw - 1);
+              nj = std::clamp(iv + (av >= 0.5f), 0, ch - 1);
+            }
+            for (int c = 0; c < 3; ++c) {
+              const float top = p00[c] + au * (p10[c] - p00[c]);
+              const float bottom = p01[c] + au * (p11[c] - p01[c]);
+              out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
+            }
+            const std::size_t nearest = static_cast<std::size_t>(nj) * cw + ni;
+            if (has_depth) out.depth_m[o] = depth_m[nearest];
+            if (has_mask) out.mask[o] = mask[nearest];
+          };
+          // Node to node: the map's cells are kMapStep pixels wide.
+          for (int a = 0; a * kMapStep < sensor.width; ++a) {
+            const int i_begin = a * kMapStep, i_end = std::min(sensor.width, i_begin + kMapStep);
+            if (row_valid[a] && row_valid[a + 1]) {
+              const float u0 = row_u[a], du = row_u[a + 1] - u0;
+              const float v0 = row_v[a], dv = row_v[a + 1] - v0;
+              const float g0 = row_gain[a], dg = row_gain[a + 1] - g0;
+              for (int i = i_begin; i < i_end; ++i) {
+                const float ta = (i - i_begin + 0.5f) / kMapStep;
+                sample(row + i, u0 + ta * du, v0 + ta * dv, g0 + ta * dg);
+              }
+              continue;
+            }
+            for (int i = i_begin; i < i_end; ++i) {
               // Next to the fold the grid cannot be interpolated: solve this pixel exactly.
+              const std::size_t o = row + i;
               const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
               const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
               ir::Vec2 xu;
@@ -312,30 +352,9 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                 if (has_mask) out.mask[o] = 0;
                 continue;
               }
-              uc = static_cast<float>(canvas.fx * xu.x() + canvas.cx - 0.5);
-              vc = static_cast<float>(canvas.fy * xu.y() + canvas.cy - 0.5);
-              gain = static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner));
-            }
-            const float fu = std::floor(uc), fv = std::floor(vc);
-            const float au = uc - fu, av = vc - fv;
-            const int iu = static_cast<int>(fu), iv = static_cast<int>(fv);
-            const int i0 = std::clamp(iu, 0, cw - 1), i1 = std::clamp(iu + 1, 0, cw - 1);
-            const int j0 = std::clamp(iv, 0, ch - 1), j1 = std::clamp(iv + 1, 0, ch - 1);
-            const float* p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
-            const float* p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
-            const float* p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
-            const float* p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
-            for (int c = 0; c < 3; ++c) {
-              const float top = p00[c] + au * (p10[c] - p00[c]);
-              const float bottom = p01[c] + au * (p11[c] - p01[c]);
-              out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
-            }
-            if (has_depth || has_mask) {
-              const int ni = std::clamp(iu + (au >= 0.5f), 0, cw - 1);
-              const int nj = std::clamp(iv + (av >= 0.5f), 0, ch - 1);
-              const std::size_t s = static_cast<std::size_t>(nj) * cw + ni;
-              if (has_depth) out.depth_m[o] = depth_m[s];
-              if (has_mask) out.mask[o] = mask[s];
+              sample(o, static_cast<float>(canvas.fx * xu.x() + canvas.cx - 0.5),
+                     static_cast<float>(canvas.fy * xu.y() + canvas.cy - 0.5),
+                     static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner)));
             }
           }
         }
