@@ -34,6 +34,10 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // Shading normals of a 2 x 2 quad within this angle (2 degrees) of their mean share one sum of
 // the lights.
 constexpr float kQuadNormalCos = 0.99939f;
+// A 4 x 4 block of the object whose corner normals are within this angle (8 degrees) of each
+// other has its lighting interpolated bilinearly from the corners. Interpolation follows the
+// first-order change that a quad's single sum ignores, so the bound can be looser.
+constexpr float kBlockNormalCos = 0.9903f;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -1201,6 +1205,73 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         std::array<Vector3f, kCorners * kCorners> corner_color;
         std::array<std::int32_t, kCorners * kCorners> corner_plane;
         corner_plane.fill(-1);
+        // The object's corners: lighting (albedo applied per pixel) and shading normal.
+        struct ObjectCorner {
+          Lighting lighting;
+          Vector3f n;
+          float footprint_m;
+          bool known = false;
+        };
+        std::array<ObjectCorner, kCorners * kCorners> object_corner;
+        // A 4 x 4 block inside one smooth patch of the object: the lights are summed at the
+        // block's corners (shared with the neighbouring blocks) and interpolated, the albedo
+        // taken per pixel; the block must be one material, one surface per pixel, without
+        // depth steps, and its corner normals within kQuadNormalCos of each other. False (and
+        // nothing written) otherwise.
+        auto shade_object_block = [&](int bx, int by) -> bool {
+          std::array<PixelSurfaces, kBlock * kBlock> block;
+          int material = -1;
+          for (int i = 0; i < kBlock * kBlock; ++i) {
+            const int px = bx + i % kBlock, py = by + i / kBlock;
+            block[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+            const PixelSurfaces& b = block[i];
+            if (b.count != 1 || b.samples[0] != kSamples || b.object_samples != kSamples) {
+              return false;
+            }
+            const int m = source_of(screen_tris[b.triangle[0]]).material();
+            if (i == 0) material = m;
+            if (m != material ||
+                std::abs(b.nearest - block[0].nearest) > 0.01f * block[0].nearest) {
+              return false;
+            }
+          }
+          std::array<const ObjectCorner*, 4> corner;
+          for (int k = 0; k < 4; ++k) {
+            const int cx = (bx - x0) / kBlock + (k & 1), cy = (by - y0) / kBlock + (k >> 1);
+            ObjectCorner& c = object_corner[cy * kCorners + cx];
+            if (!c.known) {
+              // On the plane of the triangle under the block's pixel at this corner.
+              const int pixel = (k >> 1) * (kBlock - 1) * kBlock + (k & 1) * (kBlock - 1);
+              const SurfacePoint sp = surface_at(screen_tris[block[pixel].triangle[0]],
+                                                 static_cast<float>(bx + kBlock * (k & 1)),
+                                                 static_cast<float>(by + kBlock * (k >> 1)), true);
+              c.lighting = lighting_at(sp);
+              c.n = sp.n;
+              c.footprint_m = sp.footprint_m;
+              c.known = true;
+            }
+            corner[k] = &c;
+          }
+          for (int k = 0; k < 4; ++k) {
+            for (int m = k + 1; m < 4; ++m) {
+              if (corner[k]->n.dot(corner[m]->n) < kBlockNormalCos) return false;
+            }
+          }
+          for (int i = 0; i < kBlock * kBlock; ++i) {
+            const int px = bx + i % kBlock, py = by + i / kBlock;
+            const float fx = (i % kBlock + 0.5f) / kBlock, fy = (i / kBlock + 0.5f) / kBlock;
+            const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+            Vector3f scale = Vector3f::Zero(), offset = Vector3f::Zero();
+            for (int k = 0; k < 4; ++k) {
+              scale += w[k] * corner[k]->lighting.scale;
+              offset += w[k] * corner[k]->lighting.offset;
+            }
+            const Vector3f albedo = albedo_at(screen_tris[block[i].triangle[0]], px + 0.5f,
+                                              py + 0.5f, corner[0]->footprint_m);
+            write_pixel(px, py, block[i], albedo.cwiseProduct(scale) + offset);
+          }
+          return true;
+        };
         for (int by = y0; by < y1; by += kBlock) {
           for (int bx = x0; bx < x1; bx += kBlock) {
             bool flat_block = use_blocks && bx + kBlock <= x1 && by + kBlock <= y1;
@@ -1245,6 +1316,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               }
               flat_block = plain_studio(t) && same_studio_plane(t, screen_tris[plane_triangle]) &&
                            std::abs(b.nearest - block[0].nearest) <= 0.02f * block[0].nearest;
+            }
+            if (!flat_block && use_blocks && bx + kBlock <= x1 && by + kBlock <= y1 &&
+                shade_object_block(bx, by)) {
+              continue;
             }
             if (!flat_block) {
               for (int qy = by; qy < std::min(y1, by + kBlock); qy += 2) {
