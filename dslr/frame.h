@@ -43,6 +43,9 @@ struct ShotParams {
   double focus_distance_m = 1;  // ir::Shot::focus_distance_m
   int shot_index = 0;           // varies the temporal noise between shots
   std::uint64_t seed = 1;       // camera seed: fixes the sensor's fixed-pattern noise
+  // Whether DevelopResult::depth_m is wanted (a writer of images only does not need it: at full
+  // resolution it is 80 MB and a tenth of the distortion stage).
+  bool sensor_depth = true;
 };
 
 // Wall-clock milliseconds spent in each stage of develop_frame.
@@ -65,7 +68,7 @@ struct DevelopResult {
   int bits = 8;                        // 8 for JPEG, 16 for PNG/TIFF
   std::vector<std::uint16_t> encoded;  // sRGB code values, 3 per pixel (0..255 or 0..65535)
   std::vector<std::uint8_t> mask;  // object mask on the sensor grid; empty if the frame had none
-  std::vector<float> depth_m;      // depth on the sensor grid (nearest sample)
+  std::vector<float> depth_m;      // depth on the sensor grid (nearest sample); see sensor_depth
   std::array<double, 3> white_balance_gains{1, 1, 1};
   StageTimings timings;
 };

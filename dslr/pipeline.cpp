@@ -73,8 +73,10 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
   if (camera.effects.diffraction) apply_diffraction(camera, canvas, work, scratch);
   result.timings.diffraction_ms = clock.lap_ms();
 
+  static const std::vector<float> no_depth;
   SensorImage image =
-      warp_to_sensor(camera, sensor, canvas, work, frame.depth_m, frame.mask, std::move(scratch));
+      warp_to_sensor(camera, sensor, canvas, work, shot.sensor_depth ? frame.depth_m : no_depth,
+                     frame.mask, std::move(scratch));
   recycle(std::move(work));
   if (owned != nullptr) {
     recycle(std::move(owned->depth_m));

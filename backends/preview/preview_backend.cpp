@@ -85,6 +85,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
   params.focus_distance_m = shot.focus_distance_m;
   params.shot_index = shot.index;
   params.seed = seed;
+  params.sensor_depth = false;  // only the image and the mask are written
   dslr::DevelopResult result = dslr::develop_frame(scene.camera, std::move(frame), params, scale);
   if (timing) {
     timing->raster = raster;
@@ -204,7 +205,6 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     // Only the encoded pixels and the mask are written; the rest goes back to the pool for the
     // next shot.
     dslr::recycle(std::move(result.linear));
-    dslr::recycle(std::move(result.depth_m));
     PendingWrite write;
     write.shot = &shot;
     write.key = key;
