@@ -1126,6 +1126,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   constexpr int kBlock = 4;
   constexpr int kCorners = kTileSize / kBlock + 1;
   const bool use_blocks = !request.per_pixel_lighting;
+  // Where 8 pixels subtend under 1.5 mrad (the full-resolution frames of a normal lens), the
+  // studio planes are shaded every 8 pixels: their light, soft shadows included, does not bend
+  // over that span, and the green screen and the turntable fill most of a frame.
+  const bool coarse_corners = use_blocks && 2 * kBlock / fx <= 1.5e-3f;
   rasterize_tiles<kSamples>(
       setup, canvas,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
@@ -1330,17 +1334,28 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             // Radiance at the block's corners, on the plane (unclamped barycentrics reach
             // past the triangle's edges along the plane).
             const ScreenTriangle& plane = screen_tris[plane_triangle];
-            std::array<Vector3f, 4> corner;
-            for (int k = 0; k < 4; ++k) {
-              const int cx = (bx - x0) / kBlock + (k & 1), cy = (by - y0) / kBlock + (k >> 1);
+            // Corner (cx, cy) of the tile's grid, cached per plane. With coarse corners only
+            // the even ones are shaded; odd ones are the mean of their even neighbours.
+            auto plane_corner = [&](auto&& self, int cx, int cy) -> Vector3f {
               const int slot = cy * kCorners + cx;
               if (corner_plane[slot] != plane.source) {
-                const float px = static_cast<float>(bx + kBlock * (k & 1));
-                const float py = static_cast<float>(by + kBlock * (k >> 1));
-                corner_color[slot] = shade_on_plane(plane, px, py);
+                if (coarse_corners && (cx % 2 || cy % 2)) {
+                  const int ax = cx - cx % 2, bx2 = cx + cx % 2;
+                  const int ay = cy - cy % 2, by2 = cy + cy % 2;
+                  corner_color[slot] = 0.25f * (self(self, ax, ay) + self(self, bx2, ay) +
+                                                self(self, ax, by2) + self(self, bx2, by2));
+                } else {
+                  corner_color[slot] = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
+                                                      static_cast<float>(y0 + kBlock * cy));
+                }
                 corner_plane[slot] = plane.source;
               }
-              corner[k] = corner_color[slot];
+              return corner_color[slot];
+            };
+            std::array<Vector3f, 4> corner;
+            for (int k = 0; k < 4; ++k) {
+              corner[k] = plane_corner(plane_corner, (bx - x0) / kBlock + (k & 1),
+                                       (by - y0) / kBlock + (k >> 1));
             }
             for (int i = 0; i < kBlock * kBlock; ++i) {
               const int px = bx + i % kBlock, py = by + i / kBlock;
