@@ -253,35 +253,66 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   std::vector<float> tile_range(6 * tile_max.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     const float inf = std::numeric_limits<float>::infinity();
-    std::vector<float> near(tiles_x), far(tiles_x), range(6 * tiles_x);
+    // Per tile column, running minima and maxima over the tile's rows: of the depth by lane
+    // (kTile) and of the interleaved colour by value (3·kTile), folded per tile at the end. Plain
+    // element-wise loops over contiguous values, which the compiler vectorises.
+    constexpr int kValues = 3 * kTile;
+    std::vector<float> z_lo(kTile * tiles_x), z_hi(kTile * tiles_x);
+    std::vector<float> c_lo(kValues * tiles_x), c_hi(kValues * tiles_x);
+    std::vector<float> range(6 * tiles_x);
     for (int ty = r.begin(); ty < r.end(); ++ty) {
-      std::fill(near.begin(), near.end(), inf);
-      std::fill(far.begin(), far.end(), 0.0f);
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        std::fill_n(&range[6 * tx], 3, inf);
-        std::fill_n(&range[6 * tx + 3], 3, -inf);
-      }
+      std::fill(z_lo.begin(), z_lo.end(), inf);
+      std::fill(z_hi.begin(), z_hi.end(), 0.0f);
+      std::fill(c_lo.begin(), c_lo.end(), inf);
+      std::fill(c_hi.begin(), c_hi.end(), -inf);
       for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
         const float* row = &depth_m[static_cast<std::size_t>(y) * w];
         const float* colour = &rgb[3 * static_cast<std::size_t>(y) * w];
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          float lo = near[tx], hi = far[tx];
-          float c_lo[3] = {range[6 * tx], range[6 * tx + 1], range[6 * tx + 2]};
-          float c_hi[3] = {range[6 * tx + 3], range[6 * tx + 4], range[6 * tx + 5]};
-          for (int x = tx * kTile; x < std::min(w, (tx + 1) * kTile); ++x) {
-            const float z = row[x] > 0 ? row[x] : inf;  // unknown depth: background
-            lo = std::min(lo, z);
-            hi = std::max(hi, z);
-            for (int c = 0; c < 3; ++c) {
-              c_lo[c] = std::min(c_lo[c], colour[3 * x + c]);
-              c_hi[c] = std::max(c_hi[c], colour[3 * x + c]);
-            }
+        const int full_tiles = w / kTile;
+        for (int tx = 0; tx < full_tiles; ++tx) {
+          const float* zr = row + tx * kTile;
+          float* zl = &z_lo[kTile * tx];
+          float* zh = &z_hi[kTile * tx];
+          for (int k = 0; k < kTile; ++k) {
+            const float z = zr[k] > 0 ? zr[k] : inf;  // unknown depth: background
+            zl[k] = std::min(zl[k], z);
+            zh[k] = std::max(zh[k], z);
           }
-          near[tx] = lo, far[tx] = hi;
+          const float* cr = colour + kValues * tx;
+          float* cl = &c_lo[kValues * tx];
+          float* ch = &c_hi[kValues * tx];
+          for (int k = 0; k < kValues; ++k) {
+            cl[k] = std::min(cl[k], cr[k]);
+            ch[k] = std::max(ch[k], cr[k]);
+          }
+        }
+        for (int x = full_tiles * kTile; x < w; ++x) {  // the last, partial tile
+          const int tx = full_tiles, k = x - tx * kTile;
+          const float z = row[x] > 0 ? row[x] : inf;
+          z_lo[kTile * tx + k] = std::min(z_lo[kTile * tx + k], z);
+          z_hi[kTile * tx + k] = std::max(z_hi[kTile * tx + k], z);
           for (int c = 0; c < 3; ++c) {
-            range[6 * tx + c] = c_lo[c];
-            range[6 * tx + 3 + c] = c_hi[c];
+            float& lo = c_lo[kValues * tx + 3 * k + c];
+            float& hi = c_hi[kValues * tx + 3 * k + c];
+            lo = std::min(lo, colour[3 * x + c]);
+            hi = std::max(hi, colour[3 * x + c]);
           }
+        }
+      }
+      std::vector<float> near(tiles_x, inf), far(tiles_x, 0.0f);
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        for (int k = 0; k < kTile; ++k) {
+          near[tx] = std::min(near[tx], z_lo[kTile * tx + k]);
+          far[tx] = std::max(far[tx], z_hi[kTile * tx + k]);
+        }
+        for (int c = 0; c < 3; ++c) {
+          float lo = inf, hi = -inf;
+          for (int k = 0; k < kTile; ++k) {
+            lo = std::min(lo, c_lo[kValues * tx + 3 * k + c]);
+            hi = std::max(hi, c_hi[kValues * tx + 3 * k + c]);
+          }
+          range[6 * tx + c] = lo;
+          range[6 * tx + 3 + c] = hi;
         }
       }
       for (int tx = 0; tx < tiles_x; ++tx) {
@@ -565,16 +596,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         float* zs = &pl.z[row_begin];
         float* radii = &pl.radius[row_begin];
         float* inv_area = &pl.inv_area[row_begin];
-        for (int x = std::max(0, fill_x0); x < std::min(w, fill_x1); ++x) {
-          const std::size_t p = image_row + x;
-          const float z = depth_m[p] > 0 ? depth_m[p] : inf;
+        // Depth-derived planes and the colour planes in two loops: each reads one contiguous
+        // input, so both vectorise.
+        const int fill_begin = std::max(0, fill_x0), fill_end = std::min(w, fill_x1);
+        const float* depth_row = &depth_m[image_row];
+        for (int x = fill_begin; x < fill_end; ++x) {
+          const float z = depth_row[x] > 0 ? depth_row[x] : inf;
           const float radius = radius_at(z);
-          r[x] = rgb[3 * p];
-          g[x] = rgb[3 * p + 1];
-          b[x] = rgb[3 * p + 2];
           zs[x] = z;
           radii[x] = radius;
           inv_area[x] = 1 / (std::numbers::pi_v<float> * radius * radius);
+        }
+        const float* colour_row = &rgb[3 * image_row];
+        for (int x = fill_begin; x < fill_end; ++x) {
+          r[x] = colour_row[3 * x];
+          g[x] = colour_row[3 * x + 1];
+          b[x] = colour_row[3 * x + 2];
         }
       }
       for (int ty = ty0; ty < ty1; ++ty) {
