@@ -189,16 +189,23 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
   s.behind[0] = br, s.behind[1] = bg, s.behind[2] = bb;
 }
 
-// Front-to-back compositing of the three layers for one pixel (lane).
-void composite(const GroupSums& s, int lane, float* out) {
-  const float wf = s.wf[lane], ws = s.ws[lane], wb = s.wb[lane];
-  const float alpha_same = wb > 0 ? std::min(1.f, ws) : 1.f;  // ws > 0: p covers itself
-  const float alpha_front = std::min(1.f, wf);
+// Front-to-back compositing of the three layers, for the group's first `count` pixels: all
+// lanes at once, then stored interleaved. (ws > 0 always: a pixel's own tap covers it.)
+void composite(const GroupSums& s, int count, float* out) {
+  const Floats zero = {}, one = zero + 1;
+  const auto has_behind = s.wb > zero, has_front = s.wf > zero;
+  const Floats alpha_same = has_behind ? (s.ws < one ? s.ws : one) : one;
+  const Floats alpha_front = s.wf < one ? s.wf : one;
+  // Lanes without a layer divide by zero here; the selects below drop them.
+  const Floats inv_ws = one / s.ws, inv_wb = one / s.wb, inv_wf = one / s.wf;
+  Floats v[3];
   for (int k = 0; k < 3; ++k) {
-    float v = alpha_same * s.same[k][lane] / ws;
-    if (wb > 0) v += (1 - alpha_same) * s.behind[k][lane] / wb;
-    if (wf > 0) v = alpha_front * s.front[k][lane] / wf + (1 - alpha_front) * v;
-    out[k] = v;
+    v[k] = alpha_same * s.same[k] * inv_ws;
+    v[k] = has_behind ? v[k] + (1 - alpha_same) * s.behind[k] * inv_wb : v[k];
+    v[k] = has_front ? alpha_front * s.front[k] * inv_wf + (1 - alpha_front) * v[k] : v[k];
+  }
+  for (int lane = 0; lane < count; ++lane) {
+    for (int k = 0; k < 3; ++k) out[3 * lane + k] = v[k][lane];
   }
 }
 
@@ -632,9 +639,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; x += kLanes) {
               gather_group(pl, set, tap_count, pl.index(x, y), sums);
-              for (int lane = 0; lane < kLanes && x + lane < x1; ++lane) {
-                composite(sums, lane, &out[3 * (static_cast<std::size_t>(y) * w + x + lane)]);
-              }
+              composite(sums, std::min(kLanes, x1 - x),
+                        &out[3 * (static_cast<std::size_t>(y) * w + x)]);
             }
           }
         }
