@@ -86,12 +86,18 @@ TEST(DslrNoise, DarkFrameKeepsAnUnbiasedMean) {
   EXPECT_NEAR(s.std, std::hypot(read, camera.noise.dsnu_e), 0.1 * std::hypot(read, 1.0));
 }
 
-TEST(DslrNoise, SmallSignalsArePoisson) {
-  // 5 electrons mean: exact Poisson draws, variance = mean (plus a tiny read noise).
+// ISO 6400 with the fixed pattern off and a negligible read noise: the shot noise alone.
+ir::Camera shot_noise_only_6d() {
   ir::Camera camera = noisy_6d(6400);
   camera.noise.read_noise_high_iso_e = 0.01;
   camera.noise.prnu = 0;
   camera.noise.dsnu_e = 0;
+  return camera;
+}
+
+TEST(DslrNoise, SmallSignalsArePoisson) {
+  // 5 electrons mean: exact Poisson draws, variance = mean (plus a tiny read noise).
+  const ir::Camera camera = shot_noise_only_6d();
   const double fwc = 79546.0 / 64;
   const Stats s = stats(flat_patch(camera, 5 / fwc).linear, fwc);
   const std::vector<float> linear = flat_patch(camera, 5 / fwc).linear;
@@ -106,10 +112,7 @@ TEST(DslrNoise, SmallSignalsArePoisson) {
 TEST(DslrNoise, ModerateSignalsKeepThePoissonSkew) {
   // 20 electrons: drawn from a skew-corrected Gaussian, whose variance and third moment must
   // still be the Poisson law's (mean 20, variance 20, skewness 1/sqrt(20) = 0.224).
-  ir::Camera camera = noisy_6d(6400);
-  camera.noise.read_noise_high_iso_e = 0.01;
-  camera.noise.prnu = 0;
-  camera.noise.dsnu_e = 0;
+  const ir::Camera camera = shot_noise_only_6d();
   const double fwc = 79546.0 / 64;
   const std::vector<float> linear = flat_patch(camera, 20 / fwc).linear;
   double sum = 0, sum2 = 0, sum3 = 0;
