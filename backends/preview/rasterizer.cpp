@@ -664,6 +664,12 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
   const Float4 lane_y = Samples == 1 ? Float4{0.5f, 0.5f, 0.5f, 0.5f}
                                      : Float4{kSampleY[0], kSampleY[1], kSampleY[2], kSampleY[3]};
   constexpr int kStepX = Samples == 1 ? 4 : 1;  // pixels per group of four lanes
+  using Float8 = simd::F32x8;
+  using Int8 = simd::I32x8;
+  const Float8 lane_x8 = {kSampleX[0],     kSampleX[1],     kSampleX[2],     kSampleX[3],
+                          1 + kSampleX[0], 1 + kSampleX[1], 1 + kSampleX[2], 1 + kSampleX[3]};
+  const Float8 lane_y8 = {kSampleY[0], kSampleY[1], kSampleY[2], kSampleY[3],
+                          kSampleY[0], kSampleY[1], kSampleY[2], kSampleY[3]};
   tbb::parallel_for(
       tbb::blocked_range<int>(0, setup.tiles_x * setup.tiles_y, 4),
       [&](const tbb::blocked_range<int>& range) {
@@ -688,6 +694,7 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
             const int px1 = std::min<int>(x1 - 1, s.x1);
             const int py0 = std::max<int>(y0, s.y0), py1 = std::min<int>(y1 - 1, s.y1);
             const Int4 id4 = Int4{} + id;
+            const Int8 id8 = Int8{} + id;
             // A triangle that covers the whole box of samples (the studio's big ones) needs only
             // the depth test: the planes are affine, so the box's corners decide, with a margin
             // for rounding.
@@ -714,6 +721,50 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                   const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
                   const Float4 nearest = load4(sample_inv_z + base);
                   const Int4 hit = inv_z > nearest;
+                  store4(sample_inv_z + base, hit ? inv_z : nearest);
+                  store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
+                }
+              }
+              continue;
+            }
+            if constexpr (Samples == kSamples) {
+              // Two pixels' eight samples per step (one 8-lane register), the odd last one on
+              // four lanes. The lanes of the second pixel compute px + (1 + offset), which is
+              // exactly (px + 1) + offset in floats: the same coverage and depths.
+              for (int py = py0; py <= py1; ++py) {
+                const Float8 sy = static_cast<float>(py) + lane_y8;
+                const Float8 w0_row = s.w0_plane[1] * sy;
+                const Float8 w1_row = s.w1_plane[1] * sy;
+                const Float8 iz_row = s.inv_z_plane[1] * sy;
+                int px = px0;
+                for (; px + 1 <= px1; px += 2) {
+                  const Float8 sx = static_cast<float>(px) + lane_x8;
+                  const Float8 w0 = s.w0_plane[0] * sx + w0_row + s.w0_plane[2];
+                  const Float8 w1 = s.w1_plane[0] * sx + w1_row + s.w1_plane[2];
+                  const Float8 inv_z = s.inv_z_plane[0] * sx + iz_row + s.inv_z_plane[2];
+                  const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+                  Float8 nearest;
+                  std::memcpy(&nearest, sample_inv_z + base, sizeof(nearest));
+                  const Int8 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
+                  if (!simd::any(hit)) continue;
+                  Int8 ids;
+                  std::memcpy(&ids, sample_tri + base, sizeof(ids));
+                  const Float8 new_z = hit ? inv_z : nearest;
+                  const Int8 new_ids = hit ? id8 : ids;
+                  std::memcpy(sample_inv_z + base, &new_z, sizeof(new_z));
+                  std::memcpy(sample_tri + base, &new_ids, sizeof(new_ids));
+                }
+                if (px == px1) {
+                  const Float4 sy4 = static_cast<float>(py) + lane_y;
+                  const Float4 sx = static_cast<float>(px) + lane_x;
+                  const Float4 w0 = s.w0_plane[0] * sx + s.w0_plane[1] * sy4 + s.w0_plane[2];
+                  const Float4 w1 = s.w1_plane[0] * sx + s.w1_plane[1] * sy4 + s.w1_plane[2];
+                  const Float4 inv_z =
+                      s.inv_z_plane[0] * sx + s.inv_z_plane[1] * sy4 + s.inv_z_plane[2];
+                  const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+                  const Float4 nearest = load4(sample_inv_z + base);
+                  const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
+                  if (!simd::any(hit)) continue;
                   store4(sample_inv_z + base, hit ? inv_z : nearest);
                   store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
                 }
