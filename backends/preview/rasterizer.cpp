@@ -727,6 +727,19 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
               }
               continue;
             }
+            // Four lanes at (px, py): edge and depth tests, nearest depth and triangle kept.
+            auto test4 = [&](int px, int py, Float4 w0_row, Float4 w1_row, Float4 iz_row) {
+              const Float4 sx = static_cast<float>(px) + lane_x;
+              const Float4 w0 = s.w0_plane[0] * sx + w0_row + s.w0_plane[2];
+              const Float4 w1 = s.w1_plane[0] * sx + w1_row + s.w1_plane[2];
+              const Float4 inv_z = s.inv_z_plane[0] * sx + iz_row + s.inv_z_plane[2];
+              const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
+              const Float4 nearest = load4(sample_inv_z + base);
+              const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
+              if (!simd::any(hit)) return;
+              store4(sample_inv_z + base, hit ? inv_z : nearest);
+              store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
+            };
             if constexpr (Samples == kSamples) {
               // Two pixels' eight samples per step (one 8-lane register), the odd last one on
               // four lanes. The lanes of the second pixel compute px + (1 + offset), which is
@@ -756,17 +769,7 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                 }
                 if (px == px1) {
                   const Float4 sy4 = static_cast<float>(py) + lane_y;
-                  const Float4 sx = static_cast<float>(px) + lane_x;
-                  const Float4 w0 = s.w0_plane[0] * sx + s.w0_plane[1] * sy4 + s.w0_plane[2];
-                  const Float4 w1 = s.w1_plane[0] * sx + s.w1_plane[1] * sy4 + s.w1_plane[2];
-                  const Float4 inv_z =
-                      s.inv_z_plane[0] * sx + s.inv_z_plane[1] * sy4 + s.inv_z_plane[2];
-                  const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
-                  const Float4 nearest = load4(sample_inv_z + base);
-                  const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-                  if (!simd::any(hit)) continue;
-                  store4(sample_inv_z + base, hit ? inv_z : nearest);
-                  store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
+                  test4(px, py, s.w0_plane[1] * sy4, s.w1_plane[1] * sy4, s.inv_z_plane[1] * sy4);
                 }
               }
               continue;
@@ -776,18 +779,7 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
               const Float4 w0_row = s.w0_plane[1] * sy;
               const Float4 w1_row = s.w1_plane[1] * sy;
               const Float4 iz_row = s.inv_z_plane[1] * sy;
-              for (int px = px0; px <= px1; px += kStepX) {
-                const Float4 sx = static_cast<float>(px) + lane_x;
-                const Float4 w0 = s.w0_plane[0] * sx + w0_row + s.w0_plane[2];
-                const Float4 w1 = s.w1_plane[0] * sx + w1_row + s.w1_plane[2];
-                const Float4 inv_z = s.inv_z_plane[0] * sx + iz_row + s.inv_z_plane[2];
-                const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
-                const Float4 nearest = load4(sample_inv_z + base);
-                const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-                if (!simd::any(hit)) continue;
-                store4(sample_inv_z + base, hit ? inv_z : nearest);
-                store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
-              }
+              for (int px = px0; px <= px1; px += kStepX) test4(px, py, w0_row, w1_row, iz_row);
             }
           }
           resolve_tile(x0, y0, x1, y1, sample_inv_z, sample_tri);
