@@ -7,6 +7,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/preview/preview_backend.h"
+#include "backends/preview/studio_scene.h"
 #include "compiler/frontend.h"
 #include "compiler/primitives.h"
 #include "dslr/buffer_pool.h"
@@ -286,6 +287,38 @@ TEST(Preview, ReusedBuffersAreFullyOverwritten) {
   EXPECT_EQ(bad_rgb, 0);
   EXPECT_EQ(bad_mask, 0);
   EXPECT_EQ(bad_depth, 0);
+}
+
+// The rasterizer reads the speckle and noise patterns eight points at a time; they must be the
+// same patterns as the one-point function's, sharp where resolved and faded where not.
+TEST(Preview, BatchedPatternsMatchThePointPattern) {
+  for (const auto kind :
+       {ir::PatternKind::kSpeckle, ir::PatternKind::kNoise, ir::PatternKind::kChecker}) {
+    ir::SurfacePattern pattern;
+    pattern.kind = kind;
+    pattern.scale_m = 0.002;
+    pattern.contrast = 0.7;
+    pattern.seed = 11;
+    constexpr int kPoints = 13;  // one full step of eight and a partial one
+    std::array<float, kPoints> x, y, z, batched;
+    for (const float footprint_m : {0.0001f, 0.0015f}) {
+      for (int start = 0; start < 50; ++start) {
+        for (int i = 0; i < kPoints; ++i) {
+          // Points on both sides of zero, lattice cells apart and within one cell.
+          x[i] = 0.0137f * (start - 25) + 0.00031f * i;
+          y[i] = -0.0041f * start + 0.0007f * i;
+          z[i] = 0.0029f * start - 0.0011f * i;
+        }
+        preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint_m,
+                                 batched.data());
+        for (int i = 0; i < kPoints; ++i) {
+          const float one = preview::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint_m);
+          ASSERT_NEAR(batched[i], one, 1e-5f)
+              << "kind " << static_cast<int>(kind) << " point " << i << " start " << start;
+        }
+      }
+    }
+  }
 }
 
 // Coverage pictures shade a plane evenly: a studio plane is split into long thin triangles (the

@@ -1007,17 +1007,24 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
     return n.dot(eye - p) < 0 ? Vector3f(-n) : n;
   };
-  // Base colour x texture x surface pattern at (px, py) on the screen triangle.
-  auto albedo_at = [&](const ScreenTriangle& s, float px, float py, float footprint_m) -> Vector3f {
+  // Base colour x texture at (px, py) on the screen triangle, and where on the object (in its
+  // own frame) the surface pattern is to be read, when it has one.
+  struct AlbedoSample {
+    Vector3f color;
+    Vector3f pattern_at;
+    bool patterned = false;
+  };
+  auto albedo_sample_at = [&](const ScreenTriangle& s, float px, float py) -> AlbedoSample {
     const SourceTriangle source = source_of(s);
     const bool is_object = source.is_object;
     const ShadedMaterial& material = studio.materials[source.material()];
     const bool textured =
         material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size());
-    const bool patterned = is_object && material.pattern.kind != ir::PatternKind::kNone &&
-                           material.pattern.contrast > 0;
-    Vector3f albedo = material.base_color;
-    if (!textured && !patterned) return albedo;
+    AlbedoSample out;
+    out.color = material.base_color;
+    out.patterned = is_object && material.pattern.kind != ir::PatternKind::kNone &&
+                    material.pattern.contrast > 0;
+    if (!textured && !out.patterned) return out;
     const Vector3f b = source_bary_at(s, px, py);
     if (textured) {
       const MipTexture& texture = studio.textures[material.texture];
@@ -1030,12 +1037,42 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       const float texels =
           std::max(du.norm(), dv.norm()) *
           static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
-      albedo = albedo.cwiseProduct(texture.sample(uv, texels));
+      out.color = out.color.cwiseProduct(texture.sample(uv, texels));
     }
-    if (patterned) {
-      albedo *= pattern_factor(material.pattern, source.at(source.g.positions, b), footprint_m);
+    if (out.patterned) out.pattern_at = source.at(source.g.positions, b);
+    return out;
+  };
+  // Base colour x texture x surface pattern at (px, py) on the screen triangle.
+  auto albedo_at = [&](const ScreenTriangle& s, float px, float py, float footprint_m) -> Vector3f {
+    AlbedoSample sample = albedo_sample_at(s, px, py);
+    if (sample.patterned) {
+      const ShadedMaterial& material = studio.materials[source_of(s).material()];
+      sample.color *= pattern_factor(material.pattern, sample.pattern_at, footprint_m);
     }
-    return albedo;
+    return sample.color;
+  };
+  // albedo_at for up to 16 pixels of one material at once (the pattern is evaluated eight
+  // pixels at a time): pixel i at (px[i], py[i]) on screen triangle tris[i].
+  constexpr int kMaxBatch = 16;
+  auto albedo_batch = [&](const int* tris, const int* px, const int* py, int count,
+                          float footprint_m, Vector3f* out) {
+    std::array<float, kMaxBatch> x, y, z, factor;
+    int patterned = 0;
+    for (int i = 0; i < count; ++i) {
+      const AlbedoSample sample =
+          albedo_sample_at(screen_tris[tris[i]], px[i] + 0.5f, py[i] + 0.5f);
+      out[i] = sample.color;
+      patterned += sample.patterned;
+      x[i] = sample.pattern_at.x();
+      y[i] = sample.pattern_at.y();
+      z[i] = sample.pattern_at.z();
+    }
+    if (patterned == 0) return;
+    // One material: either every pixel has the pattern or none does.
+    const ShadedMaterial& material = studio.materials[source_of(screen_tris[tris[0]]).material()];
+    pattern_factors(material.pattern, x.data(), y.data(), z.data(), count, footprint_m,
+                    factor.data());
+    for (int i = 0; i < count; ++i) out[i] *= factor[i];
   };
   // The BRDF is linear in the albedo, so the light a surface point sends to the camera is
   // albedo ⊙ scale + offset: the lights are summed once and the albedo applied per pixel.
@@ -1235,11 +1272,17 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           }
           if (smooth) {
             const Lighting lighting = lighting_at(centre);
+            std::array<int, 4> tris, pxs, pys;
+            std::array<Vector3f, 4> albedo;
             for (int i = 0; i < 4; ++i) {
-              const int px = qx + (i & 1), py = qy + (i >> 1);
-              const Vector3f albedo = albedo_at(screen_tris[quad[i].triangle[0]], px + 0.5f,
-                                                py + 0.5f, centre.footprint_m);
-              write_pixel(px, py, quad[i], albedo.cwiseProduct(lighting.scale) + lighting.offset);
+              tris[i] = quad[i].triangle[0];
+              pxs[i] = qx + (i & 1);
+              pys[i] = qy + (i >> 1);
+            }
+            albedo_batch(tris.data(), pxs.data(), pys.data(), 4, centre.footprint_m, albedo.data());
+            for (int i = 0; i < 4; ++i) {
+              write_pixel(pxs[i], pys[i], quad[i],
+                          albedo[i].cwiseProduct(lighting.scale) + lighting.offset);
             }
             return;
           }
@@ -1304,8 +1347,16 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               if (corner[k]->n.dot(corner[m]->n) < kBlockNormalCos) return false;
             }
           }
+          std::array<int, kBlock * kBlock> tris, pxs, pys;
+          std::array<Vector3f, kBlock * kBlock> albedo;
           for (int i = 0; i < kBlock * kBlock; ++i) {
-            const int px = bx + i % kBlock, py = by + i / kBlock;
+            tris[i] = block[i].triangle[0];
+            pxs[i] = bx + i % kBlock;
+            pys[i] = by + i / kBlock;
+          }
+          albedo_batch(tris.data(), pxs.data(), pys.data(), kBlock * kBlock, corner[0]->footprint_m,
+                       albedo.data());
+          for (int i = 0; i < kBlock * kBlock; ++i) {
             const float fx = (i % kBlock + 0.5f) / kBlock, fy = (i / kBlock + 0.5f) / kBlock;
             const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
             Vector3f scale = Vector3f::Zero(), offset = Vector3f::Zero();
@@ -1313,9 +1364,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               scale += w[k] * corner[k]->lighting.scale;
               offset += w[k] * corner[k]->lighting.offset;
             }
-            const Vector3f albedo = albedo_at(screen_tris[block[i].triangle[0]], px + 0.5f,
-                                              py + 0.5f, corner[0]->footprint_m);
-            write_pixel(px, py, block[i], albedo.cwiseProduct(scale) + offset);
+            write_pixel(pxs[i], pys[i], block[i], albedo[i].cwiseProduct(scale) + offset);
           }
           return true;
         };

@@ -107,6 +107,45 @@ float value_noise(const Vector3f& p, std::uint32_t seed) {
               lerp(lerp(value[4], value[5], tx), lerp(value[6], value[7], tx), ty), tz);
 }
 
+// value_noise at eight points at once, one per lane: the same hash and interpolation, so the
+// same values.
+simd::F32x8 value_noise8(simd::F32x8 px, simd::F32x8 py, simd::F32x8 pz, std::uint32_t seed) {
+  using simd::F32x8;
+  using simd::I32x8;
+  using simd::U32x8;
+  const F32x8 fx = simd::floor(px), fy = simd::floor(py), fz = simd::floor(pz);
+  const auto ix = reinterpret_cast<U32x8>(__builtin_convertvector(fx, I32x8));
+  const auto iy = reinterpret_cast<U32x8>(__builtin_convertvector(fy, I32x8));
+  const auto iz = reinterpret_cast<U32x8>(__builtin_convertvector(fz, I32x8));
+  auto fade = [](F32x8 t) { return t * t * (3 - 2 * t); };
+  const F32x8 tx = fade(px - fx), ty = fade(py - fy), tz = fade(pz - fz);
+  // The hash up to the z step is shared by the corners (dx, dy, 0) and (dx, dy, 1).
+  auto corner_pair = [&](std::uint32_t dx, std::uint32_t dy, F32x8& near, F32x8& far) {
+    U32x8 h = U32x8{} + seed * 0x9E3779B9u;
+    h ^= (ix + dx) * 0x85EBCA6Bu;
+    h = (h ^ (h >> 13)) * 0xC2B2AE35u;
+    h ^= (iy + dy) * 0x27D4EB2Fu;
+    h = (h ^ (h >> 15)) * 0x165667B1u;
+    auto finish = [&](U32x8 z) {
+      U32x8 g = h ^ (z * 0x9E3779B1u);
+      g = (g ^ (g >> 16)) * 0x85EBCA77u;
+      g ^= g >> 13;
+      const I32x8 low = reinterpret_cast<I32x8>(g & 0xFFFFFFu);
+      return __builtin_convertvector(low, F32x8) / float(0xFFFFFF);
+    };
+    near = finish(iz);
+    far = finish(iz + 1u);
+  };
+  F32x8 v000, v001, v100, v101, v010, v011, v110, v111;
+  corner_pair(0, 0, v000, v001);
+  corner_pair(1, 0, v100, v101);
+  corner_pair(0, 1, v010, v011);
+  corner_pair(1, 1, v110, v111);
+  auto lerp = [](F32x8 a, F32x8 b, F32x8 t) { return a + (b - a) * t; };
+  return lerp(lerp(lerp(v000, v100, tx), lerp(v010, v110, tx), ty),
+              lerp(lerp(v001, v101, tx), lerp(v011, v111, tx), ty), tz);
+}
+
 void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const Vector3f& edge_v,
               int material) {
   const Vector3f normal = edge_u.cross(edge_v).normalized();
@@ -234,6 +273,55 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float
   }
   darkness = resolve * darkness + (1 - resolve) * mean_darkness;
   return 1.0f - contrast * darkness;
+}
+
+void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
+                     const float* z, int count, float footprint_m, float* out) {
+  using simd::F32x8;
+  const bool vectorised =
+      pattern.kind == ir::PatternKind::kSpeckle || pattern.kind == ir::PatternKind::kNoise;
+  if (!vectorised || pattern.contrast <= 0) {
+    for (int i = 0; i < count; ++i) {
+      out[i] = pattern_factor(pattern, Vector3f(x[i], y[i], z[i]), footprint_m);
+    }
+    return;
+  }
+  const float scale = static_cast<float>(pattern.scale_m);
+  const float contrast = static_cast<float>(pattern.contrast);
+  const float resolve = std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f);
+  for (int first = 0; first < count; first += 8) {
+    const int lanes = std::min(8, count - first);
+    F32x8 qx{}, qy{}, qz{};
+    for (int k = 0; k < lanes; ++k) {
+      qx[k] = x[first + k] / scale;
+      qy[k] = y[first + k] / scale;
+      qz[k] = z[first + k] / scale;
+    }
+    F32x8 darkness;
+    float mean_darkness;
+    if (pattern.kind == ir::PatternKind::kSpeckle) {
+      const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
+                      0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
+                                           pattern.seed + 1);
+      darkness = (n - 0.47f) * 12.0f;
+      mean_darkness = 0.4f;
+    } else {
+      F32x8 n{};
+      float amplitude = 0.5f, frequency = 1;
+      for (int octave = 0; octave < 3; ++octave) {
+        n += amplitude *
+             value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
+        amplitude *= 0.5f;
+        frequency *= 2.1f;
+      }
+      darkness = n / 0.875f;
+      mean_darkness = 0.5f;
+    }
+    for (int k = 0; k < lanes; ++k) {
+      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
+      out[first + k] = 1.0f - contrast * d;
+    }
+  }
 }
 
 void Geometry::compute_face_normals() {
