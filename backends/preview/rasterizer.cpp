@@ -1210,6 +1210,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // studio planes are shaded every 8 pixels: their light, soft shadows included, does not bend
   // over that span, and the green screen and the turntable fill most of a frame.
   const bool coarse_corners = use_blocks && 2 * kBlock / fx <= 1.5e-3f;
+  // Where 16 pixels subtend under 2.5 mrad, the plane is first shaded every 16 pixels; a 16 px
+  // cell whose four corners agree within kWideCellTolerance (relative, per channel) is
+  // interpolated from them, any other is shaded every 8 pixels as above. Light falling off over a
+  // plane changes far less than that across 16 px; a shadow edge or a penumbra changes more.
+  const bool wide_corners = coarse_corners && 4 * kBlock / fx <= 2.5e-3f;
+  constexpr float kWideCellTolerance = 0.01f;
   rasterize_tiles<kSamples>(
       setup, canvas,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
@@ -1431,7 +1437,22 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             auto plane_corner = [&](auto&& self, int cx, int cy) -> Vector3f {
               const int slot = cy * kCorners + cx;
               if (corner_plane[slot] != plane.source) {
-                if (coarse_corners && (cx % 2 || cy % 2)) {
+                if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
+                  const int ax = cx - cx % 4, bx2 = std::min(ax + 4, kCorners - 1);
+                  const int ay = cy - cy % 4, by2 = std::min(ay + 4, kCorners - 1);
+                  const Vector3f c00 = self(self, ax, ay), c10 = self(self, bx2, ay);
+                  const Vector3f c01 = self(self, ax, by2), c11 = self(self, bx2, by2);
+                  const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
+                  const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
+                  if (((hi - lo).array() <= kWideCellTolerance * hi.array()).all()) {
+                    const float tx = (cx % 4) / 4.0f, ty = (cy % 4) / 4.0f;
+                    corner_color[slot] =
+                        (1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11);
+                  } else {
+                    corner_color[slot] = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
+                                                        static_cast<float>(y0 + kBlock * cy));
+                  }
+                } else if (coarse_corners && (cx % 2 || cy % 2)) {
                   const int ax = cx - cx % 2, bx2 = cx + cx % 2;
                   const int ay = cy - cy % 2, by2 = cy + cy % 2;
                   corner_color[slot] = 0.25f * (self(self, ax, ay) + self(self, bx2, ay) +
