@@ -276,5 +276,50 @@ TEST(DslrDiffraction, GaussianWidthFollowsTheFNumber) {
   EXPECT_LT(diffraction_edge_width(small_sensor_camera(2.8)), 1.0);
 }
 
+// The blur is one pass over bands of rows with a ring of blurred rows; it must equal the plain
+// separable Gaussian with clamped borders, on a frame whose height is not a multiple of the bands
+// and whose width is under the kernel's reach at the edges.
+TEST(DslrDiffraction, BandedPassEqualsTheSeparableGaussian) {
+  const ir::Camera camera = small_sensor_camera(64);
+  Intrinsics canvas = sensor_intrinsics(camera, 1.0);
+  for (const auto& [w, h] : {std::pair{37, 203}, std::pair{9, 5}}) {
+    canvas.width = w;
+    canvas.height = h;
+    std::vector<float> rgb(3 * static_cast<std::size_t>(w) * h);
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+      rgb[i] = static_cast<float>((i * 2654435761u) % 1000) / 10;
+    }
+    const std::vector<float> input = rgb;
+    std::vector<float> scratch;
+    const double sigma = apply_diffraction(camera, canvas, rgb, scratch);
+    ASSERT_GT(sigma, 2.0);
+    const int radius = static_cast<int>(std::ceil(3 * sigma));
+    std::vector<double> kernel(2 * radius + 1);
+    double total = 0;
+    for (int k = -radius; k <= radius; ++k) {
+      total += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+    }
+    double worst = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          double expected = 0;
+          for (int dy = -radius; dy <= radius; ++dy) {
+            for (int dx = -radius; dx <= radius; ++dx) {
+              const int xs = std::clamp(x + dx, 0, w - 1), ys = std::clamp(y + dy, 0, h - 1);
+              expected += kernel[dx + radius] * kernel[dy + radius] *
+                          input[3 * (static_cast<std::size_t>(ys) * w + xs) + c];
+            }
+          }
+          expected /= total * total;
+          worst = std::max(worst,
+                           std::abs(rgb[3 * (static_cast<std::size_t>(y) * w + x) + c] - expected));
+        }
+      }
+    }
+    EXPECT_LT(worst, 1e-3) << w << " x " << h;
+  }
+}
+
 }  // namespace
 }  // namespace rigc::dslr
