@@ -69,7 +69,8 @@ namespace {
 const std::vector<std::uint16_t>& srgb_table(int bits) {
   auto build = [](int index_bits, double out_max) {
     const int size = 1 << index_bits;
-    std::vector<std::uint16_t> table(size);
+    // One entry of padding past the end: a vector gather reads entries as 32-bit words.
+    std::vector<std::uint16_t> table(size + 1, 0);
     for (int i = 0; i < size; ++i) {
       table[i] =
           static_cast<std::uint16_t>(std::lround(srgb_oetf(double(i) / (size - 1)) * out_max));
@@ -87,20 +88,24 @@ const std::vector<std::uint16_t>& srgb_table(int bits) {
 
 }  // namespace
 
+SrgbEncoding srgb_encoding(const std::array<double, 3>& gains, int bits) {
+  const std::vector<std::uint16_t>& table = srgb_table(bits);
+  SrgbEncoding encoding;
+  encoding.table = table.data();
+  encoding.last = static_cast<float>(table.size() - 2);  // the last entry is padding
+  for (int c = 0; c < 3; ++c) encoding.scaled_gain[c] = float(gains[c] * encoding.last);
+  return encoding;
+}
+
 std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
                                        const std::array<double, 3>& gains, int bits) {
-  const std::vector<std::uint16_t>& table = srgb_table(bits);
-  const float last = static_cast<float>(table.size() - 1);
-  const float g[3] = {float(gains[0] * last), float(gains[1] * last), float(gains[2] * last)};
+  const SrgbEncoding encode = srgb_encoding(gains, bits);
   std::vector<std::uint16_t> out = take_words(linear.size());  // every value is written
   const std::size_t n = linear.size() / 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t p = range.begin(); p < range.end(); ++p) {
-                        for (int c = 0; c < 3; ++c) {
-                          const float x = std::clamp(linear[3 * p + c] * g[c], 0.0f, last);
-                          out[3 * p + c] = table[static_cast<std::size_t>(x + 0.5f)];
-                        }
+                        for (int c = 0; c < 3; ++c) out[3 * p + c] = encode(linear[3 * p + c], c);
                       }
                     });
   return out;

@@ -1,6 +1,7 @@
 // Development of the sensor signal into an image file's pixels: white balance, tone curve, sRGB.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -31,5 +32,19 @@ double srgb_oetf(double linear);
 // curve: previews look about 3/4 stop darker than in-camera JPEGs, but stay linear to invert.
 std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
                                        const std::array<double, 3>& gains, int bits);
+
+// encode_srgb for one value of colour channel c (0, 1, 2), for a stage that fuses the encoding
+// into its own pass: the same table and gains, so the same codes.
+struct SrgbEncoding {
+  // table[0 .. last], and one entry more that may be read but is never used.
+  const std::uint16_t* table = nullptr;
+  float last = 0;                      // the table's last index
+  std::array<float, 3> scaled_gain{};  // gain x last, per channel
+  std::uint16_t operator()(float value, int channel) const {
+    const float x = std::clamp(value * scaled_gain[channel], 0.0f, last);
+    return table[static_cast<std::size_t>(x + 0.5f)];
+  }
+};
+SrgbEncoding srgb_encoding(const std::array<double, 3>& gains, int bits);
 
 }  // namespace rigc::dslr

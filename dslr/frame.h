@@ -46,6 +46,9 @@ struct ShotParams {
   // Whether DevelopResult::depth_m is wanted (a writer of images only does not need it: at full
   // resolution it is 80 MB and a tenth of the distortion stage).
   bool sensor_depth = true;
+  // Whether DevelopResult::linear is wanted. Without it, and with a fixed white balance, the
+  // sensor and the encoding run as one pass (the full-size linear image is never written).
+  bool keep_linear = true;
 };
 
 // Wall-clock milliseconds spent in each stage of develop_frame.

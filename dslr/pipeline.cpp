@@ -84,16 +84,30 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
   }
   result.timings.distortion_ms = clock.lap_ms();
 
-  apply_sensor(camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index);
-  result.timings.noise_ms = clock.lap_ms();
-
   result.width = sensor.width;
   result.height = sensor.height;
   result.bits = output_bits(camera);
-  const auto gains = white_balance_gains(camera, image.rgb, image.mask);
-  result.white_balance_gains = gains;
-  result.encoded = encode_srgb(image.rgb, gains, result.bits);
-  result.linear = std::move(image.rgb);
+  if (!shot.keep_linear && camera.white_balance == ir::WhiteBalanceMode::kKelvin) {
+    // The gains do not depend on the image: noise and encoding in one pass (timed as noise).
+    const auto gains = white_balance_gains(camera, {}, {});
+    result.white_balance_gains = gains;
+    result.encoded =
+        apply_sensor_and_encode(camera, sensor.width, sensor.height, image.rgb, shot.seed,
+                                shot.shot_index, srgb_encoding(gains, result.bits));
+    recycle(std::move(image.rgb));
+    result.timings.noise_ms = clock.lap_ms();
+  } else {
+    apply_sensor(camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index);
+    result.timings.noise_ms = clock.lap_ms();
+    const auto gains = white_balance_gains(camera, image.rgb, image.mask);
+    result.white_balance_gains = gains;
+    result.encoded = encode_srgb(image.rgb, gains, result.bits);
+    if (shot.keep_linear) {
+      result.linear = std::move(image.rgb);
+    } else {
+      recycle(std::move(image.rgb));
+    }
+  }
   result.mask = std::move(image.mask);
   result.depth_m = std::move(image.depth_m);
   result.timings.develop_ms = clock.lap_ms();

@@ -146,6 +146,7 @@ inline F32x8 exp_negative8(F32x8 x) {
 // and shot. One pattern is kept: a run has one camera and one resolution.
 constexpr float kPatternStep = 1.0f / 32;
 using I8x8 = std::int8_t __attribute__((vector_size(8)));
+using U16x8 = std::uint16_t __attribute__((vector_size(16)));
 
 struct FixedPattern {
   std::uint32_t key = 0;
@@ -205,11 +206,31 @@ float normal_from_bits(std::uint32_t bits16) {
   return normal_table()[bits16 & 0xFFFF];
 }
 
-void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
-                  std::uint64_t seed, int shot_index) {
+namespace {
+
+// The sensor over `signal` (3 values per pixel), eight values per step: store(first, count, out)
+// receives values [first, first + count) as the ADC leaves them, normalised (first is a multiple
+// of eight). The store may write over the signal it came from.
+template <typename Store>
+void sensor_pass(const ir::Camera& camera, int width, int height, const float* signal,
+                 std::uint64_t seed, int shot_index, const Store& store) {
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  const std::size_t values = 3 * pixels;
   if (!camera.effects.noise) {
-    for (float& v : signal) v = std::clamp(v, 0.0f, 1.0f);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t group = range.begin(); group < range.end(); ++group) {
+            const std::size_t first = group * kNoiseLanes;
+            const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
+            F32x8 x = {};
+            std::memcpy(&x, signal + first, count * sizeof(float));
+            const F32x8 zero = {}, one = zero + 1;
+            x = x < zero ? zero : x;
+            x = x > one ? one : x;
+            store(first, count, x);
+          }
+        });
     return;
   }
   const ir::SensorNoise& model = camera.noise;
@@ -239,7 +260,6 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
   // together (one 8-lane register).
   const std::uint32_t fixed_key32 = static_cast<std::uint32_t>(fixed_key ^ (fixed_key >> 32));
   const std::uint32_t shot_key32 = static_cast<std::uint32_t>(shot_key ^ (shot_key >> 32));
-  const std::size_t values = 3 * pixels;
   const float* table = normal.data();
   const std::shared_ptr<const FixedPattern> pattern = fixed_pattern(fixed_key32, values, table);
   const std::int8_t* prnu_pattern = pattern->prnu.data();
@@ -259,7 +279,7 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           const F32x8 prnu = load_pattern(prnu_pattern + first);
           const F32x8 dsnu = load_pattern(dsnu_pattern + first);
           const F32x8 temporal = lookup(table, shot_bits & 0xFFFF);
-          float* v = signal.data() + first;
+          const float* v = signal + first;
           F32x8 x = {};
           if (count == kNoiseLanes) {
             std::memcpy(&x, v, sizeof(x));
@@ -296,14 +316,65 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
           F32x8 dn = simd::floor(electrons * dn_per_e + 0.5f);
           dn = dn < dn_low ? F32x8{} + dn_low : dn;
           dn = dn > dn_high ? F32x8{} + dn_high : dn;
-          const F32x8 out = dn * per_dn;
-          if (count == kNoiseLanes) {
-            std::memcpy(v, &out, sizeof(out));
-          } else {
-            std::memcpy(v, &out, count * sizeof(float));
-          }
+          store(first, count, dn * per_dn);
         }
       });
+}
+
+}  // namespace
+
+void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
+                  std::uint64_t seed, int shot_index) {
+  float* values = signal.data();
+  sensor_pass(camera, width, height, values, seed, shot_index,
+              [values](std::size_t first, std::size_t count, F32x8 out) {
+                if (count == kNoiseLanes) {
+                  std::memcpy(values + first, &out, sizeof(out));
+                } else {
+                  std::memcpy(values + first, &out, count * sizeof(float));
+                }
+              });
+}
+
+std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
+                                                   const std::vector<float>& signal,
+                                                   std::uint64_t seed, int shot_index,
+                                                   const SrgbEncoding& encode) {
+  std::vector<std::uint16_t> encoded = take_words(signal.size());  // every value is written
+  std::uint16_t* codes = encoded.data();
+  // Value i is channel i % 3: a group starting at value `first` has the gains of phase first % 3.
+  std::array<F32x8, 3> gains;
+  for (int phase = 0; phase < 3; ++phase) {
+    for (int k = 0; k < kNoiseLanes; ++k) gains[phase][k] = encode.scaled_gain[(phase + k) % 3];
+  }
+  const std::uint16_t* table = encode.table;
+  const float last = encode.last;
+  sensor_pass(camera, width, height, signal.data(), seed, shot_index,
+              [codes, table, last, &gains](std::size_t first, std::size_t count, F32x8 out) {
+                // SrgbEncoding's arithmetic, eight values at once.
+                const F32x8 zero = {};
+                F32x8 x = out * gains[first % 3];
+                x = x > zero ? x : zero;
+                x = x < last ? x : zero + last;
+                const I32x8 index = __builtin_convertvector(x + 0.5f, I32x8);
+                if (count < kNoiseLanes) {
+                  for (std::size_t k = 0; k < count; ++k) codes[first + k] = table[index[k]];
+                  return;
+                }
+#if defined(__AVX2__)
+                // Entries read as 32-bit words at 2-byte steps (the table has a padding entry),
+                // the high half dropped.
+                const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(table),
+                                                             reinterpret_cast<__m256i>(index), 2);
+                const auto low = reinterpret_cast<U32x8>(words) & 0xFFFFu;
+                const U16x8 code = __builtin_convertvector(low, U16x8);
+#else
+                U16x8 code;
+                for (int k = 0; k < kNoiseLanes; ++k) code[k] = table[index[k]];
+#endif
+                std::memcpy(codes + first, &code, sizeof code);
+              });
+  return encoded;
 }
 
 }  // namespace rigc::dslr

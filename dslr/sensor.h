@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "compiler/ir.h"
+#include "dslr/develop.h"
 
 namespace rigc::dslr {
 
@@ -38,5 +39,13 @@ float normal_from_bits(std::uint32_t bits16);
 // on `shot_index`. With camera.effects.noise off the signal is only clipped to [0, 1].
 void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
                   std::uint64_t seed, int shot_index);
+
+// apply_sensor and then `encode` (white balance and sRGB, see encode_srgb) in one pass, for a
+// caller that keeps only the encoded image: the same codes, without writing the noisy signal
+// back. `signal` is left as it was.
+std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
+                                                   const std::vector<float>& signal,
+                                                   std::uint64_t seed, int shot_index,
+                                                   const SrgbEncoding& encode);
 
 }  // namespace rigc::dslr

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "dslr/develop.h"
 #include "dslr/exposure.h"
 #include "dslr/pipeline.h"
 #include "dslr/test_helpers.h"
@@ -41,6 +42,44 @@ ir::Camera noisy_6d(double iso) {
   camera.effects.noise = true;
   camera.iso = iso;
   return camera;
+}
+
+// The fused pass of a run that keeps only the encoded image gives the codes of the two stages
+// run one after the other: noise on and off, at 8 and 16 bits, with a value count that ends in a
+// partial group of eight, and through develop_frame.
+TEST(DslrNoise, SensorAndEncodingInOnePassGiveTheSameCodes) {
+  ir::Camera camera = canon_6d();
+  const int width = 101, height = 7;  // 2121 values: not a multiple of eight
+  std::vector<float> signal(3 * width * height);
+  for (std::size_t i = 0; i < signal.size(); ++i) {
+    signal[i] = static_cast<float>((i * 2654435761u) % 1200) / 1000 - 0.05f;  // past both ends
+  }
+  const std::array<double, 3> gains = {2.1, 1.0, 1.4};
+  for (const bool noise : {true, false}) {
+    for (const int bits : {8, 16}) {
+      camera.effects.noise = noise;
+      std::vector<float> two_stages = signal;
+      apply_sensor(camera, width, height, two_stages, 5, 3);
+      const std::vector<std::uint16_t> expected = encode_srgb(two_stages, gains, bits);
+      const std::vector<float> before = signal;
+      const std::vector<std::uint16_t> fused =
+          apply_sensor_and_encode(camera, width, height, signal, 5, 3, srgb_encoding(gains, bits));
+      EXPECT_EQ(fused, expected) << "noise " << noise << ", " << bits << " bits";
+      EXPECT_EQ(signal, before);
+    }
+  }
+  camera.effects.noise = true;
+  camera.white_balance = ir::WhiteBalanceMode::kKelvin;  // gains fixed before the image exists
+  camera.white_balance_k = 4300;
+  const LinearFrame frame = flat_frame(sensor_intrinsics(camera, 0.05), 400.0, 1.0f);
+  ShotParams kept, dropped;
+  dropped.keep_linear = false;
+  const DevelopResult a = develop_frame(camera, frame, kept, 0.05);
+  const DevelopResult b = develop_frame(camera, frame, dropped, 0.05);
+  EXPECT_FALSE(a.linear.empty());
+  EXPECT_TRUE(b.linear.empty());
+  EXPECT_EQ(a.encoded, b.encoded);
+  EXPECT_GT(a.encoded[0], 20);  // not black
 }
 
 TEST(DslrNoise, ReadNoiseIsInterpolatedInLogIso) {

@@ -52,7 +52,8 @@ int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, con
 
 dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
                                 const ir::Shot& shot, double scale, std::uint64_t seed,
-                                ShotTiming* timing, dslr::LinearFrame* linear_out) {
+                                ShotTiming* timing, dslr::LinearFrame* linear_out,
+                                bool keep_linear) {
   const auto start = Clock::now();
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   FrameRequest request;
@@ -86,6 +87,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
   params.shot_index = shot.index;
   params.seed = seed;
   params.sensor_depth = false;  // only the image and the mask are written
+  params.keep_linear = keep_linear;
   dslr::DevelopResult result = dslr::develop_frame(scene.camera, std::move(frame), params, scale);
   if (timing) {
     timing->raster = raster;
@@ -199,12 +201,9 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     }
     ShotTiming timing;
     dslr::DevelopResult result =
-        render_shot(scene, studio, shot, options.scale, options.seed, &timing);
+        render_shot(scene, studio, shot, options.scale, options.seed, &timing, nullptr, false);
     finish_pending();
     if (manifest_failed) return 2;
-    // Only the encoded pixels and the mask are written; the rest goes back to the pool for the
-    // next shot.
-    dslr::recycle(std::move(result.linear));
     PendingWrite write;
     write.shot = &shot;
     write.key = key;

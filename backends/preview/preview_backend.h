@@ -30,11 +30,12 @@ struct ShotTiming {
   bool skipped = false;  // already in the manifest with the same inputs
 };
 
-// Renders one shot to developed pixels (no files). For tests and benchmarks.
+// Renders one shot to developed pixels (no files). For tests and benchmarks. Without
+// `keep_linear` the result's linear image is left empty (what a run that writes files does).
 dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
                                 const ir::Shot& shot, double scale, std::uint64_t seed,
                                 ShotTiming* timing = nullptr,
-                                dslr::LinearFrame* linear_out = nullptr);
+                                dslr::LinearFrame* linear_out = nullptr, bool keep_linear = true);
 
 // The number of sub-frames motion blur needs for a shot (1 when there is no motion).
 int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
