@@ -102,10 +102,16 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
 
   if (eight_bits) {
     std::vector<std::uint8_t> pixels = take_bytes(values);  // every value is written
-    const int shift = result.bits == 8 ? 0 : 1;
-    for (std::size_t i = 0; i < values; ++i) {
-      pixels[i] = static_cast<std::uint8_t>(shift ? (result.encoded[i] * 255u + 32767u) / 65535u
-                                                  : result.encoded[i]);
+    // Plain pointers and one loop per case: stores through a byte pointer may alias anything,
+    // so indexing the vectors reloads their data pointers on every value and nothing vectorises.
+    const std::uint16_t* codes = result.encoded.data();
+    std::uint8_t* bytes = pixels.data();
+    if (result.bits == 8) {
+      for (std::size_t i = 0; i < values; ++i) bytes[i] = static_cast<std::uint8_t>(codes[i]);
+    } else {
+      for (std::size_t i = 0; i < values; ++i) {
+        bytes[i] = static_cast<std::uint8_t>((codes[i] * 255u + 32767u) / 65535u);
+      }
     }
     const bool written = write_atomically(path, spec, pixels.data(), error);
     recycle(std::move(pixels));

@@ -60,6 +60,39 @@ TEST(DslrWrite, JpegCarriesTheExifACameraWouldWrite) {
   EXPECT_NEAR(pixels[0], image.encoded[0], 3);  // JPEG at quality 95
 }
 
+// A JPEG holds 8-bit codes: an 8-bit result's codes as they are, a 16-bit one's scaled down
+// (65535 -> 255). A smooth ramp survives quality 100 within a code or two.
+TEST(DslrWrite, JpegPixelsAreTheEightBitCodes) {
+  rigc::testing::TempDir dir;
+  ir::Camera camera = canon_6d();
+  camera.jpeg_quality = 100;
+  for (const int bits : {8, 16}) {
+    DevelopResult image;
+    image.width = 64;
+    image.height = 16;
+    image.bits = bits;
+    image.encoded.resize(3 * 64 * 16);
+    std::vector<int> expected(image.encoded.size());
+    for (std::size_t i = 0; i < image.encoded.size(); ++i) {
+      const int code = static_cast<int>(40 + 2 * ((i / 3) % 64) + 10 * (i % 3));
+      expected[i] = code;
+      image.encoded[i] = static_cast<std::uint16_t>(bits == 8 ? code : code * 256 + 128);
+    }
+    const std::string path = dir.file("ramp" + std::to_string(bits) + ".jpg");
+    std::string error;
+    ASSERT_TRUE(write_image(path, image, camera, &error)) << error;
+    auto in = OIIO::ImageInput::open(path);
+    ASSERT_TRUE(in);
+    std::vector<std::uint8_t> pixels(image.encoded.size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+    int worst = 0;
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      worst = std::max(worst, std::abs(pixels[i] - expected[i]));
+    }
+    EXPECT_LE(worst, 3) << bits << " bits";
+  }
+}
+
 TEST(DslrWrite, Png16KeepsEveryCodeValue) {
   rigc::testing::TempDir dir;
   ir::Camera camera = canon_6d();
