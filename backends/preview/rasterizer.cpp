@@ -653,9 +653,12 @@ inline void store4(std::int32_t* p, Int4 v) {
 // Four samples are tested at once: a pixel's four, or four neighbouring pixel centres. Each lane
 // evaluates the planes with the same expression as a scalar pass would, so coverage and depth
 // ties come out the same.
-template <int Samples, typename ResolveTile>
+// uniform_tile(x0, y0, x1, y1, id) is offered each tile that one triangle covers whole while
+// the rest of its bin misses it (the studio's big planes); returning true, it has written the
+// tile itself and the samples are skipped.
+template <int Samples, typename UniformTile, typename ResolveTile>
 void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
-                     const ResolveTile& resolve_tile) {
+                     const UniformTile& uniform_tile, const ResolveTile& resolve_tile) {
   static_assert(Samples == 1 || Samples == kSamples);
   static_assert(kTileSize % 4 == 0);
   // Lane offsets from the pixel (Samples 4) or from the first of four pixels (Samples 1).
@@ -680,6 +683,35 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
           const int x0 = tx * kTileSize, y0 = ty * kTileSize;
           const int x1 = std::min(x0 + kTileSize, canvas.width);
           const int y1 = std::min(y0 + kTileSize, canvas.height);
+          {
+            // Each triangle against the box of the tile's samples: inside all three edges at
+            // the four corners (covers), outside one edge at all four (misses), or neither.
+            // The planes are affine, so the corners decide; a margin keeps rounding out.
+            constexpr float kMargin = 1e-4f;
+            const float bx0 = x0 + (Samples == 1 ? 0.5f : 0.125f);
+            const float bx1 = x1 - 1 + (Samples == 1 ? 0.5f : 0.875f);
+            const float by0 = y0 + (Samples == 1 ? 0.5f : 0.125f);
+            const float by1 = y1 - 1 + (Samples == 1 ? 0.5f : 0.875f);
+            const Float4 cx = {bx0, bx1, bx0, bx1}, cy = {by0, by0, by1, by1};
+            std::int32_t covering = -1;
+            bool uniform = true;
+            for (std::int32_t i = setup.tile_start[tile]; i < setup.tile_start[tile + 1]; ++i) {
+              const ScreenTriangle& s = setup.tris[setup.tile_tris[i]];
+              const Float4 w0 = s.w0_plane[0] * cx + s.w0_plane[1] * cy + s.w0_plane[2];
+              const Float4 w1 = s.w1_plane[0] * cx + s.w1_plane[1] * cy + s.w1_plane[2];
+              const Float4 w2 = 1 - (w0 + w1);
+              const Int4 in = (w0 >= kMargin) & (w1 >= kMargin) & (w2 >= kMargin);
+              const Int4 out0 = w0 < -kMargin, out1 = w1 < -kMargin, out2 = w2 < -kMargin;
+              auto all = [](Int4 m) { return m[0] && m[1] && m[2] && m[3]; };
+              if (all(out0) || all(out1) || all(out2)) continue;  // misses
+              if (!all(in) || covering >= 0) {
+                uniform = false;
+                break;
+              }
+              covering = setup.tile_tris[i];
+            }
+            if (uniform && covering >= 0 && uniform_tile(x0, y0, x1, y1, covering)) continue;
+          }
           std::fill(std::begin(sample_inv_z), std::end(sample_inv_z), 0.0f);
           std::fill(std::begin(sample_tri), std::end(sample_tri), -1);
           const std::int32_t* bin = setup.tile_tris.data();
@@ -792,7 +824,7 @@ template <int Samples, typename Resolve>
 void rasterize_pixels(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                       const Resolve& resolve) {
   rasterize_tiles<Samples>(
-      setup, canvas,
+      setup, canvas, [](int, int, int, int, std::int32_t) { return false; },
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         for (int py = y0; py < y1; ++py) {
           for (int px = x0; px < x1; ++px) {
@@ -1216,8 +1248,97 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // plane changes far less than that across 16 px; a shadow edge or a penumbra changes more.
   const bool wide_corners = coarse_corners && 4 * kBlock / fx <= 2.5e-3f;
   constexpr float kWideCellTolerance = 0.01f;
+  // Radiance at the corners of a tile's 4 x 4 blocks on a plain studio plane, cached per tile
+  // and plane. On the plane: unclamped barycentrics reach past the triangle's edges along it.
+  struct PlaneCorners {
+    std::array<Vector3f, kCorners * kCorners> color;
+    std::array<std::int32_t, kCorners * kCorners> plane;  // source triangle, -1: not yet
+    PlaneCorners() { plane.fill(-1); }
+  };
+  // Corner (cx, cy) of the grid of the tile at (x0, y0). With coarse corners only the even ones
+  // are shaded and odd ones are the mean of their even neighbours; with wide corners the even
+  // ones come from the 16 px cell's corners where those agree.
+  auto plane_corner_of = [&](auto&& self, PlaneCorners& cache, const ScreenTriangle& plane, int x0,
+                             int y0, int cx, int cy) -> Vector3f {
+    const int slot = cy * kCorners + cx;
+    if (cache.plane[slot] == plane.source) return cache.color[slot];
+    auto at = [&](int ax, int ay) { return self(self, cache, plane, x0, y0, ax, ay); };
+    Vector3f color;
+    if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
+      const int ax = cx - cx % 4, bx = std::min(ax + 4, kCorners - 1);
+      const int ay = cy - cy % 4, by = std::min(ay + 4, kCorners - 1);
+      const Vector3f c00 = at(ax, ay), c10 = at(bx, ay), c01 = at(ax, by), c11 = at(bx, by);
+      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
+      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
+      if (((hi - lo).array() <= kWideCellTolerance * hi.array()).all()) {
+        const float tx = (cx % 4) / 4.0f, ty = (cy % 4) / 4.0f;
+        color = (1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11);
+      } else {
+        color = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
+                               static_cast<float>(y0 + kBlock * cy));
+      }
+    } else if (coarse_corners && (cx % 2 || cy % 2)) {
+      const int ax = cx - cx % 2, bx = cx + cx % 2;
+      const int ay = cy - cy % 2, by = cy + cy % 2;
+      color = 0.25f * (at(ax, ay) + at(bx, ay) + at(ax, by) + at(bx, by));
+    } else {
+      color = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
+                             static_cast<float>(y0 + kBlock * cy));
+    }
+    cache.plane[slot] = plane.source;
+    cache.color[slot] = color;
+    return color;
+  };
+  auto plane_corner = [&](PlaneCorners& cache, const ScreenTriangle& plane, int x0, int y0, int cx,
+                          int cy) {
+    return plane_corner_of(plane_corner_of, cache, plane, x0, y0, cx, cy);
+  };
+  // A tile inside one plain studio triangle that nothing else in its bin touches: every sample
+  // is that plane, so the tile is its blocks' interpolated corners, the depth the plane's
+  // nearest sample per pixel and the mask empty, without the per-sample buffers.
+  auto plain_studio_tile = [&](int x0, int y0, int x1, int y1, std::int32_t id) -> bool {
+    const ScreenTriangle& plane = screen_tris[id];
+    if (!use_blocks || !plain_studio(plane)) return false;
+    PlaneCorners cache;
+    for (int py = y0; py < y1; ++py) {
+      const int cy = (py - y0) / kBlock;
+      const float fy = ((py - y0) % kBlock + 0.5f) / kBlock;
+      float* rgb = &frame.rgb[3 * (static_cast<std::size_t>(py) * canvas.width + x0)];
+      float* depth = &frame.depth_m[static_cast<std::size_t>(py) * canvas.width + x0];
+      std::fill_n(&frame.mask[static_cast<std::size_t>(py) * canvas.width + x0], x1 - x0, 0);
+      // The samples' depth rows, as the visibility pass computes them.
+      std::array<float, kSamples> iz_row;
+      for (int k = 0; k < kSamples; ++k) {
+        iz_row[k] = plane.inv_z_plane[1] * (static_cast<float>(py) + kSampleY[k]);
+      }
+      for (int bx = x0; bx < x1; bx += kBlock) {
+        const int cx = (bx - x0) / kBlock;
+        const Vector3f c00 = plane_corner(cache, plane, x0, y0, cx, cy);
+        const Vector3f c10 = plane_corner(cache, plane, x0, y0, cx + 1, cy);
+        const Vector3f c01 = plane_corner(cache, plane, x0, y0, cx, cy + 1);
+        const Vector3f c11 = plane_corner(cache, plane, x0, y0, cx + 1, cy + 1);
+        const Vector3f left = (1 - fy) * c00 + fy * c01, right = (1 - fy) * c10 + fy * c11;
+        for (int px = bx; px < std::min(x1, bx + kBlock); ++px) {
+          const float fx = ((px - bx) + 0.5f) / kBlock;
+          const Vector3f color = (1 - fx) * left + fx * right;
+          float* out = rgb + 3 * (px - x0);
+          out[0] = color.x();
+          out[1] = color.y();
+          out[2] = color.z();
+          float nearest = 0;
+          for (int k = 0; k < kSamples; ++k) {
+            const float sx = static_cast<float>(px) + kSampleX[k];
+            nearest =
+                std::max(nearest, plane.inv_z_plane[0] * sx + iz_row[k] + plane.inv_z_plane[2]);
+          }
+          depth[px - x0] = nearest > 0 ? 1 / nearest : std::numeric_limits<float>::infinity();
+        }
+      }
+    }
+    return true;
+  };
   rasterize_tiles<kSamples>(
-      setup, canvas,
+      setup, canvas, plain_studio_tile,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         auto at = [&](int px, int py) { return ((py - y0) * kTileSize + (px - x0)) * kSamples; };
         // 2 x 2 quads inside one surface sum the lights once, at the quad's centre, and take the
@@ -1297,10 +1418,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             shade_pixel(px, py, quad[i]);
           }
         };
-        // Corner radiance cache of the tile's blocks (NaN: not computed yet).
-        std::array<Vector3f, kCorners * kCorners> corner_color;
-        std::array<std::int32_t, kCorners * kCorners> corner_plane;
-        corner_plane.fill(-1);
+        PlaneCorners corners;
         // The object's corners: lighting (albedo applied per pixel) and shading normal.
         struct ObjectCorner {
           Lighting lighting;
@@ -1432,42 +1550,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             // Radiance at the block's corners, on the plane (unclamped barycentrics reach
             // past the triangle's edges along the plane).
             const ScreenTriangle& plane = screen_tris[plane_triangle];
-            // Corner (cx, cy) of the tile's grid, cached per plane. With coarse corners only
-            // the even ones are shaded; odd ones are the mean of their even neighbours.
-            auto plane_corner = [&](auto&& self, int cx, int cy) -> Vector3f {
-              const int slot = cy * kCorners + cx;
-              if (corner_plane[slot] != plane.source) {
-                if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
-                  const int ax = cx - cx % 4, bx2 = std::min(ax + 4, kCorners - 1);
-                  const int ay = cy - cy % 4, by2 = std::min(ay + 4, kCorners - 1);
-                  const Vector3f c00 = self(self, ax, ay), c10 = self(self, bx2, ay);
-                  const Vector3f c01 = self(self, ax, by2), c11 = self(self, bx2, by2);
-                  const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
-                  const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
-                  if (((hi - lo).array() <= kWideCellTolerance * hi.array()).all()) {
-                    const float tx = (cx % 4) / 4.0f, ty = (cy % 4) / 4.0f;
-                    corner_color[slot] =
-                        (1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11);
-                  } else {
-                    corner_color[slot] = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
-                                                        static_cast<float>(y0 + kBlock * cy));
-                  }
-                } else if (coarse_corners && (cx % 2 || cy % 2)) {
-                  const int ax = cx - cx % 2, bx2 = cx + cx % 2;
-                  const int ay = cy - cy % 2, by2 = cy + cy % 2;
-                  corner_color[slot] = 0.25f * (self(self, ax, ay) + self(self, bx2, ay) +
-                                                self(self, ax, by2) + self(self, bx2, by2));
-                } else {
-                  corner_color[slot] = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
-                                                      static_cast<float>(y0 + kBlock * cy));
-                }
-                corner_plane[slot] = plane.source;
-              }
-              return corner_color[slot];
-            };
             std::array<Vector3f, 4> corner;
             for (int k = 0; k < 4; ++k) {
-              corner[k] = plane_corner(plane_corner, (bx - x0) / kBlock + (k & 1),
+              corner[k] = plane_corner(corners, plane, x0, y0, (bx - x0) / kBlock + (k & 1),
                                        (by - y0) / kBlock + (k >> 1));
             }
             for (int i = 0; i < kBlock * kBlock; ++i) {
