@@ -1300,9 +1300,19 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     const ScreenTriangle& plane = screen_tris[id];
     if (!use_blocks || !plain_studio(plane)) return false;
     PlaneCorners cache;
+    const int columns = (x1 - x0 + kBlock - 1) / kBlock, rows = (y1 - y0 + kBlock - 1) / kBlock;
+    for (int cy = 0; cy <= rows; ++cy) {
+      for (int cx = 0; cx <= columns; ++cx) plane_corner(cache, plane, x0, y0, cx, cy);
+    }
     for (int py = y0; py < y1; ++py) {
       const int cy = (py - y0) / kBlock;
       const float fy = ((py - y0) % kBlock + 0.5f) / kBlock;
+      // The corner grid's two rows around this one, blended down to it.
+      std::array<Vector3f, kCorners> edge;
+      for (int cx = 0; cx <= columns; ++cx) {
+        edge[cx] =
+            (1 - fy) * cache.color[cy * kCorners + cx] + fy * cache.color[(cy + 1) * kCorners + cx];
+      }
       float* rgb = &frame.rgb[3 * (static_cast<std::size_t>(py) * canvas.width + x0)];
       float* depth = &frame.depth_m[static_cast<std::size_t>(py) * canvas.width + x0];
       std::fill_n(&frame.mask[static_cast<std::size_t>(py) * canvas.width + x0], x1 - x0, 0);
@@ -1311,28 +1321,20 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       for (int k = 0; k < kSamples; ++k) {
         iz_row[k] = plane.inv_z_plane[1] * (static_cast<float>(py) + kSampleY[k]);
       }
-      for (int bx = x0; bx < x1; bx += kBlock) {
-        const int cx = (bx - x0) / kBlock;
-        const Vector3f c00 = plane_corner(cache, plane, x0, y0, cx, cy);
-        const Vector3f c10 = plane_corner(cache, plane, x0, y0, cx + 1, cy);
-        const Vector3f c01 = plane_corner(cache, plane, x0, y0, cx, cy + 1);
-        const Vector3f c11 = plane_corner(cache, plane, x0, y0, cx + 1, cy + 1);
-        const Vector3f left = (1 - fy) * c00 + fy * c01, right = (1 - fy) * c10 + fy * c11;
-        for (int px = bx; px < std::min(x1, bx + kBlock); ++px) {
-          const float fx = ((px - bx) + 0.5f) / kBlock;
-          const Vector3f color = (1 - fx) * left + fx * right;
-          float* out = rgb + 3 * (px - x0);
-          out[0] = color.x();
-          out[1] = color.y();
-          out[2] = color.z();
-          float nearest = 0;
-          for (int k = 0; k < kSamples; ++k) {
-            const float sx = static_cast<float>(px) + kSampleX[k];
-            nearest =
-                std::max(nearest, plane.inv_z_plane[0] * sx + iz_row[k] + plane.inv_z_plane[2]);
-          }
-          depth[px - x0] = nearest > 0 ? 1 / nearest : std::numeric_limits<float>::infinity();
+      for (int px = x0; px < x1; ++px) {
+        const int cx = (px - x0) / kBlock;
+        const float fx = ((px - x0) % kBlock + 0.5f) / kBlock;
+        const Vector3f color = (1 - fx) * edge[cx] + fx * edge[cx + 1];
+        float* out = rgb + 3 * (px - x0);
+        out[0] = color.x();
+        out[1] = color.y();
+        out[2] = color.z();
+        float nearest = 0;
+        for (int k = 0; k < kSamples; ++k) {
+          const float sx = static_cast<float>(px) + kSampleX[k];
+          nearest = std::max(nearest, plane.inv_z_plane[0] * sx + iz_row[k] + plane.inv_z_plane[2]);
         }
+        depth[px - x0] = nearest > 0 ? 1 / nearest : std::numeric_limits<float>::infinity();
       }
     }
     return true;
