@@ -62,7 +62,9 @@ bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pi
 bool write_image(const fs::path& path, const DevelopResult& result, const ir::Camera& camera,
                  std::string* error) {
   const std::size_t values = static_cast<std::size_t>(result.width) * result.height * 3;
-  if (result.width <= 0 || result.height <= 0 || result.encoded.size() != values) {
+  const bool bytes_only = result.encoded.empty() && result.bits == 8;
+  if (result.width <= 0 || result.height <= 0 ||
+      (bytes_only ? result.encoded_bytes.size() : result.encoded.size()) != values) {
     set_error(error, "cannot write " + path.string() + ": the image is empty or malformed");
     return false;
   }
@@ -100,6 +102,7 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
     spec.attribute("Exif:FocalPlaneResolutionUnit", 3);  // centimetres
   }
 
+  if (bytes_only) return write_atomically(path, spec, result.encoded_bytes.data(), error);
   if (eight_bits) {
     std::vector<std::uint8_t> pixels = take_bytes(values);  // every value is written
     // Plain pointers and one loop per case: stores through a byte pointer may alias anything,

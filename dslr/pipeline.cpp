@@ -91,9 +91,14 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
     // The gains do not depend on the image: noise and encoding in one pass (timed as noise).
     const auto gains = white_balance_gains(camera, {}, {});
     result.white_balance_gains = gains;
-    result.encoded =
-        apply_sensor_and_encode(camera, sensor.width, sensor.height, image.rgb, shot.seed,
-                                shot.shot_index, srgb_encoding(gains, result.bits));
+    const SrgbEncoding encoding = srgb_encoding(gains, result.bits);
+    if (result.bits == 8) {
+      result.encoded_bytes = apply_sensor_and_encode_bytes(
+          camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index, encoding);
+    } else {
+      result.encoded = apply_sensor_and_encode(camera, sensor.width, sensor.height, image.rgb,
+                                               shot.seed, shot.shot_index, encoding);
+    }
     recycle(std::move(image.rgb));
     result.timings.noise_ms = clock.lap_ms();
   } else {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <numbers>
+#include <type_traits>
 
 #include "compiler/hash.h"
 #include "dslr/buffer_pool.h"
@@ -336,12 +337,22 @@ void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<f
               });
 }
 
-std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
-                                                   const std::vector<float>& signal,
-                                                   std::uint64_t seed, int shot_index,
-                                                   const SrgbEncoding& encode) {
-  std::vector<std::uint16_t> encoded = take_words(signal.size());  // every value is written
-  std::uint16_t* codes = encoded.data();
+namespace {
+
+// apply_sensor_and_encode for codes of type Code (std::uint16_t, or std::uint8_t for 8-bit
+// tables).
+template <typename Code>
+std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int height,
+                                    const std::vector<float>& signal, std::uint64_t seed,
+                                    int shot_index, const SrgbEncoding& encode) {
+  // From the pool (a writer hands it back); every value is written.
+  std::vector<Code> encoded;
+  if constexpr (sizeof(Code) == 1) {
+    encoded = take_bytes(signal.size());
+  } else {
+    encoded = take_words(signal.size());
+  }
+  Code* codes = encoded.data();
   // Value i is channel i % 3: a group starting at value `first` has the gains of phase first % 3.
   std::array<F32x8, 3> gains;
   for (int phase = 0; phase < 3; ++phase) {
@@ -358,23 +369,50 @@ std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int
                 x = x < last ? x : zero + last;
                 const I32x8 index = __builtin_convertvector(x + 0.5f, I32x8);
                 if (count < kNoiseLanes) {
-                  for (std::size_t k = 0; k < count; ++k) codes[first + k] = table[index[k]];
+                  for (std::size_t k = 0; k < count; ++k) {
+                    codes[first + k] = static_cast<Code>(table[index[k]]);
+                  }
                   return;
                 }
 #if defined(__AVX2__)
                 // Entries read as 32-bit words at 2-byte steps (the table has a padding entry),
-                // the high half dropped.
-                const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(table),
-                                                             reinterpret_cast<__m256i>(index), 2);
-                const auto low = reinterpret_cast<U32x8>(words) & 0xFFFFu;
-                const U16x8 code = __builtin_convertvector(low, U16x8);
+                // the high half dropped, then packed down to the code's width.
+                const __m256i words =
+                    _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(table),
+                                                            reinterpret_cast<__m256i>(index), 2),
+                                     _mm256_set1_epi32(0xFFFF));
+                const __m128i codes16 = _mm_packus_epi32(_mm256_castsi256_si128(words),
+                                                         _mm256_extracti128_si256(words, 1));
+                if constexpr (sizeof(Code) == 1) {
+                  _mm_storel_epi64(reinterpret_cast<__m128i*>(codes + first),
+                                   _mm_packus_epi16(codes16, codes16));
+                } else {
+                  _mm_storeu_si128(reinterpret_cast<__m128i*>(codes + first), codes16);
+                }
 #else
-                U16x8 code;
-                for (int k = 0; k < kNoiseLanes; ++k) code[k] = table[index[k]];
+                for (int k = 0; k < kNoiseLanes; ++k) {
+                  codes[first + k] = static_cast<Code>(table[index[k]]);
+                }
 #endif
-                std::memcpy(codes + first, &code, sizeof code);
               });
   return encoded;
+}
+
+}  // namespace
+
+std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
+                                                   const std::vector<float>& signal,
+                                                   std::uint64_t seed, int shot_index,
+                                                   const SrgbEncoding& encode) {
+  return sensor_and_encode<std::uint16_t>(camera, width, height, signal, seed, shot_index, encode);
+}
+
+std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera, int width,
+                                                        int height,
+                                                        const std::vector<float>& signal,
+                                                        std::uint64_t seed, int shot_index,
+                                                        const SrgbEncoding& encode) {
+  return sensor_and_encode<std::uint8_t>(camera, width, height, signal, seed, shot_index, encode);
 }
 
 }  // namespace rigc::dslr

@@ -47,5 +47,11 @@ std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int
                                                    const std::vector<float>& signal,
                                                    std::uint64_t seed, int shot_index,
                                                    const SrgbEncoding& encode);
+// The same for an 8-bit encoding (srgb_encoding(gains, 8)): one byte per value.
+std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera, int width,
+                                                        int height,
+                                                        const std::vector<float>& signal,
+                                                        std::uint64_t seed, int shot_index,
+                                                        const SrgbEncoding& encode);
 
 }  // namespace rigc::dslr

@@ -216,13 +216,14 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
          result = std::move(result)]() mutable -> WriteOutcome {
           const auto start = Clock::now();
           WriteOutcome outcome;
-          if (result.encoded.empty()) {
+          if (result.encoded.empty() && result.encoded_bytes.empty()) {
             outcome.error = "the DSLR model produced no image";
           } else if (dslr::write_image(run_dir / image, result, scene.camera, &outcome.error)) {
             dslr::write_mask(run_dir / mask, result.mask, result.width, result.height,
                              &outcome.error);
           }
           dslr::recycle(std::move(result.encoded));
+          dslr::recycle(std::move(result.encoded_bytes));
           dslr::recycle(std::move(result.mask));
           outcome.ms = ms_since(start);
           return outcome;
