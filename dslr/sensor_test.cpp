@@ -156,6 +156,28 @@ TEST(DslrNoise, SmallSignalsArePoisson) {
   EXPECT_NEAR(static_cast<double>(zeros) / linear.size(), std::exp(-5.0), 0.002);
 }
 
+// Where the read noise is several electrons (base ISO), small signals take the skew-corrected
+// Gaussian too: the sum's mean and variance must still be the Poisson law's plus the read
+// noise's, and no value may be held at zero.
+TEST(DslrNoise, SmallSignalsUnderReadNoiseKeepTheirMeanAndVariance) {
+  ir::Camera camera = noisy_6d(200);
+  camera.noise.prnu = 0;
+  camera.noise.dsnu_e = 0;
+  const double read = read_noise_electrons(camera.noise, 200);
+  ASSERT_GT(read, 4);  // above the exact draw's limit
+  const double fwc = 79546.0 / 2;
+  const double dark = camera.noise.dark_current_e_per_s * camera.shutter_s;
+  for (const double electrons : {0.3, 3.0, 9.0}) {
+    const std::vector<float> linear = flat_patch(camera, electrons / fwc).linear;
+    const Stats s = stats(linear, fwc);
+    const double lsb = fwc / (std::pow(2.0, camera.noise.adc_bits) - 1);
+    const double variance = electrons + dark + read * read + lsb * lsb / 12;
+    // The mean of n draws varies by sqrt(variance / n); the variance's by about 2 %.
+    EXPECT_NEAR(s.mean, electrons + dark, 4 * std::sqrt(variance / linear.size())) << electrons;
+    EXPECT_NEAR(s.std * s.std, variance, 0.03 * variance) << electrons;
+  }
+}
+
 TEST(DslrNoise, ModerateSignalsKeepThePoissonSkew) {
   // 20 electrons: drawn from a skew-corrected Gaussian, whose variance and third moment must
   // still be the Poisson law's (mean 20, variance 20, skewness 1/sqrt(20) = 0.224).
