@@ -215,6 +215,20 @@ float normal_from_bits(std::uint32_t bits16) {
 
 namespace {
 
+// fn(first, count) for each group of up to kNoiseLanes values [first, first + count) of
+// [0, values), in parallel; first is a multiple of kNoiseLanes.
+template <typename Fn>
+void for_each_group(std::size_t values, const Fn& fn) {
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t group = range.begin(); group < range.end(); ++group) {
+          const std::size_t first = group * kNoiseLanes;
+          fn(first, std::min<std::size_t>(kNoiseLanes, values - first));
+        }
+      });
+}
+
 // The sensor over `signal` (3 values per pixel), eight values per step: store(first, count, out)
 // receives values [first, first + count) as the ADC leaves them, normalised (first is a multiple
 // of eight). The store may write over the signal it came from.
@@ -224,20 +238,14 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   const std::size_t values = 3 * pixels;
   if (!camera.effects.noise) {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t group = range.begin(); group < range.end(); ++group) {
-            const std::size_t first = group * kNoiseLanes;
-            const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
-            F32x8 x = {};
-            std::memcpy(&x, signal + first, count * sizeof(float));
-            const F32x8 zero = {}, one = zero + 1;
-            x = x < zero ? zero : x;
-            x = x > one ? one : x;
-            store(first, count, x);
-          }
-        });
+    for_each_group(values, [&](std::size_t first, std::size_t count) {
+      F32x8 x = {};
+      std::memcpy(&x, signal + first, count * sizeof(float));
+      const F32x8 zero = {}, one = zero + 1;
+      x = x < zero ? zero : x;
+      x = x > one ? one : x;
+      store(first, count, x);
+    });
     return;
   }
   const ir::SensorNoise& model = camera.noise;
@@ -277,57 +285,50 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const float exact_below =
       read_f < kExactPoissonMaxReadNoise ? static_cast<float>(kExactPoissonBelow) : 0.0f;
   const std::uint32_t uniform_key32 = static_cast<std::uint32_t>(uniform_key ^ (uniform_key >> 32));
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t group = range.begin(); group < range.end(); ++group) {
-          const std::size_t first = group * kNoiseLanes;
-          const std::size_t count = std::min<std::size_t>(kNoiseLanes, values - first);
-          const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
-          const U32x8 shot_bits = lowbias32(index ^ shot_key32);
-          const F32x8 prnu = load_pattern(prnu_pattern + first);
-          const F32x8 dsnu = load_pattern(dsnu_pattern + first);
-          const F32x8 temporal = lookup(table, shot_bits & 0xFFFF);
-          const float* v = signal + first;
-          F32x8 x = {};
-          if (count == kNoiseLanes) {
-            std::memcpy(&x, v, sizeof(x));
-          } else {
-            std::memcpy(&x, v, count * sizeof(float));
-          }
-          const F32x8 zero = {};
-          F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
-          mean = (mean > zero ? mean : zero) + dark_f;
-          const I32x8 small = mean < exact_below;
-          // Cornish-Fisher: the Poisson part's third cumulant (= mean) gives the sum a skew,
-          // mean / (6 s²)·(z² - 1) with s² = mean + read², which a plain Gaussian lacks.
-          const F32x8 variance = mean + read_variance;
-          const F32x8 skew = mean / (6 * variance);
-          F32x8 electrons =
-              mean + simd::sqrt(variance) * temporal + skew * (temporal * temporal - 1);
-          if (simd::any(small)) {
-            // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
-            // all lanes at once, from a second hash as the uniform, plus the read noise.
-            const U32x8 uniform_bits = lowbias32(index ^ uniform_key32);
-            const F32x8 u = __builtin_convertvector(uniform_bits >> 8, F32x8) * 0x1.0p-24f;
-            const F32x8 clamped_mean = small ? mean : zero;
-            F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;
-            I32x8 going = small & (u > cumulative);
-            for (int step = 1; step <= 200 && simd::any(going); ++step) {
-              p = p * clamped_mean * (1.0f / static_cast<float>(step));
-              cumulative += p;
-              k = going ? k + 1.0f : k;
-              going = going & (u > cumulative);
-            }
-            electrons = small ? k + read_f * temporal : electrons;
-          }
-          electrons += dsnu_f * dsnu;
-          F32x8 dn = simd::floor(electrons * dn_per_e + 0.5f);
-          dn = dn < dn_low ? F32x8{} + dn_low : dn;
-          dn = dn > dn_high ? F32x8{} + dn_high : dn;
-          store(first, count, dn * per_dn);
-        }
-      });
+  for_each_group(values, [&](std::size_t first, std::size_t count) {
+    const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
+    const U32x8 shot_bits = lowbias32(index ^ shot_key32);
+    const F32x8 prnu = load_pattern(prnu_pattern + first);
+    const F32x8 dsnu = load_pattern(dsnu_pattern + first);
+    const F32x8 temporal = lookup(table, shot_bits & 0xFFFF);
+    const float* v = signal + first;
+    F32x8 x = {};
+    if (count == kNoiseLanes) {
+      std::memcpy(&x, v, sizeof(x));
+    } else {
+      std::memcpy(&x, v, count * sizeof(float));
+    }
+    const F32x8 zero = {};
+    F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
+    mean = (mean > zero ? mean : zero) + dark_f;
+    const I32x8 small = mean < exact_below;
+    // Cornish-Fisher: the Poisson part's third cumulant (= mean) gives the sum a skew,
+    // mean / (6 s²)·(z² - 1) with s² = mean + read², which a plain Gaussian lacks.
+    const F32x8 variance = mean + read_variance;
+    const F32x8 skew = mean / (6 * variance);
+    F32x8 electrons = mean + simd::sqrt(variance) * temporal + skew * (temporal * temporal - 1);
+    if (simd::any(small)) {
+      // Dark values (a green screen's red channel): an exact Poisson draw by inversion,
+      // all lanes at once, from a second hash as the uniform, plus the read noise.
+      const U32x8 uniform_bits = lowbias32(index ^ uniform_key32);
+      const F32x8 u = __builtin_convertvector(uniform_bits >> 8, F32x8) * 0x1.0p-24f;
+      const F32x8 clamped_mean = small ? mean : zero;
+      F32x8 p = exp_negative8(clamped_mean), cumulative = p, k = zero;
+      I32x8 going = small & (u > cumulative);
+      for (int step = 1; step <= 200 && simd::any(going); ++step) {
+        p = p * clamped_mean * (1.0f / static_cast<float>(step));
+        cumulative += p;
+        k = going ? k + 1.0f : k;
+        going = going & (u > cumulative);
+      }
+      electrons = small ? k + read_f * temporal : electrons;
+    }
+    electrons += dsnu_f * dsnu;
+    F32x8 dn = simd::floor(electrons * dn_per_e + 0.5f);
+    dn = dn < dn_low ? F32x8{} + dn_low : dn;
+    dn = dn > dn_high ? F32x8{} + dn_high : dn;
+    store(first, count, dn * per_dn);
+  });
 }
 
 }  // namespace

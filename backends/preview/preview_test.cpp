@@ -187,6 +187,34 @@ ir::Scene paper_scene() {
   return compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
 }
 
+// How far a frame's shading strays from per-pixel lighting's, over the object's pixels or the
+// studio's (the masks must agree): the summed difference over the summed per-pixel radiance,
+// and each pixel's relative difference, sorted.
+struct LightingDifference {
+  double mean = 0;
+  std::vector<double> relative;
+  double percentile(int p) const { return relative[relative.size() * p / 100]; }
+};
+LightingDifference lighting_difference(const dslr::LinearFrame& shaded,
+                                       const dslr::LinearFrame& per_pixel, bool object) {
+  LightingDifference out;
+  double sum = 0, difference = 0;
+  for (size_t p = 0; p < shaded.mask.size(); ++p) {
+    if ((shaded.mask[p] != 0) != object) continue;
+    double a = 0, b = 0;
+    for (int c = 0; c < 3; ++c) {
+      a += shaded.rgb[3 * p + c];
+      b += per_pixel.rgb[3 * p + c];
+    }
+    sum += b;
+    difference += std::abs(a - b);
+    out.relative.push_back(std::abs(a - b) / std::max(b, 1e-6));
+  }
+  std::sort(out.relative.begin(), out.relative.end());
+  out.mean = sum > 0 ? difference / sum : 0;
+  return out;
+}
+
 // Lights summed once per 2 x 2 quad or interpolated over 4 x 4 blocks of the object (the
 // default) against every pixel: on the paper's statue, with its speckle pattern, soft shadows
 // and a green screen, the radiance must agree closely, at a small scale (mostly quads) and a
@@ -206,25 +234,12 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
     const dslr::LinearFrame pixel = render_frame(scene, studio, request);
     ASSERT_EQ(quad.rgb.size(), pixel.rgb.size());
     ASSERT_EQ(quad.mask, pixel.mask);
-    double sum = 0, difference = 0;
-    std::vector<double> relative;
-    for (size_t p = 0; p < quad.mask.size(); ++p) {
-      if (!quad.mask[p]) continue;
-      double a = 0, b = 0;
-      for (int c = 0; c < 3; ++c) {
-        a += quad.rgb[3 * p + c];
-        b += pixel.rgb[3 * p + c];
-      }
-      sum += b;
-      difference += std::abs(a - b);
-      relative.push_back(std::abs(a - b) / std::max(b, 1e-6));
-    }
-    ASSERT_GT(relative.size(), 5000u);
-    std::sort(relative.begin(), relative.end());
+    const LightingDifference d = lighting_difference(quad, pixel, true);
+    ASSERT_GT(d.relative.size(), 5000u);
     SCOPED_TRACE(::testing::Message() << "scale " << scale);
-    EXPECT_LT(difference / sum, 0.01);                      // on average within 1 %
-    EXPECT_LT(relative[relative.size() * 99 / 100], 0.08);  // 99 % of pixels within 8 %
-    EXPECT_GT(difference, 0.0) << "the two paths should not be the same code";
+    EXPECT_LT(d.mean, 0.01);            // on average within 1 %
+    EXPECT_LT(d.percentile(99), 0.08);  // 99 % of pixels within 8 %
+    EXPECT_GT(d.mean, 0.0) << "the two paths should not be the same code";
   }
 }
 
@@ -253,29 +268,16 @@ TEST(Preview, SparseStudioLightingMatchesPerPixelLighting) {
     request.per_pixel_lighting = true;
     const dslr::LinearFrame pixel = render_frame(scene, studio, request);
     ASSERT_EQ(sparse.mask, pixel.mask);
-    double sum = 0, difference = 0;
-    std::vector<double> relative;
-    for (size_t p = 0; p < sparse.mask.size(); ++p) {
-      if (sparse.mask[p]) continue;
-      double a = 0, b = 0;
-      for (int c = 0; c < 3; ++c) {
-        a += sparse.rgb[3 * p + c];
-        b += pixel.rgb[3 * p + c];
-      }
-      sum += b;
-      difference += std::abs(a - b);
-      relative.push_back(std::abs(a - b) / std::max(b, 1e-6));
-    }
-    ASSERT_GT(relative.size(), 100000u);
-    std::sort(relative.begin(), relative.end());
+    const LightingDifference d = lighting_difference(sparse, pixel, false);
+    ASSERT_GT(d.relative.size(), 100000u);
     SCOPED_TRACE(::testing::Message() << "window " << window.x << ", " << window.y);
     // Both hold at 0.13-0.17 % and 1.4-2.5 %; interpolating 16 px cells whose corners differ
     // by up to 30 % already breaks them (0.22-0.25 %, 4.1 %). The rest of the 99th percentile
     // (9 % at the statue's foot, as with per-pixel corners every 8 px) is the contact shadow's
     // dark core and the turntable's rim at grazing view.
-    EXPECT_LT(difference / sum, 0.002);
-    EXPECT_LT(relative[relative.size() * 95 / 100], 0.03);
-    EXPECT_LT(relative[relative.size() * 99 / 100], 0.12);
+    EXPECT_LT(d.mean, 0.002);
+    EXPECT_LT(d.percentile(95), 0.03);
+    EXPECT_LT(d.percentile(99), 0.12);
   }
 }
 
