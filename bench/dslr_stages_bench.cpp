@@ -114,10 +114,9 @@ void BM_DistortionVignetting(benchmark::State& state) {
   }
 }
 
-// The sensor's input as a shot has it: the frame's radiance through the exposure.
+// The sensor's input: the fixture's exposed frame, cut to the sensor's size.
 std::vector<float> exposed_signal(Fixture& f) {
   std::vector<float> signal = f.frame.rgb;
-  rigc::dslr::expose_in_place(f.scene.camera, signal);
   signal.resize(3 * static_cast<size_t>(f.sensor.width) * f.sensor.height);
   return signal;
 }

@@ -77,7 +77,8 @@ void resize_huge(std::vector<T>& buffer, std::size_t size) {
     std::vector<T> bigger;
     bigger.reserve(size);  // allocated, not yet touched: the advice applies to its first faults
     advise_huge_pages(bigger.data(), size * sizeof(T));
-    // Trivial element type: the allocation's bytes may be written before the elements exist.
+    // Trivial element type: the allocation's bytes may be written before the elements exist
+    // (a container-overflow checker would flag it; resize then zeroes them again, warm).
     first_touch(bigger.data(), size * sizeof(T));
     bigger.assign(buffer.begin(), buffer.end());
     buffer.swap(bigger);

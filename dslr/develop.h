@@ -41,7 +41,10 @@ struct SrgbEncoding {
   float last = 0;                      // the table's last index
   std::array<float, 3> scaled_gain{};  // gain x last, per channel
   std::uint16_t operator()(float value, int channel) const {
-    const float x = std::clamp(value * scaled_gain[channel], 0.0f, last);
+    // Written so that NaN lands on 0, as in the fused vector pass.
+    float x = value * scaled_gain[channel];
+    x = x > 0 ? x : 0.0f;
+    x = x < last ? x : last;
     return table[static_cast<std::size_t>(x + 0.5f)];
   }
 };

@@ -70,8 +70,9 @@ struct DevelopResult {
   std::vector<float> linear;
   int bits = 8;                        // 8 for JPEG, 16 for PNG/TIFF
   std::vector<std::uint16_t> encoded;  // sRGB code values, 3 per pixel (0..255 or 0..65535)
-  // Instead of `encoded` (then empty), for 8 bits where no linear image was kept: the codes as
-  // bytes, which is what a JPEG takes (ShotParams::keep_linear).
+  // Instead of `encoded` (then empty) when the sensor and the encoding ran as one pass (8 bits,
+  // ShotParams::keep_linear false, a fixed white balance): the codes as bytes, as a JPEG takes
+  // them.
   std::vector<std::uint8_t> encoded_bytes;
   std::vector<std::uint8_t> mask;  // object mask on the sensor grid; empty if the frame had none
   std::vector<float> depth_m;      // depth on the sensor grid (nearest sample); see sensor_depth

@@ -12,11 +12,12 @@
 
 namespace rigc::dslr {
 
-// Writes result.encoded; the file type follows the path's extension (.jpg, .png, .tif). JPEG uses
-// camera.jpeg_quality and is always 8-bit. Metadata: Make, Model, Exif:FocalLength (mm), FNumber,
-// ExposureTime, Exif:PhotographicSensitivity (ISO), Exif:FocalLengthIn35mmFilm, and
-// Exif:FocalPlaneX/YResolution in pixels per cm (unit 3) of this image, so tools can derive the
-// focal length in pixels. Returns false and sets *error on failure; no partial file is left.
+// Writes result.encoded (or result.encoded_bytes when that holds the codes); the file type follows
+// the path's extension (.jpg, .png, .tif). JPEG uses camera.jpeg_quality and is always 8-bit.
+// Metadata: Make, Model, Exif:FocalLength (mm), FNumber, ExposureTime, Exif:PhotographicSensitivity
+// (ISO), Exif:FocalLengthIn35mmFilm, and Exif:FocalPlaneX/YResolution in pixels per cm (unit 3) of
+// this image, so tools can derive the focal length in pixels. Returns false and sets *error on
+// failure; no partial file is left.
 bool write_image(const std::filesystem::path& path, const DevelopResult& result,
                  const ir::Camera& camera, std::string* error);
 

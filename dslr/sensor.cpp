@@ -153,7 +153,6 @@ inline F32x8 exp_negative8(F32x8 x) {
 // and shot. One pattern is kept: a run has one camera and one resolution.
 constexpr float kPatternStep = 1.0f / 32;
 using I8x8 = std::int8_t __attribute__((vector_size(8)));
-using U16x8 = std::uint16_t __attribute__((vector_size(16)));
 
 struct FixedPattern {
   std::uint32_t key = 0;
@@ -354,6 +353,7 @@ template <typename Code>
 std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int height,
                                     const std::vector<float>& signal, std::uint64_t seed,
                                     int shot_index, const SrgbEncoding& encode) {
+  if (signal.size() != 3 * static_cast<std::size_t>(width) * height) return {};
   // From the pool (a writer hands it back); every value is written.
   std::vector<Code> encoded;
   if constexpr (sizeof(Code) == 1) {
@@ -421,6 +421,8 @@ std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera
                                                         const std::vector<float>& signal,
                                                         std::uint64_t seed, int shot_index,
                                                         const SrgbEncoding& encode) {
+  // Bytes hold 8-bit codes only: the 8-bit table's index runs to 2^16 - 1.
+  if (encode.last != 65535.0f) return {};
   return sensor_and_encode<std::uint8_t>(camera, width, height, signal, seed, shot_index, encode);
 }
 

@@ -48,7 +48,8 @@ std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int
                                                    const std::vector<float>& signal,
                                                    std::uint64_t seed, int shot_index,
                                                    const SrgbEncoding& encode);
-// The same for an 8-bit encoding (srgb_encoding(gains, 8)): one byte per value.
+// The same for an 8-bit encoding (srgb_encoding(gains, 8)): one byte per value. Both return
+// nothing when `signal` is not 3·width·height values, the bytes also for a 16-bit encoding.
 std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera, int width,
                                                         int height,
                                                         const std::vector<float>& signal,

@@ -1265,8 +1265,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     auto at = [&](int ax, int ay) { return self(self, cache, plane, x0, y0, ax, ay); };
     Vector3f color;
     if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
-      const int ax = cx - cx % 4, bx = std::min(ax + 4, kCorners - 1);
-      const int ay = cy - cy % 4, by = std::min(ay + 4, kCorners - 1);
+      // A corner on a 16 px cell's edge looks at that edge's two ends only (all that its
+      // interpolation uses), so the tiles on both sides of a tile border decide alike.
+      const int ax = cx - cx % 4, bx = cx % 4 ? ax + 4 : ax;
+      const int ay = cy - cy % 4, by = cy % 4 ? ay + 4 : ay;
       const Vector3f c00 = at(ax, ay), c10 = at(bx, ay), c01 = at(ax, by), c11 = at(bx, by);
       const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
       const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
