@@ -101,12 +101,6 @@ enum Stream : std::uint64_t { kPrnuDsnu = 1, kShotNormal = 3, kShotUniform = 4 }
 // Below this mean even the skew-corrected Gaussian (see apply_sensor) departs from the Poisson
 // law: its discreteness and its mass at zero matter there.
 constexpr double kExactPoissonBelow = 12;
-// ... unless the read noise hides both. Poisson(λ) + N(0, σ²) has no lattice left once σ is
-// about 1 e⁻ (its characteristic function at 2π is e^(-2π²σ²)), and of its cumulants the
-// skew-corrected Gaussian gets mean, variance and third right; the fourth's excess kurtosis,
-// λ/(λ + σ²)², stays under 0.016 for λ < 12 when σ >= 4 e⁻. Base-ISO read noise (about 16 e⁻
-// for the 6D at ISO 200) is far above that; high ISOs (1.7 e⁻ at 6400) keep the exact draw.
-constexpr float kExactPoissonMaxReadNoise = 4;
 
 constexpr int kNoiseLanes = 8;
 using simd::F32x8;
@@ -280,9 +274,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const std::int8_t* dsnu_pattern = pattern->dsnu.data();
   const float read_variance = read_f * read_f;
   // Below kExactPoissonBelow electrons the Gaussian stands in badly: those values take an
-  // exact Poisson draw, where the read noise is too low to hide the difference.
-  const float exact_below =
-      read_f < kExactPoissonMaxReadNoise ? static_cast<float>(kExactPoissonBelow) : 0.0f;
+  // exact Poisson draw.
   const std::uint32_t uniform_key32 = static_cast<std::uint32_t>(uniform_key ^ (uniform_key >> 32));
   for_each_group(values, [&](std::size_t first, std::size_t count) {
     const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
@@ -300,7 +292,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
     const F32x8 zero = {};
     F32x8 mean = x * fwc_f * (1 + prnu_f * prnu);
     mean = (mean > zero ? mean : zero) + dark_f;
-    const I32x8 small = mean < exact_below;
+    const I32x8 small = mean < static_cast<float>(kExactPoissonBelow);
     // Cornish-Fisher: the Poisson part's third cumulant (= mean) gives the sum a skew,
     // mean / (6 s²)·(z² - 1) with s² = mean + read², which a plain Gaussian lacks.
     const F32x8 variance = mean + read_variance;

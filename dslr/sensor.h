@@ -30,9 +30,8 @@ float normal_from_bits(std::uint32_t bits16);
 
 // Applies the sensor to a normalised signal (3 per pixel, 1.0 = clipping at this ISO), in place:
 //   e = v·electrons_at_clipping; PRNU gain; + dark current·t; Poisson shot noise (exact below
-//   12 e⁻ when the read noise is under 4 e⁻; otherwise one Gaussian for shot and read noise
-//   together, with the Poisson law's skew added by a Cornish-Fisher term); + Gaussian read
-//   noise; + DSNU offset; quantise to adc_bits
+//   12 e⁻; above, one Gaussian for shot and read noise together, with the Poisson law's skew
+//   added by a Cornish-Fisher term); + Gaussian read noise; + DSNU offset; quantise to adc_bits
 //   with clipping at full scale; back to normalised. PRNU and DSNU are drawn once per camera
 //   seed and resolution and kept (one byte each per value).
 // Each colour channel is simulated as its own photosite (no Bayer mosaic). PRNU and DSNU depend

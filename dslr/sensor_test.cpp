@@ -156,15 +156,14 @@ TEST(DslrNoise, SmallSignalsArePoisson) {
   EXPECT_NEAR(static_cast<double>(zeros) / linear.size(), std::exp(-5.0), 0.002);
 }
 
-// Where the read noise is several electrons (base ISO), small signals take the skew-corrected
-// Gaussian too: the sum's mean and variance must still be the Poisson law's plus the read
-// noise's, and no value may be held at zero.
+// Small signals under base-ISO read noise (about 16 e⁻ at ISO 200): the sum's mean and
+// variance must be the Poisson law's plus the read noise's, with nothing held at zero.
 TEST(DslrNoise, SmallSignalsUnderReadNoiseKeepTheirMeanAndVariance) {
   ir::Camera camera = noisy_6d(200);
   camera.noise.prnu = 0;
   camera.noise.dsnu_e = 0;
   const double read = read_noise_electrons(camera.noise, 200);
-  ASSERT_GT(read, 4);  // above the exact draw's limit
+  ASSERT_GT(read, 10);
   const double fwc = 79546.0 / 2;
   const double dark = camera.noise.dark_current_e_per_s * camera.shutter_s;
   for (const double electrons : {0.3, 3.0, 9.0}) {
