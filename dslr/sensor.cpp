@@ -14,7 +14,6 @@
 #include <memory>
 #include <mutex>
 #include <numbers>
-#include <type_traits>
 
 #include "compiler/hash.h"
 #include "dslr/buffer_pool.h"

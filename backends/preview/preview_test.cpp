@@ -342,8 +342,9 @@ TEST(Preview, ReusedBuffersAreFullyOverwritten) {
   EXPECT_EQ(bad_depth, 0);
 }
 
-// The rasterizer reads the speckle and noise patterns eight points at a time; they must be the
-// same patterns as the one-point function's, sharp where resolved and faded where not.
+// The rasterizer reads the speckle and noise patterns eight points at a time: a point's value
+// must not depend on its lane, on the points beside it or on a partial last step, resolved and
+// faded alike.
 TEST(Preview, BatchedPatternsMatchThePointPattern) {
   for (const auto kind :
        {ir::PatternKind::kSpeckle, ir::PatternKind::kNoise, ir::PatternKind::kChecker}) {

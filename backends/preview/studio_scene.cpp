@@ -78,37 +78,9 @@ Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
          (at(x0, y0 + 1) * (1 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
 }
 
-// Smooth value noise in [0, 1] on a unit lattice. The eight corner hashes are computed together
-// (one 8-lane register); a 32-bit integer hash of the corner's lattice coordinates and the seed.
-float value_noise(const Vector3f& p, std::uint32_t seed) {
-  using simd::U32x8;
-  const float fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
-  const auto ix = static_cast<std::uint32_t>(static_cast<std::int32_t>(fx)),
-             iy = static_cast<std::uint32_t>(static_cast<std::int32_t>(fy)),
-             iz = static_cast<std::uint32_t>(static_cast<std::int32_t>(fz));
-  auto fade = [](float t) { return t * t * (3 - 2 * t); };
-  const float tx = fade(p.x() - fx), ty = fade(p.y() - fy), tz = fade(p.z() - fz);
-  // Corner k is (k & 1, (k >> 1) & 1, k >> 2).
-  const U32x8 x = U32x8{0, 1, 0, 1, 0, 1, 0, 1} + ix;
-  const U32x8 y = U32x8{0, 0, 1, 1, 0, 0, 1, 1} + iy;
-  const U32x8 z = U32x8{0, 0, 0, 0, 1, 1, 1, 1} + iz;
-  U32x8 h = U32x8{} + seed * 0x9E3779B9u;
-  h ^= x * 0x85EBCA6Bu;
-  h = (h ^ (h >> 13)) * 0xC2B2AE35u;
-  h ^= y * 0x27D4EB2Fu;
-  h = (h ^ (h >> 15)) * 0x165667B1u;
-  h ^= z * 0x9E3779B1u;
-  h = (h ^ (h >> 16)) * 0x85EBCA77u;
-  h ^= h >> 13;
-  float value[8];
-  for (int k = 0; k < 8; ++k) value[k] = (h[k] & 0xFFFFFF) / float(0xFFFFFF);
-  auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
-  return lerp(lerp(lerp(value[0], value[1], tx), lerp(value[2], value[3], tx), ty),
-              lerp(lerp(value[4], value[5], tx), lerp(value[6], value[7], tx), ty), tz);
-}
-
-// value_noise at eight points at once, one per lane: the same hash and interpolation, so the
-// same values.
+// Smooth value noise in [0, 1] on a unit lattice, at eight points at once (one per lane): a
+// 32-bit integer hash of each corner's lattice coordinates and the seed, interpolated with a
+// smoothstep fade.
 simd::F32x8 value_noise8(simd::F32x8 px, simd::F32x8 py, simd::F32x8 pz, std::uint32_t seed) {
   using simd::F32x8;
   using simd::I32x8;
@@ -232,62 +204,21 @@ Vector3f MipTexture::sample(const Vector2f& uv, float footprint) const {
 }
 
 float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float footprint_m) {
-  if (pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) return 1.0f;
-  const float scale = static_cast<float>(pattern.scale_m);
-  const float contrast = static_cast<float>(pattern.contrast);
-  // Fade to the mean as the pattern gets finer than about two pixels.
-  const float resolve = std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f);
-  float darkness = 0, mean_darkness = 0;
-  const Vector3f q = p / scale;
-  switch (pattern.kind) {
-    case ir::PatternKind::kSpeckle: {
-      // Dark blotches covering about 40 % of the surface, at two scales.
-      const float n = 0.65f * value_noise(q, pattern.seed) +
-                      0.35f * value_noise(q * 2.7f + Vector3f(17.1f, 3.3f, 9.7f), pattern.seed + 1);
-      darkness = std::clamp((n - 0.47f) * 12.0f, 0.0f, 1.0f);
-      mean_darkness = 0.4f;
-      break;
-    }
-    case ir::PatternKind::kNoise: {
-      float n = 0, amplitude = 0.5f, frequency = 1;
-      for (int octave = 0; octave < 3; ++octave) {
-        n += amplitude * value_noise(q * frequency, pattern.seed + octave);
-        amplitude *= 0.5f;
-        frequency *= 2.1f;
-      }
-      darkness = std::clamp(n / 0.875f, 0.0f, 1.0f);
-      mean_darkness = 0.5f;
-      break;
-    }
-    case ir::PatternKind::kChecker: {
-      const int parity =
-          (static_cast<int>(std::floor(q.x())) + static_cast<int>(std::floor(q.y())) +
-           static_cast<int>(std::floor(q.z()))) &
-          1;
-      darkness = static_cast<float>(parity);
-      mean_darkness = 0.5f;
-      break;
-    }
-    case ir::PatternKind::kNone:
-      break;
-  }
-  darkness = resolve * darkness + (1 - resolve) * mean_darkness;
-  return 1.0f - contrast * darkness;
+  float factor = 1;
+  pattern_factors(pattern, &p.x(), &p.y(), &p.z(), 1, footprint_m, &factor);
+  return factor;
 }
 
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
                      const float* z, int count, float footprint_m, float* out) {
   using simd::F32x8;
-  const bool vectorised =
-      pattern.kind == ir::PatternKind::kSpeckle || pattern.kind == ir::PatternKind::kNoise;
-  if (!vectorised || pattern.contrast <= 0) {
-    for (int i = 0; i < count; ++i) {
-      out[i] = pattern_factor(pattern, Vector3f(x[i], y[i], z[i]), footprint_m);
-    }
+  if (pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
+    std::fill_n(out, count, 1.0f);
     return;
   }
   const float scale = static_cast<float>(pattern.scale_m);
   const float contrast = static_cast<float>(pattern.contrast);
+  // Fade to the mean as the pattern gets finer than about two pixels.
   const float resolve = std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f);
   for (int first = 0; first < count; first += 8) {
     const int lanes = std::min(8, count - first);
@@ -297,25 +228,43 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
       qy[k] = y[first + k] / scale;
       qz[k] = z[first + k] / scale;
     }
-    F32x8 darkness;
-    float mean_darkness;
-    if (pattern.kind == ir::PatternKind::kSpeckle) {
-      const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
-                      0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
-                                           pattern.seed + 1);
-      darkness = (n - 0.47f) * 12.0f;
-      mean_darkness = 0.4f;
-    } else {
-      F32x8 n{};
-      float amplitude = 0.5f, frequency = 1;
-      for (int octave = 0; octave < 3; ++octave) {
-        n += amplitude *
-             value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
-        amplitude *= 0.5f;
-        frequency *= 2.1f;
+    F32x8 darkness{};  // clamped to [0, 1] below
+    float mean_darkness = 0;
+    switch (pattern.kind) {
+      case ir::PatternKind::kSpeckle: {
+        // Dark blotches covering about 40 % of the surface, at two scales.
+        const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
+                        0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
+                                             pattern.seed + 1);
+        darkness = (n - 0.47f) * 12.0f;
+        mean_darkness = 0.4f;
+        break;
       }
-      darkness = n / 0.875f;
-      mean_darkness = 0.5f;
+      case ir::PatternKind::kNoise: {
+        F32x8 n{};
+        float amplitude = 0.5f, frequency = 1;
+        for (int octave = 0; octave < 3; ++octave) {
+          n += amplitude *
+               value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
+          amplitude *= 0.5f;
+          frequency *= 2.1f;
+        }
+        darkness = n / 0.875f;
+        mean_darkness = 0.5f;
+        break;
+      }
+      case ir::PatternKind::kChecker: {
+        for (int k = 0; k < lanes; ++k) {
+          darkness[k] = static_cast<float>((static_cast<int>(std::floor(qx[k])) +
+                                            static_cast<int>(std::floor(qy[k])) +
+                                            static_cast<int>(std::floor(qz[k]))) &
+                                           1);
+        }
+        mean_darkness = 0.5f;
+        break;
+      }
+      case ir::PatternKind::kNone:
+        break;
     }
     for (int k = 0; k < lanes; ++k) {
       const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;

@@ -78,7 +78,7 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p
                      float footprint_m);
 
 // pattern_factor at `count` points (object-frame x[i], y[i], z[i]) sharing one footprint,
-// written to out[i]; eight points per step where the pattern allows.
+// written to out[i], eight points per step (pattern_factor is this for one point).
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
                      const float* z, int count, float footprint_m, float* out);
 
