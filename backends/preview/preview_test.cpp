@@ -375,6 +375,44 @@ TEST(Preview, BatchedPatternsMatchThePointPattern) {
   }
 }
 
+// Zooming out must not change a pattern's brightness: where it is resolved (a fine footprint)
+// its mean over the surface is the faded value it turns into once finer than a pixel.
+TEST(Preview, ResolvedPatternsAverageToTheirFadedValue) {
+  for (const auto kind :
+       {ir::PatternKind::kSpeckle, ir::PatternKind::kNoise, ir::PatternKind::kChecker}) {
+    for (const int seed : {5, 77}) {
+      ir::SurfacePattern pattern;
+      pattern.kind = kind;
+      pattern.scale_m = 0.002;
+      pattern.contrast = 0.7;
+      pattern.seed = seed;
+      // Points scattered over about 500 x 500 x 500 lattice cells.
+      constexpr int kPoints = 200000;
+      std::vector<float> x(kPoints), y(kPoints), z(kPoints), factor(kPoints);
+      std::uint32_t state = 12345;
+      auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return static_cast<float>(state >> 8) * 0x1.0p-24f;
+      };
+      for (int i = 0; i < kPoints; ++i) {
+        x[i] = next() - 0.5f;
+        y[i] = next() - 0.5f;
+        z[i] = next() - 0.5f;
+      }
+      preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, 1e-6f,
+                               factor.data());
+      double mean = 0;
+      for (float f : factor) mean += f;
+      mean /= kPoints;
+      const float faded = preview::pattern_factor(pattern, {0.1f, 0.2f, 0.3f}, 1.0f);
+      EXPECT_NEAR(mean, faded, 0.02) << "kind " << static_cast<int>(kind);
+      // And the resolved pattern has contrast: it is not the faded value everywhere.
+      const auto [lo, hi] = std::minmax_element(factor.begin(), factor.end());
+      EXPECT_GT(*hi - *lo, 0.5f * pattern.contrast) << "kind " << static_cast<int>(kind);
+    }
+  }
+}
+
 // Coverage pictures shade a plane evenly: a studio plane is split into long thin triangles (the
 // turntable's caps), and shading each with its own centroid's view direction drew stripes.
 TEST(Preview, FaceColourPicturesShadePlanesEvenly) {

@@ -237,7 +237,10 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
                         0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
                                              pattern.seed + 1);
         darkness = (n - 0.47f) * 12.0f;
-        mean_darkness = 0.4f;
+        // The clamped darkness averages 0.47 over the surface (measured on 200k points, two
+        // seeds; Preview.ResolvedPatternsAverageToTheirFadedValue): fading to it keeps the
+        // brightness when zooming out (0.4 had made the faded statue 7 % brighter).
+        mean_darkness = 0.47f;
         break;
       }
       case ir::PatternKind::kNoise: {
