@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <sstream>
 
 #include "backends/common/colmap_text.h"
@@ -389,15 +390,12 @@ TEST(Preview, ResolvedPatternsAverageToTheirFadedValue) {
       // Points scattered over about 500 x 500 x 500 lattice cells.
       constexpr int kPoints = 200000;
       std::vector<float> x(kPoints), y(kPoints), z(kPoints), factor(kPoints);
-      std::uint32_t state = 12345;
-      auto next = [&] {
-        state = state * 1664525u + 1013904223u;
-        return static_cast<float>(state >> 8) * 0x1.0p-24f;
-      };
+      std::mt19937 random(12345);
+      std::uniform_real_distribution<float> coordinate(-0.5f, 0.5f);
       for (int i = 0; i < kPoints; ++i) {
-        x[i] = next() - 0.5f;
-        y[i] = next() - 0.5f;
-        z[i] = next() - 0.5f;
+        x[i] = coordinate(random);
+        y[i] = coordinate(random);
+        z[i] = coordinate(random);
       }
       preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, 1e-6f,
                                factor.data());

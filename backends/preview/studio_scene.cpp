@@ -232,7 +232,7 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
     float mean_darkness = 0;
     switch (pattern.kind) {
       case ir::PatternKind::kSpeckle: {
-        // Dark blotches covering about 40 % of the surface, at two scales.
+        // Dark blotches at two scales, with soft edges (the darkness ramps over 1/12 of n).
         const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
                         0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
                                              pattern.seed + 1);
