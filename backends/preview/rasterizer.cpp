@@ -38,6 +38,12 @@ constexpr float kQuadNormalCos = 0.99939f;
 // other has its lighting interpolated bilinearly from the corners. Interpolation follows the
 // first-order change that a quad's single sum ignores, so the bound can be looser.
 constexpr float kBlockNormalCos = 0.9903f;
+// A block whose corner normals spread further, up to 25 degrees (a scanned statue's small bumps),
+// is interpolated too when the lights summed at its centre match the corners' mean within 1 %
+// for the block's albedo: the bend that matters is the light's, not the normal's. Beyond 25
+// degrees, or failing the check, it is shaded in quads.
+constexpr float kBlockBumpyNormalCos = 0.9063f;
+constexpr float kBlockLightTolerance = 0.01f;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -1442,8 +1448,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         // A 4 x 4 block inside one smooth patch of the object: the lights are summed at the
         // block's corners (shared with the neighbouring blocks) and interpolated, the albedo
         // taken per pixel; the block must be one material, one surface per pixel, without
-        // depth steps, and its corner normals within kQuadNormalCos of each other. False (and
-        // nothing written) otherwise.
+        // depth steps, and its corner normals within kBlockNormalCos of each other (or within
+        // kBlockBumpyNormalCos and its light nearly linear). False (and nothing written)
+        // otherwise.
         auto shade_object_block = [&](int bx, int by) -> bool {
           std::array<PixelSurfaces, kBlock * kBlock> block;
           int material = -1;
@@ -1478,9 +1485,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             }
             corner[k] = &c;
           }
+          bool smooth = true;
           for (int k = 0; k < 4; ++k) {
             for (int m = k + 1; m < 4; ++m) {
-              if (corner[k]->n.dot(corner[m]->n) < kBlockNormalCos) return false;
+              const float cos_angle = corner[k]->n.dot(corner[m]->n);
+              if (cos_angle < kBlockBumpyNormalCos) return false;
+              smooth = smooth && cos_angle >= kBlockNormalCos;
             }
           }
           std::array<int, kBlock * kBlock> tris, pxs, pys;
@@ -1492,6 +1502,30 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           }
           albedo_batch(tris.data(), pxs.data(), pys.data(), kBlock * kBlock, corner[0]->footprint_m,
                        albedo.data());
+          if (!smooth) {
+            // Corner normals apart (kBlockBumpyNormalCos): the lights summed at the block's
+            // centre against the corners' mean, for the block's mean albedo. Where the light
+            // bends inside the block (a penumbra, a highlight, a crease), the bilinear fill
+            // would miss it, and the block is shaded in quads.
+            const int centre_pixel = (kBlock / 2) * kBlock + kBlock / 2;
+            const SurfacePoint sp = surface_at(screen_tris[block[centre_pixel].triangle[0]],
+                                               static_cast<float>(bx + kBlock / 2),
+                                               static_cast<float>(by + kBlock / 2), true);
+            const Lighting exact = lighting_at(sp);
+            Vector3f mean_albedo = Vector3f::Zero();
+            for (const Vector3f& a : albedo) mean_albedo += a;
+            mean_albedo /= kBlock * kBlock;
+            Vector3f scale = Vector3f::Zero(), offset = Vector3f::Zero();
+            for (int k = 0; k < 4; ++k) {
+              scale += 0.25f * corner[k]->lighting.scale;
+              offset += 0.25f * corner[k]->lighting.offset;
+            }
+            const Vector3f want = mean_albedo.cwiseProduct(exact.scale) + exact.offset;
+            const Vector3f have = mean_albedo.cwiseProduct(scale) + offset;
+            if (((have - want).cwiseAbs().array() > kBlockLightTolerance * want.array()).any()) {
+              return false;
+            }
+          }
           for (int i = 0; i < kBlock * kBlock; ++i) {
             const float fx = (i % kBlock + 0.5f) / kBlock, fy = (i / kBlock + 0.5f) / kBlock;
             const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
