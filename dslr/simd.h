@@ -59,4 +59,33 @@ inline F32x8 floor(F32x8 x) {
 #endif
 }
 
+// base[index[k]] in each lane k.
+inline F32x8 gather(const float* base, I32x8 index) {
+#if defined(__AVX2__)
+  return reinterpret_cast<F32x8>(_mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4));
+#else
+  F32x8 out;
+  for (int k = 0; k < 8; ++k) out[k] = base[index[k]];
+  return out;
+#endif
+}
+
+// How many lanes of a comparison's mask are set.
+inline int count(I32x8 mask) {
+#if defined(__AVX__)
+  return __builtin_popcount(_mm256_movemask_ps(reinterpret_cast<__m256>(mask)));
+#else
+  int n = 0;
+  for (int k = 0; k < 8; ++k) n += mask[k] != 0;
+  return n;
+#endif
+}
+
+// The sum of the eight lanes.
+inline float sum(F32x8 x) {
+  float total = 0;
+  for (int k = 0; k < 8; ++k) total += x[k];
+  return total;
+}
+
 }  // namespace rigc::simd

@@ -231,16 +231,30 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
     const int iv = std::clamp(static_cast<int>(sv), 0, size - 1);
     return depth[static_cast<size_t>(iv) * size + iu];
   };
-  // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels.
-  static constexpr float kDisc[16][2] = {
-      {-0.94f, -0.40f}, {0.95f, -0.77f},  {-0.09f, -0.93f}, {0.34f, 0.29f},
-      {-0.92f, 0.46f},  {-0.81f, -0.88f}, {-0.38f, 0.28f},  {0.97f, 0.76f},
-      {0.44f, -0.98f},  {0.54f, 0.89f},   {-0.26f, -0.60f}, {-0.10f, 0.89f},
-      {0.79f, 0.19f},   {-0.62f, 0.99f},  {0.20f, -0.35f},  {-0.50f, -0.12f}};
+  // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels. Its taps are
+  // looked up eight at a time (two thirds of the calls reach the disc loops, at full resolution).
+  using Float8 = simd::F32x8;
+  using Int8 = simd::I32x8;
+  static constexpr Float8 kDiscU[2] = {
+      {-0.94f, 0.95f, -0.09f, 0.34f, -0.92f, -0.81f, -0.38f, 0.97f},
+      {0.44f, 0.54f, -0.26f, -0.10f, 0.79f, -0.62f, 0.20f, -0.50f}};
+  static constexpr Float8 kDiscV[2] = {
+      {-0.40f, -0.77f, -0.93f, 0.29f, 0.46f, -0.88f, 0.28f, 0.76f},
+      {-0.98f, 0.89f, -0.60f, 0.89f, 0.19f, 0.99f, -0.35f, -0.12f}};
+  // Depths at the disc's eight taps (half `half`) scaled by `radius` around (u, v).
+  auto disc8 = [&](int half, float radius) {
+    const Float8 su = u + kDiscU[half] * radius, sv = v + kDiscV[half] * radius;
+    Int8 iu = __builtin_convertvector(su, Int8), iv = __builtin_convertvector(sv, Int8);
+    if (!interior) {
+      const Int8 zero = {}, last = zero + (size - 1);
+      iu = iu < zero ? zero : (iu > last ? last : iu);
+      iv = iv < zero ? zero : (iv > last ? last : iv);
+    }
+    return simd::gather(depth.data(), iv * size + iu);
+  };
   float radius = 1.5f;
   if (light_size_m > 0 && !orthographic) {
     // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
-    float blockers = 0, blocker_sum = 0;
     const float search =
         std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f, 2.0f, 24.0f);
     // Most points are plainly lit: five taps over the search area settle them cheaply.
@@ -249,24 +263,23 @@ float ShadowMap::visibility(const Vector3f& world, float cos_theta) const {
         lookup(u + search, v + search) >= receiver) {
       return 1;
     }
-    for (const auto& d : kDisc) {
-      const float z = lookup(u + d[0] * search, v + d[1] * search);
-      if (z < receiver) {
-        blockers += 1;
-        blocker_sum += z;
-      }
+    int blockers = 0;
+    Float8 blocker_sum = {};
+    for (int half = 0; half < 2; ++half) {
+      const Float8 z = disc8(half, search);
+      const Int8 blocks = z < receiver;
+      blockers += simd::count(blocks);
+      blocker_sum += blocks ? z : Float8{};
     }
     if (blockers == 0) return 1;
     if (blockers == 16) return 0;  // the whole search area blocks: umbra
-    const float blocker = blocker_sum / blockers;
+    const float blocker = simd::sum(blocker_sum) / static_cast<float>(blockers);
     const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
     radius = std::clamp(penumbra_m / texel, 1.5f, 24.0f);
   }
-  float lit = 0;
-  for (const auto& d : kDisc) {
-    if (lookup(u + d[0] * radius, v + d[1] * radius) >= receiver) lit += 1;
-  }
-  return lit / 16;
+  int lit = 0;
+  for (int half = 0; half < 2; ++half) lit += simd::count(disc8(half, radius) >= receiver);
+  return static_cast<float>(lit) / 16;
 }
 
 using Float8 = simd::F32x8;
