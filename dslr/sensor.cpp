@@ -107,19 +107,9 @@ using simd::I32x8;
 using simd::U32x8;
 constexpr U32x8 kLaneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
 
+// table[index[k]] per lane: the indices are 16-bit, so they read the same as signed.
 inline F32x8 lookup(const float* table, U32x8 index) {
-#if defined(__AVX2__)
-  I32x8 signed_index;
-  std::memcpy(&signed_index, &index, sizeof(index));
-  const __m256 gathered = _mm256_i32gather_ps(table, reinterpret_cast<__m256i&>(signed_index), 4);
-  F32x8 out;
-  std::memcpy(&out, &gathered, sizeof(out));
-  return out;
-#else
-  F32x8 out;
-  for (int k = 0; k < kNoiseLanes; ++k) out[k] = table[index[k]];
-  return out;
-#endif
+  return simd::gather(table, reinterpret_cast<I32x8>(index));
 }
 
 // e^-x for 0 <= x < 80 on eight lanes: 2^t split into 2^n (exponent bits) and 2^f (its Taylor
