@@ -47,6 +47,9 @@ constexpr double kDenseRadius = 4.5, kRingRatio = 1.3;
 // 4 px keeps the thin-lens edge widths within the tests' 15 % (5 px: 270 -> 175 ms for a full
 // frame of the paper scene); 3 px widened ReferenceAgreement.DefocusBlurWidth by 27 %.
 constexpr float kCoarseRadiusPx = 4.0f;
+// How far from a pixel a disc smaller than kCoarseRadiusPx can change its half-resolution value:
+// the disc itself, plus the bilinear upsampling's half pixels and their 2 x 2 footprints.
+constexpr int kSmallDiscReachPx = static_cast<int>(kCoarseRadiusPx) + 3;
 // A tile whose every reachable pixel lies within this fraction of the brightest value there (per
 // channel) is copied instead of gathered: any blur of it is a weighted mean of those pixels, so it
 // moves by less than this. Smooth backdrops (a green screen) are most of a frame's big discs;
@@ -391,13 +394,18 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
 
   // Coarse tiles: every pixel whose disc can reach them (and they themselves) blur by
   // kCoarseRadiusPx or more. Their result comes from the same gather on a half-size frame.
-  std::vector<char> coarse(tile_max.size(), 0);
+  // Only discs under kCoarseRadiusPx spoil that, and those reach no further than the tiles
+  // next door.
+  // Part-coarse tiles (not coarse, but with big discs of their own: the background along an
+  // object's silhouette) take the half-size result for those groups of pixels that no small disc
+  // comes near (see the gather below).
+  std::vector<char> coarse(tile_max.size(), 0), part_coarse(tile_max.size(), 0);
   bool any_coarse = false;
   if (level < kMaxCoarseLevel && w >= 8 * kTile && h >= 8 * kTile) {
+    constexpr int span = (kSmallDiscReachPx + kTile - 1) / kTile;
     for (int ty = 0; ty < tiles_y; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-        const int span = static_cast<int>(std::ceil(reach[t] / kTile)) + 1;
         float smallest = tile_min[t];
         for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
           for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
@@ -405,7 +413,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           }
         }
         coarse[t] = active(t) && smallest >= kCoarseRadiusPx;
-        any_coarse = any_coarse || coarse[t];
+        part_coarse[t] =
+            active(t) && !coarse[t] && reach[t] > 0.5f && tile_max[t] >= kCoarseRadiusPx;
+        any_coarse = any_coarse || coarse[t] || part_coarse[t];
       }
     }
   }
@@ -452,7 +462,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     std::vector<char> half_needed(static_cast<std::size_t>(half_tiles_x) * half_tiles_y, 0);
     for (int ty = 0; ty < tiles_y; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
-        if (!coarse[static_cast<std::size_t>(ty) * tiles_x + tx]) continue;
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        if (!coarse[t] && !part_coarse[t]) continue;
         for (int hy = std::max(0, (ty - 1) / 2); hy <= std::min(half_tiles_y - 1, (ty + 1) / 2);
              ++hy) {
           for (int hx = std::max(0, (tx - 1) / 2); hx <= std::min(half_tiles_x - 1, (tx + 1) / 2);
@@ -479,27 +490,52 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     // A whole tile away from the frame's edges: its columns follow the fixed pattern below.
     const bool interior = x1 - x0 == kTile && x0 >= 2 && first == x0 / 2 - 1 &&
                           column[kTile - 1] == x0 / 2 + kTile / 2 - 1 && count == kTile / 2 + 2;
-    std::array<float, 3 * (kTile / 2 + 3)> blended;  // this row's vertical blend, from `first`
-    for (int y = y0; y < y1; ++y) {
+    auto half_row_of = [&](int y, float* weight) {
       const float hy = std::clamp((y + 0.5f) / 2 - 0.5f, 0.0f, half.height - 1.0f);
       const int iy = std::min(static_cast<int>(hy), half.height - 2);
-      const float fy = hy - iy;
+      *weight = hy - iy;
+      return iy;
+    };
+    if (interior) {
+      // Across first: the half rows this tile reads (ten), each spread to the tile's width
+      // (pixel x0 + 2k sits a quarter of a half pixel left of half pixel x0/2 + k, pixel
+      // x0 + 2k + 1 a quarter right: fixed weights), then each row blends two of them. All
+      // loops run over contiguous values.
+      constexpr int kValues = 3 * kTile, kHalfValues = kValues / 2;
+      float unused;
+      const int row_first = half_row_of(y0, &unused), row_last = half_row_of(y1 - 1, &unused) + 1;
+      std::array<float, kValues*(kTile / 2 + 2)> spread;
+      for (int j = row_first; j <= row_last; ++j) {
+        const float* v = &half_out[3 * (static_cast<std::size_t>(j) * half.width + first)];
+        float left[kHalfValues], right[kHalfValues];
+        for (int k = 0; k < kHalfValues; ++k) {
+          left[k] = 0.25f * v[k] + 0.75f * v[k + 3];
+          right[k] = 0.75f * v[k + 3] + 0.25f * v[k + 6];
+        }
+        float* row = &spread[(j - row_first) * kValues];
+        for (int k = 0; k < kTile / 2; ++k) {
+          std::memcpy(row + 6 * k, left + 3 * k, 3 * sizeof(float));
+          std::memcpy(row + 6 * k + 3, right + 3 * k, 3 * sizeof(float));
+        }
+      }
+      for (int y = y0; y < y1; ++y) {
+        float fy;
+        const int iy = half_row_of(y, &fy);
+        const float* a = &spread[(iy - row_first) * kValues];
+        const float* b = a + kValues;
+        float* dst = &out[3 * (static_cast<std::size_t>(y) * w + x0)];
+        for (int k = 0; k < kValues; ++k) dst[k] = a[k] + fy * (b[k] - a[k]);
+      }
+      return;
+    }
+    std::array<float, 3 * (kTile / 2 + 3)> blended;  // this row's vertical blend, from `first`
+    for (int y = y0; y < y1; ++y) {
+      float fy;
+      const int iy = half_row_of(y, &fy);
       const float* a = &half_out[3 * (static_cast<std::size_t>(iy) * half.width + first)];
       const float* b = a + 3 * static_cast<std::size_t>(half.width);
       for (int k = 0; k < 3 * count; ++k) blended[k] = a[k] + fy * (b[k] - a[k]);
       float* dst = &out[3 * (static_cast<std::size_t>(y) * w + x0)];
-      if (interior) {
-        // Pixel x0 + 2k sits a quarter of a half pixel left of half pixel x0/2 + k, pixel
-        // x0 + 2k + 1 a quarter right: fixed weights, no per-pixel lookups.
-        for (int k = 0; k < kTile / 2; ++k) {
-          const float* v = &blended[3 * k];
-          for (int c = 0; c < 3; ++c) {
-            dst[6 * k + c] = 0.25f * v[c] + 0.75f * v[3 + c];
-            dst[6 * k + 3 + c] = 0.75f * v[3 + c] + 0.25f * v[6 + c];
-          }
-        }
-        continue;
-      }
       for (int x = 0; x < x1 - x0; ++x) {
         const float* v = &blended[3 * (column[x] - first)];
         const float fx = column_weight[x];
@@ -636,8 +672,39 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             continue;
           }
           const int tap_count = set.taps_for(radius);
+          // Part-coarse tiles: a group of pixels whose discs, and all discs within
+          // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
+          // tile. The smallest disc over each row's window, per group, then over the rows.
+          constexpr int d = kSmallDiscReachPx;
+          constexpr int kGroups = kTile / kLanes;
+          const bool split = part_coarse[t] && pl.pad >= d;
+          std::array<float, (kTile + 2 * d) * kGroups> row_smallest;
+          if (split) {
+            for (int y = y0 - d; y < y1 + d; ++y) {
+              const float* radii = &pl.radius[pl.index(0, y)];
+              for (int g = 0; g < kGroups; ++g) {
+                const int gx = x0 + g * kLanes;
+                float smallest = radii[gx - d];
+                for (int x = gx - d + 1; x < gx + kLanes + d; ++x) {
+                  smallest = std::min(smallest, radii[x]);
+                }
+                row_smallest[(y - y0 + d) * kGroups + g] = smallest;
+              }
+            }
+          }
           for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; x += kLanes) {
+              if (split) {
+                const int g = (x - x0) / kLanes;
+                float smallest = row_smallest[(y - y0) * kGroups + g];
+                for (int k = 1; k <= 2 * d; ++k) {
+                  smallest = std::min(smallest, row_smallest[(y - y0 + k) * kGroups + g]);
+                }
+                if (smallest >= kCoarseRadiusPx) {
+                  upsample_tile(x, std::min(x + kLanes, x1), y, y + 1);
+                  continue;
+                }
+              }
               gather_group(pl, set, tap_count, pl.index(x, y), sums);
               composite(sums, std::min(kLanes, x1 - x),
                         &out[3 * (static_cast<std::size_t>(y) * w + x)]);
