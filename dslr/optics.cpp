@@ -412,7 +412,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             smallest = std::min(smallest, tile_min[static_cast<std::size_t>(sy) * tiles_x + sx]);
           }
         }
-        coarse[t] = active(t) && smallest >= kCoarseRadiusPx;
+        // Flat tiles are copied: cheaper than their share of the half-size frame.
+        coarse[t] = active(t) && reach[t] > 0.5f && smallest >= kCoarseRadiusPx;
         part_coarse[t] =
             active(t) && !coarse[t] && reach[t] > 0.5f && tile_max[t] >= kCoarseRadiusPx;
         any_coarse = any_coarse || coarse[t] || part_coarse[t];
