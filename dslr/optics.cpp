@@ -502,21 +502,35 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       // (pixel x0 + 2k sits a quarter of a half pixel left of half pixel x0/2 + k, pixel
       // x0 + 2k + 1 a quarter right: fixed weights), then each row blends two of them. All
       // loops run over contiguous values.
-      constexpr int kValues = 3 * kTile, kHalfValues = kValues / 2;
+      constexpr int kValues = 3 * kTile;
       float unused;
       const int row_first = half_row_of(y0, &unused), row_last = half_row_of(y1 - 1, &unused) + 1;
-      std::array<float, kValues*(kTile / 2 + 2)> spread;
+      // One value of padding: each pixel is stored as four lanes, the fourth overwritten next.
+      std::array<float, kValues*(kTile / 2 + 2) + 1> spread;
+      using Lanes4 = float __attribute__((vector_size(16)));
+      auto load4 = [](const float* p) {
+        Lanes4 v;
+        std::memcpy(&v, p, sizeof v);
+        return v;
+      };
       for (int j = row_first; j <= row_last; ++j) {
         const float* v = &half_out[3 * (static_cast<std::size_t>(j) * half.width + first)];
-        float left[kHalfValues], right[kHalfValues];
-        for (int k = 0; k < kHalfValues; ++k) {
-          left[k] = 0.25f * v[k] + 0.75f * v[k + 3];
-          right[k] = 0.75f * v[k + 3] + 0.25f * v[k + 6];
-        }
         float* row = &spread[(j - row_first) * kValues];
+        Lanes4 here = load4(v);
         for (int k = 0; k < kTile / 2; ++k) {
-          std::memcpy(row + 6 * k, left + 3 * k, 3 * sizeof(float));
-          std::memcpy(row + 6 * k + 3, right + 3 * k, 3 * sizeof(float));
+          const Lanes4 next = load4(v + 3 * k + 3);
+          // The last pixel's fourth lane would read past the tile's half pixels: read up to them.
+          Lanes4 after;
+          if (k + 1 < kTile / 2) {
+            after = load4(v + 3 * k + 6);
+          } else {
+            after = Lanes4{v[3 * k + 6], v[3 * k + 7], v[3 * k + 8], 0.0f};
+          }
+          const Lanes4 left = 0.25f * here + 0.75f * next;
+          const Lanes4 right = 0.75f * next + 0.25f * after;
+          std::memcpy(row + 6 * k, &left, sizeof left);
+          std::memcpy(row + 6 * k + 3, &right, sizeof right);
+          here = next;
         }
       }
       for (int y = y0; y < y1; ++y) {
