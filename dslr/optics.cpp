@@ -192,6 +192,26 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
   s.behind[0] = br, s.behind[1] = bg, s.behind[2] = bb;
 }
 
+// gather_group where every tap lies on the pixels' own surface (depths within kSameDepth of
+// theirs): the same sums, without the front and behind layers, which stay zero.
+__attribute__((target_clones("avx2", "default"))) void gather_group_one_surface(
+    const Planes& pl, const TapSet& set, int tap_count, std::size_t i, GroupSums& s) {
+  const Floats zero = {};
+  Floats ws_sum = zero, sr = zero, sg = zero, sb = zero;
+  for (int t = 0; t < tap_count; ++t) {
+    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
+    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
+    const Floats rq = load(&pl.radius[q]);
+    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
+    const Floats r = load(&pl.r[q]), g = load(&pl.g[q]), b = load(&pl.b[q]);
+    ws_sum += ws;
+    sr += ws * r, sg += ws * g, sb += ws * b;
+  }
+  s.wf = zero, s.ws = ws_sum, s.wb = zero;
+  for (int k = 0; k < 3; ++k) s.front[k] = s.behind[k] = zero;
+  s.same[0] = sr, s.same[1] = sg, s.same[2] = sb;
+}
+
 // Front-to-back compositing of the three layers, for the group's first `count` pixels: all
 // lanes at once, then stored interleaved. (ws > 0 always: a pixel's own tap covers it.)
 void composite(const GroupSums& s, int count, float* out) {
@@ -388,6 +408,28 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         bool flat = peak > 0;
         for (int c = 0; c < 3; ++c) flat = flat && hi[c] - lo[c] <= kFlatTolerance * peak;
         if (flat) reach[t] = 0.5f;
+      }
+    }
+  });
+
+  // Tiles whose every reachable pixel lies within kSameDepth of every other (a margin keeps the
+  // gather's float products on the same side): one surface, the front and behind layers empty.
+  std::vector<char> one_surface(tile_max.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
+    for (int ty = r.begin(); ty < r.end(); ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        if (reach[t] <= 0.5f || !active(t)) continue;
+        const int span = static_cast<int>(std::ceil((reach[t] + 1) / kTile));
+        float nearest = tile_near[t], furthest = tile_far[t];
+        for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
+          for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
+            const std::size_t source = static_cast<std::size_t>(sy) * tiles_x + sx;
+            nearest = std::min(nearest, tile_near[source]);
+            furthest = std::max(furthest, tile_far[source]);
+          }
+        }
+        one_surface[t] = furthest <= nearest * (1 + 0.9f * kSameDepth);
       }
     }
   });
@@ -687,6 +729,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             continue;
           }
           const int tap_count = set.taps_for(radius);
+          // Every pixel a tap can reach on one surface: the cheaper gather, same sums.
+          const auto gather = one_surface[t] ? gather_group_one_surface : gather_group;
           // Part-coarse tiles: a group of pixels whose discs, and all discs within
           // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
           // tile. The smallest disc over each row's window, per group, then over the rows.
@@ -720,7 +764,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                   continue;
                 }
               }
-              gather_group(pl, set, tap_count, pl.index(x, y), sums);
+              gather(pl, set, tap_count, pl.index(x, y), sums);
               composite(sums, std::min(kLanes, x1 - x),
                         &out[3 * (static_cast<std::size_t>(y) * w + x)]);
             }
