@@ -1,16 +1,22 @@
 #include "dslr/lens.h"
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <mutex>
 
 #include "dslr/buffer_pool.h"
+#include "dslr/simd.h"
 
 namespace rigc::dslr {
 
@@ -327,6 +333,84 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             if (has_depth) out.depth_m[o] = depth_m[nearest];
             if (has_mask) out.mask[o] = mask[nearest];
           };
+          // A whole cell whose eight pixels read eight neighbouring canvas columns of one pair of
+          // rows (the distortion shifts a cell by a fraction of a pixel, it rarely stretches
+          // it across one): its 24 values are blended eight at a time from contiguous loads,
+          // the same arithmetic as `sample` per value. False (nothing written) otherwise.
+          static_assert(kMapStep == 8, "a cell is one 8-lane register of pixels");
+          auto contiguous_cell = [&](std::size_t o, float u0, float du, float v0, float dv,
+                                     float g0, float dg) {
+            using simd::F32x8;
+            using simd::I32x8;
+            const F32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+            const F32x8 ta = (lane + 0.5f) / kMapStep;
+            const F32x8 uc = u0 + ta * du, vc = v0 + ta * dv, gain = g0 + ta * dg;
+            const F32x8 fu = simd::floor(uc), fv = simd::floor(vc);
+            const float first_u = fu[0], first_v = fv[0];
+            if (simd::any((fu != first_u + lane) | (fv != first_v))) return false;
+            const int iu = static_cast<int>(first_u), iv = static_cast<int>(first_v);
+            if (!(iu >= 0 && iv >= 0 && iu + kMapStep < cw && iv + 1 < ch)) return false;
+            const F32x8 au = uc - fu, av = vc - fv;
+            const float* top = &rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
+            const float* bottom = top + 3 * static_cast<std::size_t>(cw);
+            float* dst = &out.rgb[3 * o];
+            // Value 8·part + lane is channel (8·part + lane) % 3 of pixel (8·part + lane) / 3.
+            static constexpr I32x8 kPixelOf[3] = {
+                {0, 0, 0, 1, 1, 1, 2, 2}, {2, 3, 3, 3, 4, 4, 4, 5}, {5, 5, 6, 6, 6, 7, 7, 7}};
+            auto load8 = [](const float* p) {
+              F32x8 v;
+              std::memcpy(&v, p, sizeof v);
+              return v;
+            };
+            for (int part = 0; part < 3; ++part) {
+              const F32x8 a = simd::permute(au, kPixelOf[part]);
+              const F32x8 b = simd::permute(av, kPixelOf[part]);
+              const F32x8 g = simd::permute(gain, kPixelOf[part]);
+              const F32x8 p00 = load8(top + 8 * part), p10 = load8(top + 8 * part + 3);
+              const F32x8 p01 = load8(bottom + 8 * part), p11 = load8(bottom + 8 * part + 3);
+              const F32x8 upper = p00 + a * (p10 - p00);
+              const F32x8 lower = p01 + a * (p11 - p01);
+              const F32x8 value = (upper + b * (lower - upper)) * g;
+              std::memcpy(dst + 8 * part, &value, sizeof value);
+            }
+            // Depth and mask from the nearest canvas pixel: column iu + k or the next one, row iv
+            // or the next one.
+            const I32x8 right = au >= 0.5f, down = av >= 0.5f;
+            if (has_mask) {
+              const std::uint8_t* upper = &mask[static_cast<std::size_t>(iv) * cw + iu];
+              const std::uint8_t* lower = upper + cw;
+#if defined(__AVX2__)
+              // Lane masks narrowed to bytes; the eight mask bytes picked from four loads.
+              auto bytes_of = [](I32x8 lanes) {
+                const __m256i wide = reinterpret_cast<__m256i>(lanes);
+                const __m128i words = _mm_packs_epi32(_mm256_castsi256_si128(wide),
+                                                      _mm256_extracti128_si256(wide, 1));
+                return _mm_packs_epi16(words, words);
+              };
+              auto load_bytes = [](const std::uint8_t* p) {
+                return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
+              };
+              const __m128i take_right = bytes_of(right), take_lower = bytes_of(down);
+              const __m128i from_upper =
+                  _mm_blendv_epi8(load_bytes(upper), load_bytes(upper + 1), take_right);
+              const __m128i from_lower =
+                  _mm_blendv_epi8(load_bytes(lower), load_bytes(lower + 1), take_right);
+              _mm_storel_epi64(reinterpret_cast<__m128i*>(&out.mask[o]),
+                               _mm_blendv_epi8(from_upper, from_lower, take_lower));
+#else
+              for (int k = 0; k < kMapStep; ++k) {
+                out.mask[o + k] = (down[k] ? lower : upper)[k + (right[k] ? 1 : 0)];
+              }
+#endif
+            }
+            if (has_depth) {
+              for (int k = 0; k < kMapStep; ++k) {
+                out.depth_m[o + k] = depth_m[static_cast<std::size_t>(iv + (down[k] ? 1 : 0)) * cw +
+                                             iu + k + (right[k] ? 1 : 0)];
+              }
+            }
+            return true;
+          };
           // Node to node: the map's cells are kMapStep pixels wide.
           for (int a = 0; a * kMapStep < sensor.width; ++a) {
             const int i_begin = a * kMapStep, i_end = std::min(sensor.width, i_begin + kMapStep);
@@ -334,6 +418,10 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
               const float u0 = row_u[a], du = row_u[a + 1] - u0;
               const float v0 = row_v[a], dv = row_v[a + 1] - v0;
               const float g0 = row_gain[a], dg = row_gain[a + 1] - g0;
+              if (i_end - i_begin == kMapStep &&
+                  contiguous_cell(row + i_begin, u0, du, v0, dv, g0, dg)) {
+                continue;
+              }
               for (int i = i_begin; i < i_end; ++i) {
                 const float ta = (i - i_begin + 0.5f) / kMapStep;
                 sample(row + i, u0 + ta * du, v0 + ta * dv, g0 + ta * dg);

@@ -188,6 +188,50 @@ TEST(DslrDistortion, WarpSamplesTheExactUndistortedPosition) {
   EXPECT_LT(worst, 0.01);
 }
 
+TEST(DslrDistortion, WarpTakesDepthAndMaskFromTheNearestCanvasPixel) {
+  // Colour, depth and mask all ramps of the canvas position: the warped colour says where the
+  // warp sampled, and depth and mask must come from the canvas pixel nearest to that. A mild
+  // lens (most cells take the eight-pixel path) and a strong one (many fall back per pixel).
+  for (const double k1 : {-0.02, -0.2}) {
+    ir::Camera camera = canon_6d();
+    camera.effects.distortion = true;
+    camera.effects.vignetting = false;
+    camera.distortion = opencv_coefficients();
+    camera.distortion.k1 = k1;
+    const double scale = 0.25;
+    const RenderGeometry g = render_geometry_for(camera, scale);
+    const std::size_t n = static_cast<std::size_t>(g.width) * g.height;
+    std::vector<float> ramp(3 * n), depth(n);
+    std::vector<std::uint8_t> mask(n);
+    auto mask_at = [](int x, int y) { return static_cast<std::uint8_t>((7 * x + 13 * y) & 255); };
+    for (int y = 0; y < g.height; ++y) {
+      for (int x = 0; x < g.width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * g.width + x;
+        ramp[3 * p] = static_cast<float>(x), ramp[3 * p + 1] = static_cast<float>(y);
+        depth[p] = static_cast<float>(1 + p);
+        mask[p] = mask_at(x, y);
+      }
+    }
+    const Intrinsics s = sensor_intrinsics(camera, scale);
+    const SensorImage warped = warp_to_sensor(camera, s, g, ramp, depth, mask);
+    int checked = 0, wrong = 0;
+    for (std::size_t p = 0; p < static_cast<std::size_t>(s.width) * s.height; ++p) {
+      const float u = warped.rgb[3 * p], v = warped.rgb[3 * p + 1];
+      // Halfway between two pixels the ramp's rounding could pick either: skip those.
+      if (std::abs(u - std::floor(u) - 0.5f) < 1e-3f || std::abs(v - std::floor(v) - 0.5f) < 1e-3f)
+        continue;
+      const int x = std::clamp(static_cast<int>(std::floor(u + 0.5f)), 0, g.width - 1);
+      const int y = std::clamp(static_cast<int>(std::floor(v + 0.5f)), 0, g.height - 1);
+      ++checked;
+      wrong +=
+          warped.depth_m[p] != static_cast<float>(1 + static_cast<std::size_t>(y) * g.width + x) ||
+          warped.mask[p] != mask_at(x, y);
+    }
+    EXPECT_GT(checked, s.width * s.height * 9 / 10) << "k1 " << k1;
+    EXPECT_EQ(wrong, 0) << "k1 " << k1;
+  }
+}
+
 TEST(DslrVignetting, CornersLoseTheConfiguredFraction) {
   ir::Camera camera = canon_6d();
   camera.effects.vignetting = true;

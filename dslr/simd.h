@@ -59,6 +59,18 @@ inline F32x8 floor(F32x8 x) {
 #endif
 }
 
+// x[index[k]] in each lane k (index in 0..7).
+inline F32x8 permute(F32x8 x, I32x8 index) {
+#if defined(__AVX2__)
+  return reinterpret_cast<F32x8>(
+      _mm256_permutevar8x32_ps(reinterpret_cast<__m256>(x), reinterpret_cast<__m256i>(index)));
+#else
+  F32x8 out;
+  for (int k = 0; k < 8; ++k) out[k] = x[index[k] & 7];
+  return out;
+#endif
+}
+
 // base[index[k]] in each lane k.
 inline F32x8 gather(const float* base, I32x8 index) {
 #if defined(__AVX2__)
