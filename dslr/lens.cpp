@@ -404,10 +404,12 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
 #endif
             }
             if (has_depth) {
-              for (int k = 0; k < kMapStep; ++k) {
-                out.depth_m[o + k] = depth_m[static_cast<std::size_t>(iv + (down[k] ? 1 : 0)) * cw +
-                                             iu + k + (right[k] ? 1 : 0)];
-              }
+              const float* upper = &depth_m[static_cast<std::size_t>(iv) * cw + iu];
+              const float* lower = upper + cw;
+              const F32x8 from_upper = right ? load8(upper + 1) : load8(upper);
+              const F32x8 from_lower = right ? load8(lower + 1) : load8(lower);
+              const F32x8 nearest = down ? from_lower : from_upper;
+              std::memcpy(&out.depth_m[o], &nearest, sizeof nearest);
             }
             return true;
           };
