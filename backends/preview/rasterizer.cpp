@@ -1270,7 +1270,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // Radiance at the corners of a tile's 4 x 4 blocks on a plain studio plane, cached per tile
   // and plane. On the plane: unclamped barycentrics reach past the triangle's edges along it.
   struct PlaneCorners {
-    std::array<Vector3f, kCorners * kCorners> color;
+    // One corner of padding: a row's last corner is read as four floats.
+    std::array<Vector3f, kCorners * kCorners + 1> color;
     std::array<std::int32_t, kCorners * kCorners> plane;  // source triangle, -1: not yet
     PlaneCorners() { plane.fill(-1); }
   };
@@ -1339,16 +1340,6 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     for (int py = y0; py < y1; ++py) {
       const int cy = (py - y0) / kBlock;
       const float fy = ((py - y0) % kBlock + 0.5f) / kBlock;
-      // The corner grid's two rows around this one, blended down to it (one value of padding:
-      // the blocks below load four values per corner).
-      std::array<Vector3f, kCorners> edge;
-      std::array<float, 3 * kCorners + 1> edge_values;
-      for (int cx = 0; cx <= columns; ++cx) {
-        edge[cx] =
-            (1 - fy) * cache.color[cy * kCorners + cx] + fy * cache.color[(cy + 1) * kCorners + cx];
-        for (int c = 0; c < 3; ++c) edge_values[3 * cx + c] = edge[cx][c];
-      }
-      edge_values[3 * columns + 3] = 0;
       float* rgb = &frame.rgb[3 * (static_cast<std::size_t>(py) * canvas.width + x0)];
       float* depth = &frame.depth_m[static_cast<std::size_t>(py) * canvas.width + x0];
       std::fill_n(&frame.mask[static_cast<std::size_t>(py) * canvas.width + x0], x1 - x0, 0);
@@ -1360,22 +1351,28 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                                             {0.375f, 0.375f, 0.625f, 0.625f},
                                             {0.625f, 0.875f, 0.875f, 0.875f}};
       static constexpr Int4 kChannel[3] = {{0, 1, 2, 0}, {1, 2, 0, 1}, {2, 0, 1, 2}};
+      // The corners' rows read directly: loading four floats just stored as three stalls.
+      const float* upper_row = cache.color[cy * kCorners].data();
+      const float* lower_row = cache.color[(cy + 1) * kCorners].data();
+      auto edge_at = [&](int cx) {
+        return fy * load4(lower_row + 3 * cx) + (1 - fy) * load4(upper_row + 3 * cx);
+      };
       for (int cx = 0; cx < whole_blocks; ++cx) {
-        const Float4 left = load4(&edge_values[3 * cx]), right = load4(&edge_values[3 * cx + 3]);
+        const Float4 left = edge_at(cx), right = edge_at(cx + 1);
         for (int k = 0; k < 3; ++k) {
           const Float4 from = __builtin_shuffle(left, kChannel[k]);
           const Float4 to = __builtin_shuffle(right, kChannel[k]);
           store4(rgb + 3 * kBlock * cx + 4 * k, kWeight[k] * to + (1 - kWeight[k]) * from);
         }
       }
+      // A last, partial block (the canvas's right edge): pixel by pixel.
       for (int px = x0 + kBlock * whole_blocks; px < x1; ++px) {
         const int cx = (px - x0) / kBlock;
         const float fx = ((px - x0) % kBlock + 0.5f) / kBlock;
-        const Vector3f color = (1 - fx) * edge[cx] + fx * edge[cx + 1];
+        const Float4 left = edge_at(cx), right = edge_at(cx + 1);
+        const Float4 color = fx * right + (1 - fx) * left;
         float* out = rgb + 3 * (px - x0);
-        out[0] = color.x();
-        out[1] = color.y();
-        out[2] = color.z();
+        for (int c = 0; c < 3; ++c) out[c] = color[c];
       }
       // The nearest sample's 1/z, as the visibility pass computes it.
       const float iz_row = plane.inv_z_plane[1] * (static_cast<float>(py) + kSampleY[near_sample]);
@@ -1383,7 +1380,11 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         const Float8 sx = (static_cast<float>(px) + pixel_x) + kSampleX[near_sample];
         const Float8 nearest = plane.inv_z_plane[0] * sx + iz_row + plane.inv_z_plane[2];
         const Float8 z = nearest > 0 ? 1 / nearest : infinity;
-        std::memcpy(depth + (px - x0), &z, std::min(8, x1 - px) * sizeof(float));
+        if (x1 - px >= 8) {
+          std::memcpy(depth + (px - x0), &z, sizeof z);  // a fixed size: no library call
+        } else {
+          std::memcpy(depth + (px - x0), &z, (x1 - px) * sizeof(float));
+        }
       }
     }
     return true;
