@@ -384,6 +384,10 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
 
   // Flat tiles: every pixel a tap of theirs can reach is within kFlatTolerance of the others,
   // so the gather could not change them beyond that. They keep their values (reach 0.5).
+  // One-surface tiles: every pixel a tap can reach lies within kSameDepth in depth of every other
+  // (a margin keeps the gather's float products on the same side), so the front and behind
+  // layers stay empty and the cheaper gather gives the same sums.
+  std::vector<char> one_surface(tile_max.size(), 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
     for (int ty = r.begin(); ty < r.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
@@ -395,40 +399,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           lo[c] = tile_range[6 * t + c];
           hi[c] = tile_range[6 * t + 3 + c];
         }
+        float nearest = tile_near[t], furthest = tile_far[t];
         for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
           for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
-            const float* source = &tile_range[6 * (static_cast<std::size_t>(sy) * tiles_x + sx)];
+            const std::size_t source = static_cast<std::size_t>(sy) * tiles_x + sx;
             for (int c = 0; c < 3; ++c) {
-              lo[c] = std::min(lo[c], source[c]);
-              hi[c] = std::max(hi[c], source[3 + c]);
+              lo[c] = std::min(lo[c], tile_range[6 * source + c]);
+              hi[c] = std::max(hi[c], tile_range[6 * source + 3 + c]);
             }
+            nearest = std::min(nearest, tile_near[source]);
+            furthest = std::max(furthest, tile_far[source]);
           }
         }
         const float peak = std::max({hi[0], hi[1], hi[2]});
         bool flat = peak > 0;
         for (int c = 0; c < 3; ++c) flat = flat && hi[c] - lo[c] <= kFlatTolerance * peak;
         if (flat) reach[t] = 0.5f;
-      }
-    }
-  });
-
-  // Tiles whose every reachable pixel lies within kSameDepth of every other (a margin keeps the
-  // gather's float products on the same side): one surface, the front and behind layers empty.
-  std::vector<char> one_surface(tile_max.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
-    for (int ty = r.begin(); ty < r.end(); ++ty) {
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-        if (reach[t] <= 0.5f || !active(t)) continue;
-        const int span = static_cast<int>(std::ceil((reach[t] + 1) / kTile));
-        float nearest = tile_near[t], furthest = tile_far[t];
-        for (int sy = std::max(0, ty - span); sy <= std::min(tiles_y - 1, ty + span); ++sy) {
-          for (int sx = std::max(0, tx - span); sx <= std::min(tiles_x - 1, tx + span); ++sx) {
-            const std::size_t source = static_cast<std::size_t>(sy) * tiles_x + sx;
-            nearest = std::min(nearest, tile_near[source]);
-            furthest = std::max(furthest, tile_far[source]);
-          }
-        }
         one_surface[t] = furthest <= nearest * (1 + 0.9f * kSameDepth);
       }
     }
