@@ -357,11 +357,7 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             // Value 8·part + lane is channel (8·part + lane) % 3 of pixel (8·part + lane) / 3.
             static constexpr I32x8 kPixelOf[3] = {
                 {0, 0, 0, 1, 1, 1, 2, 2}, {2, 3, 3, 3, 4, 4, 4, 5}, {5, 5, 6, 6, 6, 7, 7, 7}};
-            auto load8 = [](const float* p) {
-              F32x8 v;
-              std::memcpy(&v, p, sizeof v);
-              return v;
-            };
+            using simd::load8;
             for (int part = 0; part < 3; ++part) {
               const F32x8 a = simd::permute(au, kPixelOf[part]);
               const F32x8 b = simd::permute(av, kPixelOf[part]);

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "dslr/buffer_pool.h"
+#include "dslr/simd.h"
 
 // The 32-byte vectors of the gather are only passed between functions inlined into the AVX2 and
 // the default clone of one function, so GCC's note on their ABI without AVX does not apply.
@@ -135,13 +136,9 @@ struct Planes {
   }
 };
 
-using Floats = float __attribute__((vector_size(4 * kLanes)));
-
-inline Floats load(const float* p) {
-  Floats v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
+static_assert(kLanes == 8, "a group of pixels is one simd::F32x8");
+using Floats = simd::F32x8;
+using simd::load8;
 
 inline Floats clamp01(Floats v) {
   const Floats zero = {}, one = zero + 1;
@@ -160,7 +157,7 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
                                                                     const TapSet& set,
                                                                     int tap_count, std::size_t i,
                                                                     GroupSums& s) {
-  const Floats zp = load(&pl.z[i]), rp = load(&pl.radius[i]);
+  const Floats zp = load8(&pl.z[i]), rp = load8(&pl.radius[i]);
   const Floats z_front = zp * (1 - kSameDepth), z_back = zp * (1 + kSameDepth);
   const Floats zero = {};
   // Locals rather than s's members, so the accumulators can stay in registers.
@@ -170,9 +167,9 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
   for (int t = 0; t < tap_count; ++t) {
     const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
     const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
-    const Floats zq = load(&pl.z[q]), rq = load(&pl.radius[q]);
+    const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
     // In front or on the same surface: q's own disc must reach p, with q's energy per pixel.
-    const Floats w_disc = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
+    const Floats w_disc = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
     // Behind: seen only through p's own disc, so a sharp p never picks it up.
     const Floats w_behind = area * clamp01((rp - d) * inv_soft + 0.5f);
     const auto front = zq < z_front;
@@ -180,7 +177,7 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
     const Floats wf = front ? w_disc : zero;
     const Floats wb = behind ? w_behind : zero;
     const Floats ws = (front | behind) ? zero : w_disc;
-    const Floats r = load(&pl.r[q]), g = load(&pl.g[q]), b = load(&pl.b[q]);
+    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
     wf_sum += wf, ws_sum += ws, wb_sum += wb;
     fr += wf * r, fg += wf * g, fb += wf * b;
     sr += ws * r, sg += ws * g, sb += ws * b;
@@ -201,9 +198,9 @@ __attribute__((target_clones("avx2", "default"))) void gather_group_one_surface(
   for (int t = 0; t < tap_count; ++t) {
     const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
     const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
-    const Floats rq = load(&pl.radius[q]);
-    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load(&pl.inv_area[q]);
-    const Floats r = load(&pl.r[q]), g = load(&pl.g[q]), b = load(&pl.b[q]);
+    const Floats rq = load8(&pl.radius[q]);
+    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
+    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
     ws_sum += ws;
     sr += ws * r, sg += ws * g, sb += ws * b;
   }
@@ -535,27 +532,23 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       const int row_first = half_row_of(y0, &unused), row_last = half_row_of(y1 - 1, &unused) + 1;
       // One value of padding: each pixel is stored as four lanes, the fourth overwritten next.
       std::array<float, kValues*(kTile / 2 + 2) + 1> spread;
-      using Lanes4 = float __attribute__((vector_size(16)));
-      auto load4 = [](const float* p) {
-        Lanes4 v;
-        std::memcpy(&v, p, sizeof v);
-        return v;
-      };
+      using simd::F32x4;
+      using simd::load4;
       for (int j = row_first; j <= row_last; ++j) {
         const float* v = &half_out[3 * (static_cast<std::size_t>(j) * half.width + first)];
         float* row = &spread[(j - row_first) * kValues];
-        Lanes4 here = load4(v);
+        F32x4 here = load4(v);
         for (int k = 0; k < kTile / 2; ++k) {
-          const Lanes4 next = load4(v + 3 * k + 3);
+          const F32x4 next = load4(v + 3 * k + 3);
           // The last pixel's fourth lane would read past the tile's half pixels: read up to them.
-          Lanes4 after;
+          F32x4 after;
           if (k + 1 < kTile / 2) {
             after = load4(v + 3 * k + 6);
           } else {
-            after = Lanes4{v[3 * k + 6], v[3 * k + 7], v[3 * k + 8], 0.0f};
+            after = F32x4{v[3 * k + 6], v[3 * k + 7], v[3 * k + 8], 0.0f};
           }
-          const Lanes4 left = 0.25f * here + 0.75f * next;
-          const Lanes4 right = 0.75f * next + 0.25f * after;
+          const F32x4 left = 0.25f * here + 0.75f * next;
+          const F32x4 right = 0.75f * next + 0.25f * after;
           std::memcpy(row + 6 * k, &left, sizeof left);
           std::memcpy(row + 6 * k + 3, &right, sizeof right);
           here = next;
@@ -799,7 +792,7 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
     int i = 3 * inner_begin;
     for (; i + kLanes <= 3 * inner_end; i += kLanes) {
       Floats acc = {};
-      for (int k = -radius; k <= radius; ++k) acc += kernel[k + radius] * load(row + i + 3 * k);
+      for (int k = -radius; k <= radius; ++k) acc += kernel[k + radius] * load8(row + i + 3 * k);
       std::memcpy(dst + i, &acc, sizeof acc);
     }
     for (; i < 3 * inner_end; ++i) {
@@ -834,7 +827,7 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
         std::size_t i = 0;
         for (; i + kLanes <= row_values; i += kLanes) {
           Floats acc = {};
-          for (int t = 0; t < taps; ++t) acc += kernel[t] * load(rows[t] + i);
+          for (int t = 0; t < taps; ++t) acc += kernel[t] * load8(rows[t] + i);
           std::memcpy(dst + i, &acc, sizeof acc);
         }
         for (; i < row_values; ++i) {

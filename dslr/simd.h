@@ -59,6 +59,18 @@ inline F32x8 floor(F32x8 x) {
 #endif
 }
 
+// Eight or four floats from p, aligned or not.
+inline F32x8 load8(const float* p) {
+  F32x8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline F32x4 load4(const float* p) {
+  F32x4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 // x[index[k]] in each lane k (index in 0..7).
 inline F32x8 permute(F32x8 x, I32x8 index) {
 #if defined(__AVX2__)

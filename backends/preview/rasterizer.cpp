@@ -649,11 +649,7 @@ ScreenSetup setup_screen(int total_tris, const CameraVertex& camera_vertex,
 using Float4 = simd::F32x4;
 using Int4 = simd::I32x4;
 
-inline Float4 load4(const float* p) {
-  Float4 v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
+using simd::load4;
 inline Int4 load4(const std::int32_t* p) {
   Int4 v;
   std::memcpy(&v, p, sizeof(v));
