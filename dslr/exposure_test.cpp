@@ -69,6 +69,37 @@ TEST(DslrExposure, StrayNanOrNegativeRadianceBecomesBlack) {
   EXPECT_FLOAT_EQ(signal[3], 100 * exposure_scale(camera));
 }
 
+TEST(DslrExposure, CleanFrameIsExposedWithTheVignettingGainAlike) {
+  // A renderer's clean frame skips the exposure pass and takes the scale in the warp: through
+  // depth of field, diffraction, distortion and vignetting it must develop as any other frame.
+  ir::Camera camera = canon_6d();
+  camera.effects.depth_of_field = camera.effects.diffraction = true;
+  camera.effects.distortion = camera.effects.vignetting = true;
+  camera.distortion.k1 = -0.05;
+  camera.vignetting = 0.4;
+  const Intrinsics grid = sensor_intrinsics(camera, kScale);
+  LinearFrame frame = flat_frame(grid, 0, 1.0f);
+  for (int y = 0; y < grid.height; ++y) {
+    for (int x = 0; x < grid.width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * grid.width + x;
+      for (int c = 0; c < 3; ++c) frame.rgb[3 * p + c] = 50.0f + 3.0f * x + 2.0f * y + 40.0f * c;
+      frame.depth_m[p] = x < grid.width / 2 ? 1.0f : 3.0f;  // a depth step: one side blurred
+    }
+  }
+  ShotParams shot;
+  shot.focus_distance_m = 1;
+  const std::vector<float> plain = develop_frame(camera, frame, shot, kScale).linear;
+  frame.rgb_clean = true;
+  const std::vector<float> clean = develop_frame(camera, frame, shot, kScale).linear;
+  ASSERT_EQ(plain.size(), clean.size());
+  double largest = 0;
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    largest = std::max(largest, std::abs(double(plain[i]) - clean[i]) / std::max(plain[i], 1e-6f));
+  }
+  EXPECT_LT(largest, 1e-5);
+  EXPECT_GT(mean_of(clean), 0.5 * exposure_scale(camera) * 50);  // exposed once, not twice
+}
+
 TEST(DslrMotionBlur, LengthIsAngularSpeedTimesLeverArmInPixels) {
   const double omega = 2 * M_PI / 10;  // one turn in 10 s
   EXPECT_NEAR(motion_blur_length_px(omega, 1.0 / 125, 0.1, 0.8, 7642),

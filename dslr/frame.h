@@ -34,6 +34,10 @@ struct LinearFrame {
   std::vector<float> depth_m;
   // Optional object mask (0 or 255); empty when the renderer has none.
   std::vector<std::uint8_t> mask;
+  // Whether every rgb value is known to be finite and >= 0 (the preview renderer's frames). Such
+  // a frame skips the exposure pass that would clean it: the exposure's scale is applied with the
+  // vignetting gain instead, a multiply on values the warp writes anyway.
+  bool rgb_clean = false;
 
   Intrinsics intrinsics() const { return {width, height, fx, fy, cx, cy}; }
 };

@@ -235,7 +235,7 @@ bool same_grid(const Intrinsics& a, const Intrinsics& b) {
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
                            const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask,
-                           std::vector<float> storage) {
+                           std::vector<float> storage, double signal_scale) {
   SensorImage out;
   out.intrinsics = sensor;
   const std::size_t n = static_cast<std::size_t>(sensor.width) * sensor.height;
@@ -265,9 +265,9 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             const std::size_t row = static_cast<std::size_t>(j) * sensor.width;
             for (int i = 0; i < sensor.width; ++i) {
               const double xd = (i + 0.5 - sensor.cx) / sensor.fx;
-              const float gain = vignetting > 0 ? static_cast<float>(vignetting_gain(
-                                                      vignetting, xd * xd + yd * yd, r2_corner))
-                                                : 1.0f;
+              const float gain = static_cast<float>(
+                  signal_scale *
+                  (vignetting > 0 ? vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner) : 1));
               for (int c = 0; c < 3; ++c)
                 out.rgb[3 * (row + i) + c] = rgb[3 * (row + i) + c] * gain;
             }
@@ -295,7 +295,8 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             const std::size_t k0 = map.node(a, b), k1 = k0 + map.nodes_x;
             row_u[a] = static_cast<float>((1 - tb) * map.u[k0] + tb * map.u[k1]);
             row_v[a] = static_cast<float>((1 - tb) * map.v[k0] + tb * map.v[k1]);
-            row_gain[a] = static_cast<float>((1 - tb) * map.gain[k0] + tb * map.gain[k1]);
+            row_gain[a] =
+                static_cast<float>(signal_scale * ((1 - tb) * map.gain[k0] + tb * map.gain[k1]));
             row_valid[a] = map.valid[k0] && map.valid[k1];
           }
           // Bilinear from the canvas at (uc, vc), scaled by the vignetting gain; depth and mask
@@ -440,7 +441,8 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
               }
               sample(o, static_cast<float>(canvas.fx * xu.x() + canvas.cx - 0.5),
                      static_cast<float>(canvas.fy * xu.y() + canvas.cy - 0.5),
-                     static_cast<float>(vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner)));
+                     static_cast<float>(signal_scale *
+                                        vignetting_gain(vignetting, xd * xd + yd * yd, r2_corner)));
             }
           }
         }

@@ -47,9 +47,11 @@ struct SensorImage {
 // coordinates and sample the canvas (bilinear for colour, nearest for depth and mask), then apply
 // vignetting. camera.effects.distortion / .vignetting switch the two effects.
 // `storage`, if given, is a spare buffer reused for the output colour (no fresh pages to fault in).
+// `signal_scale` multiplies the colour with the vignetting gain (the exposure, when the canvas
+// holds radiance).
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
                            const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask,
-                           std::vector<float> storage = {});
+                           std::vector<float> storage = {}, double signal_scale = 1);
 
 }  // namespace rigc::dslr

@@ -58,7 +58,15 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
                       std::vector<float> work, const ShotParams& shot, double scale) {
   DevelopResult result;
   StageClock clock;
-  expose_in_place(camera, work);
+  // Depth of field and diffraction are linear, so a clean frame's exposure can wait for the
+  // warp's gain; any other frame is scaled here, which also zeroes its negative and non-finite
+  // values before a blur could spread them.
+  double signal_scale = 1;
+  if (frame.rgb_clean) {
+    signal_scale = exposure_scale(camera);
+  } else {
+    expose_in_place(camera, work);
+  }
   result.timings.exposure_ms = clock.lap_ms();
 
   const Intrinsics canvas = frame.intrinsics();
@@ -76,7 +84,7 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
   static const std::vector<float> no_depth;
   SensorImage image =
       warp_to_sensor(camera, sensor, canvas, work, shot.sensor_depth ? frame.depth_m : no_depth,
-                     frame.mask, std::move(scratch));
+                     frame.mask, std::move(scratch), signal_scale);
   recycle(std::move(work));
   if (owned != nullptr) {
     recycle(std::move(owned->depth_m));

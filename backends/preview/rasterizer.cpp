@@ -938,6 +938,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   frame.rgb = dslr::take_floats(pixel_count * 3);
   frame.depth_m = dslr::take_floats(pixel_count);
   frame.mask = dslr::take_bytes(pixel_count);
+  // Shading sums non-negative light with finite weights (GGX's roughness is floored).
+  frame.rgb_clean = true;
 
   const FrameContext context(scene, studio, request);
   const Matrix3f& object_rot = context.object_rot;
