@@ -1101,10 +1101,11 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     return sample.color;
   };
   // albedo_at for up to 16 pixels of one material at once (the pattern is evaluated eight
-  // pixels at a time): pixel i at (px[i], py[i]) on screen triangle tris[i].
+  // pixels at a time): pixel i at (px[i], py[i]) on screen triangle tris[i], with the footprint
+  // `footprint_m` (a float: all alike; a pointer: one per pixel).
   constexpr int kMaxBatch = 16;
   auto albedo_batch = [&](const int* tris, const int* px, const int* py, int count,
-                          float footprint_m, Vector3f* out) {
+                          auto footprint_m, Vector3f* out) {
     std::array<float, kMaxBatch> x, y, z, factor;
     int patterned = 0;
     for (int i = 0; i < count; ++i) {
@@ -1156,6 +1157,23 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // brdf = albedo·(1 - metallic)·(1 - F)/π + spec_colour·specular, where the specular colour
     // is white for dielectrics and blends towards the albedo with the metallic factor.
     return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
+  };
+  // Four pixels of one surface and material, each shaded as shade() does (its own normal, light
+  // and footprint), with their albedos batched: pixel i at (px[i], py[i]) on screen triangle
+  // tris[i].
+  auto shade_four = [&](const int* tris, const int* px, const int* py, Vector3f* out) {
+    std::array<float, 4> footprint;
+    std::array<Vector3f, 4> scale, offset;
+    for (int i = 0; i < 4; ++i) {
+      const SurfacePoint sp = surface_at(screen_tris[tris[i]], px[i] + 0.5f, py[i] + 0.5f);
+      const auto lighting = lighting_at(sp);
+      scale[i] = lighting.scale;
+      offset[i] = lighting.offset;
+      footprint[i] = sp.footprint_m;
+    }
+    std::array<Vector3f, 4> albedo;
+    albedo_batch(tris, px, py, 4, footprint.data(), albedo.data());
+    for (int i = 0; i < 4; ++i) out[i] = albedo[i].cwiseProduct(scale[i]) + offset[i];
   };
   // Studio triangles without a texture: one colour over a plane, lit smoothly.
   auto plain_studio = [&](const ScreenTriangle& t) {
@@ -1463,10 +1481,16 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             }
             return;
           }
+          // A bumpy patch: each pixel lit on its own; the albedos (the pattern) in one batch.
+          std::array<int, 4> tris, pxs, pys;
           for (int i = 0; i < 4; ++i) {
-            const int px = qx + (i & 1), py = qy + (i >> 1);
-            shade_pixel(px, py, quad[i]);
+            tris[i] = quad[i].triangle[0];
+            pxs[i] = qx + (i & 1);
+            pys[i] = qy + (i >> 1);
           }
+          std::array<Vector3f, 4> colors;
+          shade_four(tris.data(), pxs.data(), pys.data(), colors.data());
+          for (int i = 0; i < 4; ++i) write_pixel(pxs[i], pys[i], quad[i], colors[i]);
         };
         PlaneCorners corners;
         // The object's corners: lighting (albedo applied per pixel) and shading normal.

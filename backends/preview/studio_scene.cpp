@@ -209,8 +209,12 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float
   return factor;
 }
 
-void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
-                     const float* z, int count, float footprint_m, float* out) {
+namespace {
+
+// pattern_factors with point i's footprint footprint_of(i).
+template <typename FootprintOf>
+void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, const float* y,
+                          const float* z, int count, const FootprintOf& footprint_of, float* out) {
   using simd::F32x8;
   if (pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
     std::fill_n(out, count, 1.0f);
@@ -218,8 +222,6 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
   }
   const float scale = static_cast<float>(pattern.scale_m);
   const float contrast = static_cast<float>(pattern.contrast);
-  // Fade to the mean as the pattern gets finer than about two pixels.
-  const float resolve = std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f);
   for (int first = 0; first < count; first += 8) {
     const int lanes = std::min(8, count - first);
     F32x8 qx{}, qy{}, qz{};
@@ -270,10 +272,26 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
         break;
     }
     for (int k = 0; k < lanes; ++k) {
+      // Fade to the mean as the pattern gets finer than about two pixels.
+      const float resolve = std::clamp(2.0f - 2.0f * footprint_of(first + k) / scale, 0.0f, 1.0f);
       const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
       out[first + k] = 1.0f - contrast * d;
     }
   }
+}
+
+}  // namespace
+
+void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
+                     const float* z, int count, float footprint_m, float* out) {
+  pattern_factors_with(
+      pattern, x, y, z, count, [footprint_m](int) { return footprint_m; }, out);
+}
+
+void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
+                     const float* z, int count, const float* footprints_m, float* out) {
+  pattern_factors_with(
+      pattern, x, y, z, count, [footprints_m](int i) { return footprints_m[i]; }, out);
 }
 
 void Geometry::compute_face_normals() {

@@ -81,5 +81,8 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p
 // written to out[i], eight points per step (pattern_factor is this for one point).
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
                      const float* z, int count, float footprint_m, float* out);
+// The same with a footprint per point, footprints_m[i].
+void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
+                     const float* z, int count, const float* footprints_m, float* out);
 
 }  // namespace rigc::preview
