@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "backends/common/colmap_text.h"
@@ -378,6 +379,33 @@ TEST(Preview, BatchedPatternsMatchThePointPattern) {
 
 // Zooming out must not change a pattern's brightness: where it is resolved (a fine footprint)
 // its mean over the surface is the faded value it turns into once finer than a pixel.
+TEST(Preview, PatternFactorsWithAFootprintPerPointMatchEachPointAlone) {
+  ir::SurfacePattern pattern;
+  pattern.kind = ir::PatternKind::kSpeckle;
+  pattern.scale_m = 0.002;
+  pattern.contrast = 0.7;
+  pattern.seed = 9;
+  // Footprints from sharp (resolved) through half faded to fully faded, eleven points: one full
+  // batch of eight and a partial one.
+  constexpr int kPoints = 11;
+  std::vector<float> x(kPoints), y(kPoints), z(kPoints), footprint(kPoints), factor(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    x[i] = 0.0031f * i;
+    y[i] = 0.01f - 0.0017f * i;
+    z[i] = 0.0023f * i * i;
+    footprint[i] = 0.0002f * i;
+  }
+  preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint.data(),
+                           factor.data());
+  std::set<float> distinct;
+  for (int i = 0; i < kPoints; ++i) {
+    EXPECT_EQ(factor[i], preview::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint[i]))
+        << "point " << i;
+    distinct.insert(factor[i]);
+  }
+  EXPECT_GT(distinct.size(), 5u);  // the points do differ
+}
+
 TEST(Preview, ResolvedPatternsAverageToTheirFadedValue) {
   for (const auto kind :
        {ir::PatternKind::kSpeckle, ir::PatternKind::kNoise, ir::PatternKind::kChecker}) {
