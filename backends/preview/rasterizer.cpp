@@ -1160,8 +1160,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   };
   // Four pixels of one surface and material, each shaded as shade() does (its own normal, light
   // and footprint), with their albedos batched: pixel i at (px[i], py[i]) on screen triangle
-  // tris[i].
-  auto shade_four = [&](const int* tris, const int* px, const int* py, Vector3f* out) {
+  // tris[i]. known(px, py, footprints, albedo) may supply the albedos (true) instead.
+  auto shade_four = [&](const int* tris, const int* px, const int* py, auto&& known,
+                        Vector3f* out) {
     std::array<float, 4> footprint;
     std::array<Vector3f, 4> scale, offset;
     for (int i = 0; i < 4; ++i) {
@@ -1172,7 +1173,9 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       footprint[i] = sp.footprint_m;
     }
     std::array<Vector3f, 4> albedo;
-    albedo_batch(tris, px, py, 4, footprint.data(), albedo.data());
+    if (!known(px, py, footprint.data(), albedo.data())) {
+      albedo_batch(tris, px, py, 4, footprint.data(), albedo.data());
+    }
     for (int i = 0; i < 4; ++i) out[i] = albedo[i].cwiseProduct(scale[i]) + offset[i];
   };
   // Studio triangles without a texture: one colour over a plane, lit smoothly.
@@ -1413,6 +1416,34 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         // albedo (texture, pattern) per pixel: lighting varies slowly across two pixels, the
         // surface's detail does not. Quads that hold an edge, and odd last rows and columns, are
         // shaded pixel by pixel.
+        // A bumpy block that failed its light check (shade_object_block) leaves its sixteen
+        // albedos here for its quads: the same pixels, triangles and sample points. Of an
+        // albedo only the pattern's fade depends on the footprint, and where the block's and the
+        // quad's footprints both leave the pattern fully resolved, the albedos are the quad's.
+        struct BlockAlbedos {
+          bool valid = false;
+          int bx = 0, by = 0;
+          float footprint_m = 0;
+          float pattern_scale_m = 0;  // 0: no pattern, any footprint
+          std::array<Vector3f, kBlock * kBlock> albedo;
+        } failed_block;
+        auto resolved = [&](float footprint_m) {
+          const float scale = failed_block.pattern_scale_m;
+          // pattern_factors' fade, exactly: 1 leaves the pattern as it is.
+          return scale == 0 || std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f) == 1.0f;
+        };
+        auto known_albedos = [&](const int* px, const int* py, const float* footprints,
+                                 Vector3f* out) {
+          if (!failed_block.valid || !resolved(failed_block.footprint_m)) return false;
+          for (int i = 0; i < 4; ++i) {
+            if (!resolved(footprints[i])) return false;
+          }
+          for (int i = 0; i < 4; ++i) {
+            out[i] =
+                failed_block.albedo[(py[i] - failed_block.by) * kBlock + px[i] - failed_block.bx];
+          }
+          return true;
+        };
         auto resolve_quad = [&](int qx, int qy) {
           const bool whole = qx + 1 < x1 && qy + 1 < y1 && !request.per_pixel_lighting;
           std::array<PixelSurfaces, 4> quad;
@@ -1474,7 +1505,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               pxs[i] = qx + (i & 1);
               pys[i] = qy + (i >> 1);
             }
-            albedo_batch(tris.data(), pxs.data(), pys.data(), 4, centre.footprint_m, albedo.data());
+            const std::array<float, 4> footprints = {centre.footprint_m, centre.footprint_m,
+                                                     centre.footprint_m, centre.footprint_m};
+            if (!known_albedos(pxs.data(), pys.data(), footprints.data(), albedo.data())) {
+              albedo_batch(tris.data(), pxs.data(), pys.data(), 4, centre.footprint_m,
+                           albedo.data());
+            }
             for (int i = 0; i < 4; ++i) {
               write_pixel(pxs[i], pys[i], quad[i],
                           albedo[i].cwiseProduct(lighting.scale) + lighting.offset);
@@ -1489,7 +1525,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             pys[i] = qy + (i >> 1);
           }
           std::array<Vector3f, 4> colors;
-          shade_four(tris.data(), pxs.data(), pys.data(), colors.data());
+          shade_four(tris.data(), pxs.data(), pys.data(), known_albedos, colors.data());
           for (int i = 0; i < 4; ++i) write_pixel(pxs[i], pys[i], quad[i], colors[i]);
         };
         PlaneCorners corners;
@@ -1508,6 +1544,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         // kBlockBumpyNormalCos and its light nearly linear). False (and nothing written)
         // otherwise.
         auto shade_object_block = [&](int bx, int by) -> bool {
+          failed_block.valid = false;
           std::array<PixelSurfaces, kBlock * kBlock> block;
           int material = -1;
           for (int i = 0; i < kBlock * kBlock; ++i) {
@@ -1579,6 +1616,14 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             const Vector3f want = mean_albedo.cwiseProduct(exact.scale) + exact.offset;
             const Vector3f have = mean_albedo.cwiseProduct(scale) + offset;
             if (((have - want).cwiseAbs().array() > kBlockLightTolerance * want.array()).any()) {
+              const ir::SurfacePattern& pattern = studio.materials[material].pattern;
+              const bool patterned = pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
+              failed_block.valid = true;
+              failed_block.bx = bx;
+              failed_block.by = by;
+              failed_block.footprint_m = corner[0]->footprint_m;
+              failed_block.pattern_scale_m = patterned ? static_cast<float>(pattern.scale_m) : 0;
+              failed_block.albedo = albedo;
               return false;
             }
           }
@@ -1647,6 +1692,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               for (int qy = by; qy < std::min(y1, by + kBlock); qy += 2) {
                 for (int qx = bx; qx < std::min(x1, bx + kBlock); qx += 2) resolve_quad(qx, qy);
               }
+              failed_block.valid = false;  // its albedos served these quads only
               continue;
             }
             // Radiance at the block's corners, on the plane (unclamped barycentrics reach
