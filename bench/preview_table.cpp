@@ -25,6 +25,15 @@ namespace {
 namespace fs = std::filesystem;
 using rigc::preview::ShotTiming;
 
+// Seconds of CPU (user + system) the process has used: on a shared VM whose speed swings from
+// run to run, the CPU a run takes moves less than its wall time does.
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return t.tv_sec + t.tv_usec / 1e6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
 double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -35,6 +44,7 @@ struct Row {
   std::string name;
   int shots = 0;
   double seconds = 0;
+  double cpu_seconds = 0;
   std::map<std::string, double> stage_ms;
 };
 
@@ -50,15 +60,17 @@ Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int
   std::vector<ShotTiming> timings;
   std::ostringstream log;
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = cpu_seconds();
   const int code = rigc::preview::run_preview(scene, options, log, &timings);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = cpu_seconds() - cpu_start;
   fs::remove_all(dir);
   if (code != 0) {
     std::cerr << log.str();
     std::exit(2);
   }
-  Row row{name, static_cast<int>(options.shots.size()), seconds, {}};
+  Row row{name, static_cast<int>(options.shots.size()), seconds, cpu, {}};
   for (const auto& t : timings) {
     row.stage_ms["shadows"] += t.raster.shadow_ms;
     row.stage_ms["setup+bin"] += t.raster.setup_ms;
@@ -117,12 +129,13 @@ int main(int argc, char** argv) {
     rows.push_back(run(fmt::format("full res, {} tris", scene.object.mesh.triangles.size()), scene,
                        1.0, shots));
   }
-  std::cout << fmt::format("{:<24} {:>5} {:>9} {:>9}", "run", "shots", "total s", "s/shot");
+  std::cout << fmt::format("{:<24} {:>5} {:>9} {:>9} {:>9}", "run", "shots", "total s", "s/shot",
+                           "cpu s");
   for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
   std::cout << '\n';
   for (const auto& row : rows) {
-    std::cout << fmt::format("{:<24} {:>5} {:>9.2f} {:>9.3f}", row.name, row.shots, row.seconds,
-                             row.seconds / row.shots);
+    std::cout << fmt::format("{:<24} {:>5} {:>9.2f} {:>9.3f} {:>9.2f}", row.name, row.shots,
+                             row.seconds, row.seconds / row.shots, row.cpu_seconds);
     double sum = 0;
     for (const auto& [stage, ms] : row.stage_ms) sum += ms;
     for (const auto& [stage, ms] : row.stage_ms) {
@@ -131,11 +144,11 @@ int main(int argc, char** argv) {
     std::cout << '\n';
   }
   // The same split in milliseconds per shot.
-  std::cout << fmt::format("{:<24} {:>25}", "ms per shot", "");
+  std::cout << fmt::format("{:<24} {:>35}", "ms per shot", "");
   for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
   std::cout << '\n';
   for (const auto& row : rows) {
-    std::cout << fmt::format("{:<24} {:>25}", row.name, "");
+    std::cout << fmt::format("{:<24} {:>35}", row.name, "");
     for (const auto& [stage, ms] : row.stage_ms) {
       std::cout << fmt::format(" {:>12.1f}", ms / std::max(row.shots, 1));
     }
