@@ -1071,8 +1071,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size());
     AlbedoSample out;
     out.color = material.base_color;
-    out.patterned = is_object && material.pattern.kind != ir::PatternKind::kNone &&
-                    material.pattern.contrast > 0;
+    out.patterned = is_object && has_pattern(material.pattern);
     if (!textured && !out.patterned) return out;
     const Vector3f b = source_bary_at(s, px, py);
     if (textured) {
@@ -1424,19 +1423,16 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           bool valid = false;
           int bx = 0, by = 0;
           float footprint_m = 0;
-          float pattern_scale_m = 0;  // 0: no pattern, any footprint
+          const ir::SurfacePattern* pattern = nullptr;  // the block's material's
           std::array<Vector3f, kBlock * kBlock> albedo;
         } failed_block;
-        auto resolved = [&](float footprint_m) {
-          const float scale = failed_block.pattern_scale_m;
-          // pattern_factors' fade, exactly: 1 leaves the pattern as it is.
-          return scale == 0 || std::clamp(2.0f - 2.0f * footprint_m / scale, 0.0f, 1.0f) == 1.0f;
-        };
         auto known_albedos = [&](const int* px, const int* py, const float* footprints,
                                  Vector3f* out) {
-          if (!failed_block.valid || !resolved(failed_block.footprint_m)) return false;
+          if (!failed_block.valid) return false;
+          const ir::SurfacePattern& pattern = *failed_block.pattern;
+          if (!pattern_fully_resolved(pattern, failed_block.footprint_m)) return false;
           for (int i = 0; i < 4; ++i) {
-            if (!resolved(footprints[i])) return false;
+            if (!pattern_fully_resolved(pattern, footprints[i])) return false;
           }
           for (int i = 0; i < 4; ++i) {
             out[i] =
@@ -1496,15 +1492,15 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                                qy + (i >> 1) + 0.5f)
                          .dot(centre.n) >= kQuadNormalCos;
           }
+          std::array<int, 4> tris, pxs, pys;
+          for (int i = 0; i < 4; ++i) {
+            tris[i] = quad[i].triangle[0];
+            pxs[i] = qx + (i & 1);
+            pys[i] = qy + (i >> 1);
+          }
           if (smooth) {
             const Lighting lighting = lighting_at(centre);
-            std::array<int, 4> tris, pxs, pys;
             std::array<Vector3f, 4> albedo;
-            for (int i = 0; i < 4; ++i) {
-              tris[i] = quad[i].triangle[0];
-              pxs[i] = qx + (i & 1);
-              pys[i] = qy + (i >> 1);
-            }
             const std::array<float, 4> footprints = {centre.footprint_m, centre.footprint_m,
                                                      centre.footprint_m, centre.footprint_m};
             if (!known_albedos(pxs.data(), pys.data(), footprints.data(), albedo.data())) {
@@ -1518,12 +1514,6 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             return;
           }
           // A bumpy patch: each pixel lit on its own; the albedos (the pattern) in one batch.
-          std::array<int, 4> tris, pxs, pys;
-          for (int i = 0; i < 4; ++i) {
-            tris[i] = quad[i].triangle[0];
-            pxs[i] = qx + (i & 1);
-            pys[i] = qy + (i >> 1);
-          }
           std::array<Vector3f, 4> colors;
           shade_four(tris.data(), pxs.data(), pys.data(), known_albedos, colors.data());
           for (int i = 0; i < 4; ++i) write_pixel(pxs[i], pys[i], quad[i], colors[i]);
@@ -1616,13 +1606,11 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             const Vector3f want = mean_albedo.cwiseProduct(exact.scale) + exact.offset;
             const Vector3f have = mean_albedo.cwiseProduct(scale) + offset;
             if (((have - want).cwiseAbs().array() > kBlockLightTolerance * want.array()).any()) {
-              const ir::SurfacePattern& pattern = studio.materials[material].pattern;
-              const bool patterned = pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
               failed_block.valid = true;
               failed_block.bx = bx;
               failed_block.by = by;
               failed_block.footprint_m = corner[0]->footprint_m;
-              failed_block.pattern_scale_m = patterned ? static_cast<float>(pattern.scale_m) : 0;
+              failed_block.pattern = &studio.materials[material].pattern;
               failed_block.albedo = albedo;
               return false;
             }

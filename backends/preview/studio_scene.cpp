@@ -211,12 +211,17 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Vector3f& p, float
 
 namespace {
 
+// Fade to the mean as the pattern gets finer than about two pixels: 1 keeps it whole.
+float pattern_resolve(float scale_m, float footprint_m) {
+  return std::clamp(2.0f - 2.0f * footprint_m / scale_m, 0.0f, 1.0f);
+}
+
 // pattern_factors with point i's footprint footprint_of(i).
 template <typename FootprintOf>
 void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, const float* y,
                           const float* z, int count, const FootprintOf& footprint_of, float* out) {
   using simd::F32x8;
-  if (pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
+  if (!has_pattern(pattern)) {
     std::fill_n(out, count, 1.0f);
     return;
   }
@@ -272,8 +277,7 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
         break;
     }
     for (int k = 0; k < lanes; ++k) {
-      // Fade to the mean as the pattern gets finer than about two pixels.
-      const float resolve = std::clamp(2.0f - 2.0f * footprint_of(first + k) / scale, 0.0f, 1.0f);
+      const float resolve = pattern_resolve(scale, footprint_of(first + k));
       const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
       out[first + k] = 1.0f - contrast * d;
     }
@@ -281,6 +285,15 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
 }
 
 }  // namespace
+
+bool has_pattern(const ir::SurfacePattern& pattern) {
+  return pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
+}
+
+bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m) {
+  return !has_pattern(pattern) ||
+         pattern_resolve(static_cast<float>(pattern.scale_m), footprint_m) == 1.0f;
+}
 
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
                      const float* z, int count, float footprint_m, float* out) {

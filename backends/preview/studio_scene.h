@@ -77,6 +77,12 @@ StudioScene prepare_studio_scene(const ir::Scene& scene);
 float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p,
                      float footprint_m);
 
+// Whether `pattern` changes an albedo at all (a kind, and some contrast).
+bool has_pattern(const ir::SurfacePattern& pattern);
+// Whether `footprint_m` leaves the pattern fully resolved (no fade to its mean), so that the
+// factor at a point is the same for any such footprint. True without a pattern.
+bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m);
+
 // pattern_factor at `count` points (object-frame x[i], y[i], z[i]) sharing one footprint,
 // written to out[i], eight points per step (pattern_factor is this for one point).
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
