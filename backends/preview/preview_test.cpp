@@ -245,6 +245,32 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
   }
 }
 
+// A 4 x 4 block of the statue that fails its light check hands its 16 albedos to the quads
+// that shade its pixels instead (see FrameRequest::reuse_block_albedos). They must be the
+// albedos the quads would evaluate: the same pixel, the same bytes. At 0.7 scale the speckle is
+// fully resolved over much of the statue, so thousands of quads take them.
+TEST(Preview, QuadsTakingABlocksAlbedosShadeAsTheirOwn) {
+  const ir::Scene scene = paper_scene();
+  ASSERT_FALSE(scene.shots.empty());
+  const StudioScene studio = prepare_studio_scene(scene);
+  FrameRequest request;
+  request.world_from_camera = scene.shots[3].world_from_camera;
+  request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
+  request.canvas = dslr::render_geometry_for(scene.camera, 0.7);
+  request.shadow_map_size = 1024;
+  RasterTimings reused;
+  const dslr::LinearFrame with = render_frame(scene, studio, request, &reused);
+  request.reuse_block_albedos = false;
+  RasterTimings own;
+  const dslr::LinearFrame without = render_frame(scene, studio, request, &own);
+  EXPECT_GT(reused.quads_with_block_albedos, 1000);
+  EXPECT_EQ(own.quads_with_block_albedos, 0);
+  ASSERT_EQ(with.rgb.size(), without.rgb.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < with.rgb.size(); ++i) differing += with.rgb[i] != without.rgb[i];
+  EXPECT_EQ(differing, 0u);
+}
+
 // At full resolution the studio planes are lit at sparse corners (every 8 or 16 pixels where
 // the light is smooth). Two full-density windows of shot 3: the statue's foot on the turntable
 // (contact shadow) and the statue's soft shadow on the green screen, against per-pixel lighting.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -1269,6 +1270,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   };
 
   const auto raster_start = Clock::now();
+  std::atomic<std::int64_t> quads_with_block_albedos{0};
   // The studio is planes of one plain colour: over a 4 x 4 block within one plane the light
   // varies smoothly (soft shadows included), so it is summed at the block's corners and
   // interpolated, corners shared between blocks.
@@ -1426,9 +1428,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           const ir::SurfacePattern* pattern = nullptr;  // the block's material's
           std::array<Vector3f, kBlock * kBlock> albedo;
         } failed_block;
+        std::int64_t tile_quads_with_block_albedos = 0;  // summed once per tile (a shared counter)
         auto known_albedos = [&](const int* px, const int* py, const float* footprints,
                                  Vector3f* out) {
-          if (!failed_block.valid) return false;
+          if (!failed_block.valid || !request.reuse_block_albedos) return false;
           const ir::SurfacePattern& pattern = *failed_block.pattern;
           if (!pattern_fully_resolved(pattern, failed_block.footprint_m)) return false;
           for (int i = 0; i < 4; ++i) {
@@ -1438,6 +1441,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             out[i] =
                 failed_block.albedo[(py[i] - failed_block.by) * kBlock + px[i] - failed_block.bx];
           }
+          ++tile_quads_with_block_albedos;
           return true;
         };
         auto resolve_quad = [&](int qx, int qy) {
@@ -1700,9 +1704,14 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
             }
           }
         }
+        if (tile_quads_with_block_albedos > 0) {
+          quads_with_block_albedos.fetch_add(tile_quads_with_block_albedos,
+                                             std::memory_order_relaxed);
+        }
       });
   if (timings) {
     timings->raster_ms += ms_since(raster_start);
+    timings->quads_with_block_albedos += quads_with_block_albedos.load();
   }
   return frame;
 }

@@ -3,6 +3,7 @@
 // physical units, and shadow maps (soft for area lights).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "backends/preview/studio_scene.h"
@@ -19,12 +20,17 @@ struct FrameRequest {
   // Lights are summed once per 2 x 2 quad inside a surface (albedo stays per pixel); true sums
   // them for every pixel (tests compare the two).
   bool per_pixel_lighting = false;
+  // A 4 x 4 block of the object that fails its light check hands its albedos to the quads that
+  // then shade its pixels (where the pattern is fully resolved, they are the quads' own); false
+  // makes the quads evaluate every albedo (tests compare the two).
+  bool reuse_block_albedos = true;
 };
 
 struct RasterTimings {
   double shadow_ms = 0;
-  double setup_ms = 0;   // transform, clip, project, bin
-  double raster_ms = 0;  // visibility and shading
+  double setup_ms = 0;                        // transform, clip, project, bin
+  double raster_ms = 0;                       // visibility and shading
+  std::int64_t quads_with_block_albedos = 0;  // quads that took a failed block's albedos
 };
 
 // Renders radiance (cd/m² per channel), camera-space depth and the object mask.
