@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -67,6 +68,8 @@ struct TapSet {
   // For a radius of q/4 pixels: how many leading taps a disc that large can cover (the rest
   // weigh nothing). Quarter steps: a disc of 1.1 px needs 9 taps, not the 21 of a 2 px one.
   std::vector<int> count_for_quarter;
+  // extent_of_count[k]: how far (in x or y) the first k taps reach.
+  std::vector<int> extent_of_count;
   int taps_for(float radius) const {
     const int q = std::min(static_cast<int>(std::ceil(radius * 4)),
                            static_cast<int>(count_for_quarter.size()) - 1);
@@ -117,6 +120,11 @@ const TapSet& tap_set() {
       for (int t = 0; t < static_cast<int>(taps.size()); ++t) {
         if (taps[t].distance - 0.5f / taps[t].inv_soft < q / 4.0f) s.count_for_quarter[q] = t + 1;
       }
+    }
+    s.extent_of_count.assign(taps.size() + 1, 0);
+    for (std::size_t t = 0; t < taps.size(); ++t) {
+      s.extent_of_count[t + 1] =
+          std::max({s.extent_of_count[t], std::abs(taps[t].dx), std::abs(taps[t].dy)});
     }
     return s;
   }();
@@ -244,7 +252,8 @@ constexpr int kMaxCoarseLevel = 3;
 
 void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Intrinsics& canvas,
                     std::span<const float> rgb, std::span<const float> depth_m,
-                    std::vector<float>& out, int level, const std::vector<char>* needed_tiles) {
+                    std::vector<float>& out, int level, const std::vector<char>* needed_tiles,
+                    const DepthOfFieldOptions& options) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   resize_frame_buffer(out, rgb.size());
@@ -501,7 +510,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       }
     }
     depth_of_field(camera, focus_distance_m, half, {half_rgb, 3 * half_pixels},
-                   {half_depth, half_pixels}, half_out, level + 1, &half_needed);
+                   {half_depth, half_pixels}, half_out, level + 1, &half_needed, options);
   }
   // Bilinear from the half-size result: full pixel centre x + 0.5 sits at half x (x + 0.5) / 2.
   auto upsample_tile = [&](int x0, int x1, int y0, int y1) {
@@ -600,9 +609,11 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // Each thread's strip planes, kept between frames.
   thread_local Planes thread_planes;
 
+  std::atomic<std::int64_t> groups_with_fewer_taps{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& r) {
     Planes& pl = thread_planes;
     GroupSums sums;
+    std::int64_t strip_groups_with_fewer_taps = 0;
     for (int strip = r.begin(); strip < r.end(); ++strip) {
       const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
       const int ty0 = sy0 / kTile, ty1 = (sy1 + kTile - 1) / kTile;
@@ -711,6 +722,44 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           const int tap_count = set.taps_for(radius);
           // Every pixel a tap can reach on one surface: the cheaper gather, same sums.
           const auto gather = one_surface[t] ? gather_group_one_surface : gather_group;
+          // The taps a group of eight pixels needs. A tap at distance d weighs nothing unless the
+          // disc it tests reaches d: the disc of the pixel q there when q is in front of or level
+          // with the group's pixel, the pixel's own when q is behind. So beyond the largest of
+          // the group's own discs and the discs of every q within the tile's taps that is not
+          // behind the group's furthest pixel, the remaining taps add exact zeros. Along a
+          // silhouette that spares the object's pixels the background's big discs, which lie
+          // behind them. Only for the three-layer gather: one surface has no "behind".
+          const int extent = set.extent_of_count[tap_count];
+          const bool per_group =
+              options.taps_per_group && !one_surface[t] && tap_count > set.taps_for(2.0f);
+          auto group_taps = [&](int x, int y) {
+            if (!per_group) return tap_count;
+            const std::size_t i = pl.index(x, y);
+            const Floats zp = load8(&pl.z[i]), rp = load8(&pl.radius[i]);
+            float z_furthest = zp[0], needed = rp[0];
+            for (int k = 1; k < kLanes; ++k) {
+              z_furthest = std::max(z_furthest, zp[k]);
+              needed = std::max(needed, rp[k]);
+            }
+            const float z_behind = z_furthest * (1 + kSameDepth);
+            // The window's columns in whole registers, the last one overlapping the one before
+            // (columns counted twice change no maximum).
+            const int columns = kLanes + 2 * extent;
+            Floats largest = {};
+            for (int dy = -extent; dy <= extent; ++dy) {
+              const std::size_t row = pl.index(x - extent, y + dy);
+              for (int dx = 0; dx < columns; dx += kLanes) {
+                const std::size_t q = row + std::min(dx, columns - kLanes);
+                const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
+                const Floats counted = zq > z_behind ? Floats{} : rq;
+                largest = largest > counted ? largest : counted;
+              }
+            }
+            for (int k = 0; k < kLanes; ++k) needed = std::max(needed, largest[k]);
+            const int taps = std::min(tap_count, set.taps_for(needed));
+            strip_groups_with_fewer_taps += taps < tap_count;
+            return taps;
+          };
           // Part-coarse tiles: a group of pixels whose discs, and all discs within
           // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
           // tile. The smallest disc over each row's window, per group, then over the rows.
@@ -744,7 +793,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                   continue;
                 }
               }
-              gather(pl, set, tap_count, pl.index(x, y), sums);
+              gather(pl, set, group_taps(x, y), pl.index(x, y), sums);
               composite(sums, std::min(kLanes, x1 - x),
                         &out[3 * (static_cast<std::size_t>(y) * w + x)]);
             }
@@ -752,15 +801,21 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         }
       }
     }
+    groups_with_fewer_taps.fetch_add(strip_groups_with_fewer_taps, std::memory_order_relaxed);
   });
+  if (options.groups_with_fewer_taps != nullptr) {
+    *options.groups_with_fewer_taps += groups_with_fewer_taps.load();
+  }
 }
 
 }  // namespace
 
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
-                          const std::vector<float>& depth_m, std::vector<float>& out) {
-  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr);
+                          const std::vector<float>& depth_m, std::vector<float>& out,
+                          const DepthOfFieldOptions& options) {
+  if (options.groups_with_fewer_taps != nullptr) *options.groups_with_fewer_taps = 0;
+  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr, options);
 }
 
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,

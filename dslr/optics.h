@@ -37,9 +37,18 @@ double diffraction_sigma_m(double f_number, double wavelength_m = 550e-9);
 // pixels (large discs of small bright highlights show ring structure); discs are capped at
 // kMaxCocRadiusPx. Each 16x16 tile only visits the taps that the largest disc reaching it needs,
 // so sharp regions cost a copy and the cost grows with the blur (see the timings in the report).
+// Where several depths meet, each group of eight pixels narrows that further to the taps its own
+// discs and the discs not behind it can reach (the rest add exact zeros).
+struct DepthOfFieldOptions {
+  // False: every group gathers its tile's taps (tests compare the two; the sums are the same).
+  bool taps_per_group = true;
+  // If set, receives how many groups gathered fewer taps than their tile.
+  std::int64_t* groups_with_fewer_taps = nullptr;
+};
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
-                          const std::vector<float>& depth_m, std::vector<float>& out);
+                          const std::vector<float>& depth_m, std::vector<float>& out,
+                          const DepthOfFieldOptions& options = {});
 
 // Diffraction as a separable Gaussian of σ = 0.42·λ·N (λ = 550 nm) in canvas pixels, skipped
 // below 0.2 px. Applied after the disc blur it adds variances as CAMERA.md combines them

@@ -239,6 +239,49 @@ TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
   EXPECT_NEAR(red_at(edge - static_cast<int>(radius_px) - 2) / peak, 1, 1e-5);
 }
 
+// Where a blurred foreground, a sharp subject and a blurred background meet, each group of
+// eight pixels gathers only the taps that can weigh anything for it (DepthOfFieldOptions): the
+// sums, and so every value, must be those of the tile's full tap count.
+TEST(DslrDepthOfField, TapsPerGroupGiveTheTilesResult) {
+  ir::Camera camera = canon_6d();
+  camera.aperture_f_number = 2.8;
+  const double scale = 0.125;
+  LinearFrame frame = flat_frame(sensor_intrinsics(camera, scale), 0, 3.0f);
+  const int w = frame.width, h = frame.height;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * w + x;
+      float* rgb = &frame.rgb[3 * p];
+      // Left to right: subject, a bar in front of it, subject, background (and a band of
+      // background along the top), so some groups see only the bar's discs, some only the
+      // background's, some both.
+      const bool subject = x < 3 * w / 4 && y > h / 6;
+      const bool near = x > w / 4 && x < w / 3 && y > h / 3;
+      if (near) {  // a blurred bar in front of the subject
+        frame.depth_m[p] = 0.45f;
+        rgb[0] = 900, rgb[1] = 300 + 200 * ((y / 3) % 2), rgb[2] = 100;
+      } else if (subject) {  // the sharp subject at the focus distance, finely striped
+        frame.depth_m[p] = static_cast<float>(kFocus);
+        rgb[0] = 200, rgb[1] = 500 + 400 * ((x / 2) % 2), rgb[2] = 300;
+      } else {  // a textured background, far behind
+        rgb[0] = 100 + 300 * (((x / 5) + (y / 5)) % 2), rgb[1] = 600, rgb[2] = 800;
+      }
+    }
+  }
+  std::vector<float> per_group, per_tile;
+  std::int64_t narrowed = -1, not_narrowed = -1;
+  apply_depth_of_field(camera, kFocus, frame.intrinsics(), frame.rgb, frame.depth_m, per_group,
+                       {true, &narrowed});
+  apply_depth_of_field(camera, kFocus, frame.intrinsics(), frame.rgb, frame.depth_m, per_tile,
+                       {false, &not_narrowed});
+  EXPECT_GT(narrowed, 500);
+  EXPECT_EQ(not_narrowed, 0);
+  ASSERT_EQ(per_group.size(), per_tile.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < per_group.size(); ++i) differing += per_group[i] != per_tile[i];
+  EXPECT_EQ(differing, 0u);
+}
+
 // A small camera with the 6D's 6.54 µm pixels, so diffraction has its real size in pixels.
 ir::Camera small_sensor_camera(double f_number) {
   ir::Camera camera = canon_6d();
