@@ -162,10 +162,13 @@ struct GroupSums {
 
 // One row of kLanes neighbouring pixels against taps [0, tap_count): the loads for a tap are
 // contiguous, so this vectorises. AVX2 where the CPU has it, SSE otherwise.
+// Taps [three_layer, tap_count) are known to hold no pixel behind any of the eight and no pixel
+// in front of one whose disc reaches that far: there the front and behind terms add exact zeros,
+// so they take the one-surface arithmetic (the same sums, in the same order).
 __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes& pl,
                                                                     const TapSet& set,
                                                                     int tap_count, std::size_t i,
-                                                                    GroupSums& s) {
+                                                                    GroupSums& s, int three_layer) {
   const Floats zp = load8(&pl.z[i]), rp = load8(&pl.radius[i]);
   const Floats z_front = zp * (1 - kSameDepth), z_back = zp * (1 + kSameDepth);
   const Floats zero = {};
@@ -173,7 +176,8 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
   Floats wf_sum = zero, ws_sum = zero, wb_sum = zero;
   Floats fr = zero, fg = zero, fb = zero, sr = zero, sg = zero, sb = zero, br = zero, bg = zero,
          bb = zero;
-  for (int t = 0; t < tap_count; ++t) {
+  const int layered = std::min(three_layer, tap_count);
+  for (int t = 0; t < layered; ++t) {
     const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
     const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
     const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
@@ -192,6 +196,15 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
     sr += ws * r, sg += ws * g, sb += ws * b;
     br += wb * r, bg += wb * g, bb += wb * b;
   }
+  for (int t = layered; t < tap_count; ++t) {
+    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
+    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
+    const Floats rq = load8(&pl.radius[q]);
+    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
+    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
+    ws_sum += ws;
+    sr += ws * r, sg += ws * g, sb += ws * b;
+  }
   s.wf = wf_sum, s.ws = ws_sum, s.wb = wb_sum;
   s.front[0] = fr, s.front[1] = fg, s.front[2] = fb;
   s.same[0] = sr, s.same[1] = sg, s.same[2] = sb;
@@ -201,7 +214,7 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
 // gather_group where every tap lies on the pixels' own surface (depths within kSameDepth of
 // theirs): the same sums, without the front and behind layers, which stay zero.
 __attribute__((target_clones("avx2", "default"))) void gather_group_one_surface(
-    const Planes& pl, const TapSet& set, int tap_count, std::size_t i, GroupSums& s) {
+    const Planes& pl, const TapSet& set, int tap_count, std::size_t i, GroupSums& s, int) {
   const Floats zero = {};
   Floats ws_sum = zero, sr = zero, sg = zero, sb = zero;
   for (int t = 0; t < tap_count; ++t) {
@@ -732,16 +745,28 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           const int extent = set.extent_of_count[tap_count];
           const bool per_group =
               options.taps_per_group && !one_surface[t] && tap_count > set.taps_for(2.0f);
-          auto group_taps = [&](int x, int y) {
-            if (!per_group) return tap_count;
+          // Also the taps from which no pixel is behind any of the group's (behind its nearest)
+          // and no disc of a pixel in front of one of them (of its furthest) reaches: from
+          // there on the cheaper arithmetic of one surface gives the same sums.
+          struct GroupTaps {
+            int three_layer, count;
+          };
+          auto group_taps = [&](int x, int y) -> GroupTaps {
+            if (!per_group) return {tap_count, tap_count};
             const std::size_t i = pl.index(x, y);
             const Floats zp = load8(&pl.z[i]), rp = load8(&pl.radius[i]);
-            float z_furthest = zp[0], needed = rp[0];
+            float z_furthest = zp[0], z_nearest = zp[0], needed = rp[0];
             for (int k = 1; k < kLanes; ++k) {
               z_furthest = std::max(z_furthest, zp[k]);
+              z_nearest = std::min(z_nearest, zp[k]);
               needed = std::max(needed, rp[k]);
             }
             const float z_behind = z_furthest * (1 + kSameDepth);
+            // As gather_group compares: behind the nearest pixel, in front of the furthest.
+            const float z_behind_nearest = z_nearest * (1 + kSameDepth);
+            const float z_front_furthest = z_furthest * (1 - kSameDepth);
+            Floats front_largest = {};
+            simd::I32x8 any_behind = {};
             // The window's columns in whole registers, the last one overlapping the one before
             // (columns counted twice change no maximum).
             const int columns = kLanes + 2 * extent;
@@ -753,12 +778,20 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                 const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
                 const Floats counted = zq > z_behind ? Floats{} : rq;
                 largest = largest > counted ? largest : counted;
+                const Floats front = zq < z_front_furthest ? rq : Floats{};
+                front_largest = front_largest > front ? front_largest : front;
+                any_behind |= zq > z_behind_nearest;
               }
             }
-            for (int k = 0; k < kLanes; ++k) needed = std::max(needed, largest[k]);
+            float front_needed = 0;
+            for (int k = 0; k < kLanes; ++k) {
+              needed = std::max(needed, largest[k]);
+              front_needed = std::max(front_needed, front_largest[k]);
+            }
             const int taps = std::min(tap_count, set.taps_for(needed));
             strip_groups_with_fewer_taps += taps < tap_count;
-            return taps;
+            if (simd::any(any_behind)) return {taps, taps};
+            return {std::min(taps, set.taps_for(front_needed)), taps};
           };
           // Part-coarse tiles: a group of pixels whose discs, and all discs within
           // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
@@ -793,7 +826,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                   continue;
                 }
               }
-              gather(pl, set, group_taps(x, y), pl.index(x, y), sums);
+              const GroupTaps taps = group_taps(x, y);
+              gather(pl, set, taps.count, pl.index(x, y), sums, taps.three_layer);
               composite(sums, std::min(kLanes, x1 - x),
                         &out[3 * (static_cast<std::size_t>(y) * w + x)]);
             }

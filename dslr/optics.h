@@ -38,9 +38,11 @@ double diffraction_sigma_m(double f_number, double wavelength_m = 550e-9);
 // kMaxCocRadiusPx. Each 16x16 tile only visits the taps that the largest disc reaching it needs,
 // so sharp regions cost a copy and the cost grows with the blur (see the timings in the report).
 // Where several depths meet, each group of eight pixels narrows that further to the taps its own
-// discs and the discs not behind it can reach (the rest add exact zeros).
+// discs and the discs not behind it can reach (the rest add exact zeros), and takes the cheaper
+// one-surface arithmetic for the taps that no front disc and no pixel behind it reaches.
 struct DepthOfFieldOptions {
-  // False: every group gathers its tile's taps (tests compare the two; the sums are the same).
+  // False: every group gathers its tile's taps, all in three layers (tests compare the two; the
+  // sums are the same).
   bool taps_per_group = true;
   // If set, receives how many groups gathered fewer taps than their tile.
   std::int64_t* groups_with_fewer_taps = nullptr;

@@ -240,8 +240,9 @@ TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
 }
 
 // Where a blurred foreground, a sharp subject and a blurred background meet, each group of
-// eight pixels gathers only the taps that can weigh anything for it (DepthOfFieldOptions): the
-// sums, and so every value, must be those of the tile's full tap count.
+// eight pixels gathers only the taps that can weigh anything for it, in one layer where nothing
+// in front or behind can weigh (DepthOfFieldOptions): the sums, and so every value, must be those
+// of the tile's full tap count in three layers.
 TEST(DslrDepthOfField, TapsPerGroupGiveTheTilesResult) {
   ir::Camera camera = canon_6d();
   camera.aperture_f_number = 2.8;
