@@ -704,7 +704,28 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         // input, so both vectorise.
         const int fill_begin = std::max(0, fill_x0), fill_end = std::min(w, fill_x1);
         const float* depth_row = &depth_m[image_row];
-        for (int x = fill_begin; x < fill_end; ++x) {
+        // Eight at a time with radius_at's arithmetic, op for op (the compiler leaves the plain
+        // loop scalar: the lambda's captures might alias the planes).
+        int x = fill_begin;
+        {
+          const Floats zero = {}, infinity = zero + inf, half = zero + 0.5f,
+                       largest = zero + static_cast<float>(kMaxCocRadiusPx);
+          for (; x + kLanes <= fill_end; x += kLanes) {
+            const Floats depth = load8(depth_row + x);
+            const Floats z = depth > zero ? depth : infinity;
+            Floats raw = radius_at_infinity * (1 - focus / z);
+            raw = raw < zero ? -raw : raw;
+            Floats square = raw * raw - removed_radius_sq;
+            square = zero < square ? square : zero;
+            Floats radius = simd::sqrt(square);
+            radius = radius < half ? half : (largest < radius ? largest : radius);
+            const Floats area = 1 / (std::numbers::pi_v<float> * radius * radius);
+            std::memcpy(zs + x, &z, sizeof z);
+            std::memcpy(radii + x, &radius, sizeof radius);
+            std::memcpy(inv_area + x, &area, sizeof area);
+          }
+        }
+        for (; x < fill_end; ++x) {
           const float z = depth_row[x] > 0 ? depth_row[x] : inf;
           const float radius = radius_at(z);
           zs[x] = z;
