@@ -410,12 +410,13 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       }
     }
     const float inf = std::numeric_limits<float>::infinity();
-    for (float* key = key_rows; key != map.depth.data() + static_cast<size_t>(row1) * size; ++key) {
-      if (map.orthographic) {
-        *key = -*key;
-      } else {
-        *key = *key > 0 ? 1 / *key : inf;
-      }
+    // The flag read once: the stores below might alias it, which kept the loop scalar.
+    const bool orthographic = map.orthographic;
+    float* const keys_end = map.depth.data() + static_cast<size_t>(row1) * size;
+    if (orthographic) {
+      for (float* key = key_rows; key != keys_end; ++key) *key = -*key;
+    } else {
+      for (float* key = key_rows; key != keys_end; ++key) *key = *key > 0 ? 1 / *key : inf;
     }
   });
 }
