@@ -160,6 +160,22 @@ struct GroupSums {
   Floats front[3], same[3], behind[3];
 };
 
+// Taps [begin, end) on the pixels' own surface: each tap's disc weight and colour into the same
+// layer's sums (inlined into each gather, so the sums stay in registers).
+[[gnu::always_inline]] inline void one_surface_taps(const Planes& pl, const TapSet& set, int begin,
+                                                    int end, std::size_t i, Floats& ws_sum,
+                                                    Floats& sr, Floats& sg, Floats& sb) {
+  for (int t = begin; t < end; ++t) {
+    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
+    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
+    const Floats rq = load8(&pl.radius[q]);
+    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
+    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
+    ws_sum += ws;
+    sr += ws * r, sg += ws * g, sb += ws * b;
+  }
+}
+
 // One row of kLanes neighbouring pixels against taps [0, tap_count): the loads for a tap are
 // contiguous, so this vectorises. AVX2 where the CPU has it, SSE otherwise.
 // Taps [three_layer, tap_count) are known to hold no pixel behind any of the eight and no pixel
@@ -196,15 +212,7 @@ __attribute__((target_clones("avx2", "default"))) void gather_group(const Planes
     sr += ws * r, sg += ws * g, sb += ws * b;
     br += wb * r, bg += wb * g, bb += wb * b;
   }
-  for (int t = layered; t < tap_count; ++t) {
-    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
-    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
-    const Floats rq = load8(&pl.radius[q]);
-    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
-    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
-    ws_sum += ws;
-    sr += ws * r, sg += ws * g, sb += ws * b;
-  }
+  one_surface_taps(pl, set, layered, tap_count, i, ws_sum, sr, sg, sb);
   s.wf = wf_sum, s.ws = ws_sum, s.wb = wb_sum;
   s.front[0] = fr, s.front[1] = fg, s.front[2] = fb;
   s.same[0] = sr, s.same[1] = sg, s.same[2] = sb;
@@ -217,15 +225,7 @@ __attribute__((target_clones("avx2", "default"))) void gather_group_one_surface(
     const Planes& pl, const TapSet& set, int tap_count, std::size_t i, GroupSums& s, int) {
   const Floats zero = {};
   Floats ws_sum = zero, sr = zero, sg = zero, sb = zero;
-  for (int t = 0; t < tap_count; ++t) {
-    const std::ptrdiff_t q = static_cast<std::ptrdiff_t>(i) + set.dy[t] * pl.stride + set.dx[t];
-    const float d = set.distance[t], area = set.area[t], inv_soft = set.inv_soft[t];
-    const Floats rq = load8(&pl.radius[q]);
-    const Floats ws = area * clamp01((rq - d) * inv_soft + 0.5f) * load8(&pl.inv_area[q]);
-    const Floats r = load8(&pl.r[q]), g = load8(&pl.g[q]), b = load8(&pl.b[q]);
-    ws_sum += ws;
-    sr += ws * r, sg += ws * g, sb += ws * b;
-  }
+  one_surface_taps(pl, set, 0, tap_count, i, ws_sum, sr, sg, sb);
   s.wf = zero, s.ws = ws_sum, s.wb = zero;
   for (int k = 0; k < 3; ++k) s.front[k] = s.behind[k] = zero;
   s.same[0] = sr, s.same[1] = sg, s.same[2] = sb;
