@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 #include <span>
+#include <type_traits>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/simd.h"
@@ -283,10 +284,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   const float focus = static_cast<float>(focus_distance_m);
   float removed_radius_sq = 0;
   for (int k = 0; k < level; ++k) removed_radius_sq += std::ldexp(1.0f, -2 * k);
-  auto radius_at = [&](float z) {
-    const float radius = radius_at_infinity * std::abs(1 - focus / z);
-    return std::clamp(std::sqrt(std::max(0.0f, radius * radius - removed_radius_sq)), 0.5f,
-                      static_cast<float>(kMaxCocRadiusPx));
+  // For one depth (float) or eight (Floats), with the same operations: the plane fill runs it
+  // eight at a time. Captures by value, so a loop storing through pointers need not reload them.
+  auto radius_at = [radius_at_infinity, focus, removed_radius_sq](auto z) {
+    using T = decltype(z);
+    const T zero = T{}, half = zero + 0.5f, largest = zero + static_cast<float>(kMaxCocRadiusPx);
+    T radius = radius_at_infinity * (1 - focus / z);
+    radius = radius < zero ? -radius : radius;
+    T square = radius * radius - removed_radius_sq;
+    square = zero < square ? square : zero;
+    T root;
+    if constexpr (std::is_same_v<T, float>) {
+      root = std::sqrt(square);
+    } else {
+      root = simd::sqrt(square);
+    }
+    return root < half ? half : (largest < root ? largest : root);
   };
 
   // Largest disc per tile, then the largest disc reaching each tile.
@@ -755,21 +768,14 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         // input, so both vectorise.
         const int fill_begin = std::max(0, fill_x0), fill_end = std::min(w, fill_x1);
         const float* depth_row = &depth_m[image_row];
-        // Eight at a time with radius_at's arithmetic, op for op (the compiler leaves the plain
-        // loop scalar: the lambda's captures might alias the planes).
+        // Eight at a time (the compiler leaves the plain loop scalar), then the rest.
         int x = fill_begin;
         {
-          const Floats zero = {}, infinity = zero + inf, half = zero + 0.5f,
-                       largest = zero + static_cast<float>(kMaxCocRadiusPx);
+          const Floats zero = {}, infinity = zero + inf;
           for (; x + kLanes <= fill_end; x += kLanes) {
             const Floats depth = load8(depth_row + x);
             const Floats z = depth > zero ? depth : infinity;
-            Floats raw = radius_at_infinity * (1 - focus / z);
-            raw = raw < zero ? -raw : raw;
-            Floats square = raw * raw - removed_radius_sq;
-            square = zero < square ? square : zero;
-            Floats radius = simd::sqrt(square);
-            radius = radius < half ? half : (largest < radius ? largest : radius);
+            const Floats radius = radius_at(z);
             const Floats area = 1 / (std::numbers::pi_v<float> * radius * radius);
             std::memcpy(zs + x, &z, sizeof z);
             std::memcpy(radii + x, &radius, sizeof radius);
@@ -826,12 +832,11 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           auto group_taps = [&](int x, int y) -> GroupTaps {
             if (!per_group) return {tap_count, tap_count};
             const std::size_t i = pl.index(x, y);
-            const Floats zp = load8(&pl.z[i]), rp = load8(&pl.radius[i]);
-            float z_furthest = zp[0], z_nearest = zp[0], needed = rp[0];
+            const Floats zp = load8(&pl.z[i]);
+            float z_furthest = zp[0], z_nearest = zp[0];
             for (int k = 1; k < kLanes; ++k) {
               z_furthest = std::max(z_furthest, zp[k]);
               z_nearest = std::min(z_nearest, zp[k]);
-              needed = std::max(needed, rp[k]);
             }
             const float z_behind = z_furthest * (1 + kSameDepth);
             // As gather_group compares: behind the nearest pixel, in front of the furthest.
@@ -855,7 +860,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                 any_behind |= zq > z_behind_nearest;
               }
             }
-            float front_needed = 0;
+            // The group's own pixels lie in the window and are never behind the furthest of
+            // them: their discs are in `largest`.
+            float needed = 0, front_needed = 0;
             for (int k = 0; k < kLanes; ++k) {
               needed = std::max(needed, largest[k]);
               front_needed = std::max(front_needed, front_largest[k]);
