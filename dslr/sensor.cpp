@@ -213,9 +213,12 @@ void for_each_group(std::size_t values, const Fn& fn) {
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, (values + kNoiseLanes - 1) / kNoiseLanes, 1024),
       [&](const tbb::blocked_range<std::size_t>& range) {
+        // A local copy of fn (its captures by value): byte stores may alias any memory, so
+        // captures read through a reference would be loaded again after every group's store.
+        const Fn body = fn;
         for (std::size_t group = range.begin(); group < range.end(); ++group) {
           const std::size_t first = group * kNoiseLanes;
-          fn(first, std::min<std::size_t>(kNoiseLanes, values - first));
+          body(first, std::min<std::size_t>(kNoiseLanes, values - first));
         }
       });
 }
@@ -229,7 +232,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   const std::size_t values = 3 * pixels;
   if (!camera.effects.noise) {
-    for_each_group(values, [&](std::size_t first, std::size_t count) {
+    for_each_group(values, [=](std::size_t first, std::size_t count) {
       F32x8 x = {};
       std::memcpy(&x, signal + first, count * sizeof(float));
       const F32x8 zero = {}, one = zero + 1;
@@ -274,7 +277,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   // Below kExactPoissonBelow electrons the Gaussian stands in badly: those values take an
   // exact Poisson draw.
   const std::uint32_t uniform_key32 = static_cast<std::uint32_t>(uniform_key ^ (uniform_key >> 32));
-  for_each_group(values, [&](std::size_t first, std::size_t count) {
+  for_each_group(values, [=](std::size_t first, std::size_t count) {
     const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
     const U32x8 shot_bits = lowbias32(index ^ shot_key32);
     const F32x8 prnu = load_pattern(prnu_pattern + first);
@@ -360,7 +363,7 @@ std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int hei
   const std::uint16_t* table = encode.table;
   const float last = encode.last;
   sensor_pass(camera, width, height, signal.data(), seed, shot_index,
-              [codes, table, last, &gains](std::size_t first, std::size_t count, F32x8 out) {
+              [codes, table, last, gains](std::size_t first, std::size_t count, F32x8 out) {
                 // SrgbEncoding's arithmetic, eight values at once.
                 const F32x8 zero = {};
                 F32x8 x = out * gains[first % 3];
