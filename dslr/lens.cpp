@@ -283,6 +283,14 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
   const CanvasMap& map = *shared_map;
   tbb::parallel_for(
       tbb::blocked_range<int>(0, sensor.height), [&](const tbb::blocked_range<int>& rows) {
+        // Plain local pointers: the mask's byte stores may alias any memory, so data pointers
+        // read out of the vectors would be loaded again after every pixel.
+        const float* const canvas_rgb = rgb.data();
+        const float* const canvas_depth = depth_m.data();
+        const std::uint8_t* const canvas_mask = mask.data();
+        float* const sensor_rgb = out.rgb.data();
+        float* const sensor_depth = out.depth_m.data();
+        std::uint8_t* const sensor_mask = out.mask.data();
         // The map interpolated to this row, node by node.
         std::vector<float> row_u(map.nodes_x), row_v(map.nodes_x), row_gain(map.nodes_x);
         std::vector<char> row_valid(map.nodes_x);
@@ -309,7 +317,7 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             const float *p00, *p10, *p01, *p11;
             int ni, nj;
             if (iu >= 0 && iv >= 0 && iu + 1 < cw && iv + 1 < ch) {
-              p00 = &rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
+              p00 = &canvas_rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
               p10 = p00 + 3;
               p01 = p00 + 3 * static_cast<std::size_t>(cw);
               p11 = p01 + 3;
@@ -318,21 +326,21 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             } else {
               const int i0 = std::clamp(iu, 0, cw - 1), i1 = std::clamp(iu + 1, 0, cw - 1);
               const int j0 = std::clamp(iv, 0, ch - 1), j1 = std::clamp(iv + 1, 0, ch - 1);
-              p00 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
-              p10 = &rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
-              p01 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
-              p11 = &rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
+              p00 = &canvas_rgb[3 * (static_cast<std::size_t>(j0) * cw + i0)];
+              p10 = &canvas_rgb[3 * (static_cast<std::size_t>(j0) * cw + i1)];
+              p01 = &canvas_rgb[3 * (static_cast<std::size_t>(j1) * cw + i0)];
+              p11 = &canvas_rgb[3 * (static_cast<std::size_t>(j1) * cw + i1)];
               ni = std::clamp(iu + (au >= 0.5f), 0, cw - 1);
               nj = std::clamp(iv + (av >= 0.5f), 0, ch - 1);
             }
             for (int c = 0; c < 3; ++c) {
               const float top = p00[c] + au * (p10[c] - p00[c]);
               const float bottom = p01[c] + au * (p11[c] - p01[c]);
-              out.rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
+              sensor_rgb[3 * o + c] = (top + av * (bottom - top)) * gain;
             }
             const std::size_t nearest = static_cast<std::size_t>(nj) * cw + ni;
-            if (has_depth) out.depth_m[o] = depth_m[nearest];
-            if (has_mask) out.mask[o] = mask[nearest];
+            if (has_depth) sensor_depth[o] = canvas_depth[nearest];
+            if (has_mask) sensor_mask[o] = canvas_mask[nearest];
           };
           // A whole cell whose eight pixels read eight neighbouring canvas columns of one pair of
           // rows (the distortion shifts a cell by a fraction of a pixel, it rarely stretches
@@ -352,9 +360,9 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             const int iu = static_cast<int>(first_u), iv = static_cast<int>(first_v);
             if (!(iu >= 0 && iv >= 0 && iu + kMapStep < cw && iv + 1 < ch)) return false;
             const F32x8 au = uc - fu, av = vc - fv;
-            const float* top = &rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
+            const float* top = &canvas_rgb[3 * (static_cast<std::size_t>(iv) * cw + iu)];
             const float* bottom = top + 3 * static_cast<std::size_t>(cw);
-            float* dst = &out.rgb[3 * o];
+            float* dst = &sensor_rgb[3 * o];
             // Value 8·part + lane is channel (8·part + lane) % 3 of pixel (8·part + lane) / 3.
             static constexpr I32x8 kPixelOf[3] = {
                 {0, 0, 0, 1, 1, 1, 2, 2}, {2, 3, 3, 3, 4, 4, 4, 5}, {5, 5, 6, 6, 6, 7, 7, 7}};
@@ -374,7 +382,7 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
             // or the next one.
             const I32x8 right = au >= 0.5f, down = av >= 0.5f;
             if (has_mask) {
-              const std::uint8_t* upper = &mask[static_cast<std::size_t>(iv) * cw + iu];
+              const std::uint8_t* upper = &canvas_mask[static_cast<std::size_t>(iv) * cw + iu];
               const std::uint8_t* lower = upper + cw;
 #if defined(__AVX2__)
               // Lane masks narrowed to bytes; the eight mask bytes picked from four loads.
@@ -392,21 +400,21 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                   _mm_blendv_epi8(load_bytes(upper), load_bytes(upper + 1), take_right);
               const __m128i from_lower =
                   _mm_blendv_epi8(load_bytes(lower), load_bytes(lower + 1), take_right);
-              _mm_storel_epi64(reinterpret_cast<__m128i*>(&out.mask[o]),
+              _mm_storel_epi64(reinterpret_cast<__m128i*>(&sensor_mask[o]),
                                _mm_blendv_epi8(from_upper, from_lower, take_lower));
 #else
               for (int k = 0; k < kMapStep; ++k) {
-                out.mask[o + k] = (down[k] ? lower : upper)[k + (right[k] ? 1 : 0)];
+                sensor_mask[o + k] = (down[k] ? lower : upper)[k + (right[k] ? 1 : 0)];
               }
 #endif
             }
             if (has_depth) {
-              const float* upper = &depth_m[static_cast<std::size_t>(iv) * cw + iu];
+              const float* upper = &canvas_depth[static_cast<std::size_t>(iv) * cw + iu];
               const float* lower = upper + cw;
               const F32x8 from_upper = right ? load8(upper + 1) : load8(upper);
               const F32x8 from_lower = right ? load8(lower + 1) : load8(lower);
               const F32x8 nearest = down ? from_lower : from_upper;
-              std::memcpy(&out.depth_m[o], &nearest, sizeof nearest);
+              std::memcpy(&sensor_depth[o], &nearest, sizeof nearest);
             }
             return true;
           };
@@ -434,9 +442,9 @@ SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
               const double yd = (j + 0.5 - sensor.cy) / sensor.fy;
               ir::Vec2 xu;
               if (!try_undistort_normalized(camera.distortion, xd, yd, &xu)) {
-                for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] = 0;  // no light arrives here
-                if (has_depth) out.depth_m[o] = std::numeric_limits<float>::infinity();
-                if (has_mask) out.mask[o] = 0;
+                for (int c = 0; c < 3; ++c) sensor_rgb[3 * o + c] = 0;  // no light arrives here
+                if (has_depth) sensor_depth[o] = std::numeric_limits<float>::infinity();
+                if (has_mask) sensor_mask[o] = 0;
                 continue;
               }
               sample(o, static_cast<float>(canvas.fx * xu.x() + canvas.cx - 0.5),
