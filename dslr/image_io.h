@@ -21,7 +21,8 @@ namespace rigc::dslr {
 bool write_image(const std::filesystem::path& path, const DevelopResult& result,
                  const ir::Camera& camera, std::string* error);
 
-// Writes an 8-bit single-channel PNG (0/255) atomically.
+// Writes an 8-bit single-channel mask (0/255) atomically: a PNG encoded by runs for a .png path
+// (encode_mask_png), otherwise the format OpenImageIO gives the extension.
 bool write_mask(const std::filesystem::path& path, const std::vector<std::uint8_t>& mask, int width,
                 int height, std::string* error);
 
