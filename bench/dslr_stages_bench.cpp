@@ -93,6 +93,20 @@ void BM_DepthOfField(benchmark::State& state) {
   }
 }
 
+// As the pipeline runs it on a preview frame: with the tile ranges the renderer recorded, so the
+// frame is not scanned for them.
+void BM_DepthOfFieldWithTileRanges(benchmark::State& state) {
+  Fixture& f = fixture();
+  std::vector<float> out(f.frame.rgb.size());
+  const double focus = f.scene.shots[3].focus_distance_m;
+  rigc::dslr::DepthOfFieldOptions options;
+  options.tile_ranges = &f.frame.tile_ranges;
+  for (auto _ : state) {
+    rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
+                                     f.frame.depth_m, out, options);
+  }
+}
+
 void BM_Diffraction(benchmark::State& state) {
   Fixture& f = fixture();
   std::vector<float> work = f.frame.rgb, scratch(work.size());
@@ -193,6 +207,7 @@ void BM_WriteJpegAndMask(benchmark::State& state) {
 BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Exposure)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DepthOfField)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DepthOfFieldWithTileRanges)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Diffraction)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DistortionVignetting)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SensorNoise)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -22,6 +22,33 @@ struct RenderGeometry : Intrinsics {
   bool clipped = false;
 };
 
+// What the depth of field first needs of a frame, per square tile of kTile pixels (the last
+// row and column of tiles may be cut by the frame's edges): the nearest and furthest depth (a
+// depth that is not > 0 counts as +inf, background) and each channel's smallest and largest
+// radiance. A renderer that has its tiles in cache hands them over with the frame
+// (record_tile_ranges, in optics.h); otherwise the depth of field reads the whole frame once more
+// for them.
+struct TileRanges {
+  static constexpr int kTile = 16;
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<float> near_m, far_m;  // per tile, row-major
+  std::vector<float> radiance;       // 6 per tile: smallest r, g, b, then largest r, g, b
+
+  void resize_for(int width, int height) {
+    tiles_x = (width + kTile - 1) / kTile;
+    tiles_y = (height + kTile - 1) / kTile;
+    const std::size_t tiles = static_cast<std::size_t>(tiles_x) * tiles_y;
+    near_m.resize(tiles);
+    far_m.resize(tiles);
+    radiance.resize(6 * tiles);
+  }
+  bool fits(int width, int height) const {
+    const std::size_t tiles = static_cast<std::size_t>(tiles_x) * tiles_y;
+    return tiles_x == (width + kTile - 1) / kTile && tiles_y == (height + kTile - 1) / kTile &&
+           near_m.size() == tiles && far_m.size() == tiles && radiance.size() == 6 * tiles;
+  }
+};
+
 // A linear frame from any renderer, rendered with an UNDISTORTED pinhole camera.
 struct LinearFrame {
   int width = 0;
@@ -38,6 +65,9 @@ struct LinearFrame {
   // a frame skips the exposure pass that would clean it: the exposure's scale is applied with the
   // vignetting gain instead, a multiply on values the warp writes anyway.
   bool rgb_clean = false;
+  // Optional, for the depth of field: the ranges of exactly this rgb and depth_m (a renderer
+  // that changes either afterwards clears them).
+  TileRanges tile_ranges;
 
   Intrinsics intrinsics() const { return {width, height, fx, fy, cx, cy}; }
 };

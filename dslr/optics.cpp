@@ -22,6 +22,80 @@
 
 namespace rigc::dslr {
 
+void record_tile_ranges(const float* rgb, const float* depth_m, int width, int x0, int y0, int x1,
+                        int y1, TileRanges& ranges) {
+  constexpr int kTile = TileRanges::kTile;
+  static_assert(kTile == 16, "a tile row is two registers of depth and six of colour");
+  using simd::F32x8;
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  auto lower = [](F32x8 a, F32x8 b) { return b < a ? b : a; };  // std::min, lane by lane
+  auto upper = [](F32x8 a, F32x8 b) { return a < b ? b : a; };  // std::max
+  for (int ty0 = y0; ty0 < y1; ty0 += kTile) {
+    for (int tx0 = x0; tx0 < x1; tx0 += kTile) {
+      const int count = std::min(kTile, x1 - tx0);
+      // Per lane (depth) and per value (colour) over the tile's rows, in registers, then
+      // folded. A tile cut by the frame's right edge reads copies of its rows, padded.
+      F32x8 z_lo[2], z_hi[2], c_lo[6], c_hi[6];
+      for (auto& v : z_lo) v = F32x8{} + inf;
+      for (auto& v : z_hi) v = F32x8{};
+      for (auto& v : c_lo) v = F32x8{} + inf;
+      for (auto& v : c_hi) v = F32x8{} - inf;
+      for (int y = ty0; y < std::min(y1, ty0 + kTile); ++y) {
+        const float* z_row = depth_m + static_cast<std::size_t>(y) * width + tx0;
+        const float* c_row = rgb + 3 * (static_cast<std::size_t>(y) * width + tx0);
+        std::array<float, kTile> z_lo_pad, z_hi_pad;
+        std::array<float, 3 * kTile> lo_pad, hi_pad;
+        const float *z_lo_values = z_row, *z_hi_values = z_row;
+        const float *lo_values = c_row, *hi_values = c_row;
+        if (count < kTile) {
+          // Pads that move neither end: +inf for the smallest; for the largest depth the least
+          // positive float (a depth must be > 0 to stay itself) and -inf for the colour.
+          z_lo_pad.fill(inf);
+          z_hi_pad.fill(std::numeric_limits<float>::denorm_min());
+          lo_pad.fill(inf);
+          hi_pad.fill(-inf);
+          std::copy_n(z_row, count, z_lo_pad.begin());
+          std::copy_n(z_row, count, z_hi_pad.begin());
+          std::copy_n(c_row, 3 * count, lo_pad.begin());
+          std::copy_n(c_row, 3 * count, hi_pad.begin());
+          z_lo_values = z_lo_pad.data();
+          z_hi_values = z_hi_pad.data();
+          lo_values = lo_pad.data();
+          hi_values = hi_pad.data();
+        }
+        auto background_inf = [](F32x8 depth) {  // unknown depth: background
+          return depth > 0.0f ? depth : F32x8{} + inf;
+        };
+        for (int k = 0; k < 2; ++k) {
+          z_lo[k] = lower(z_lo[k], background_inf(simd::load8(z_lo_values + 8 * k)));
+          z_hi[k] = upper(z_hi[k], background_inf(simd::load8(z_hi_values + 8 * k)));
+        }
+        for (int k = 0; k < 6; ++k) {
+          c_lo[k] = lower(c_lo[k], simd::load8(lo_values + 8 * k));
+          c_hi[k] = upper(c_hi[k], simd::load8(hi_values + 8 * k));
+        }
+      }
+      const std::size_t t = static_cast<std::size_t>(ty0 / kTile) * ranges.tiles_x + tx0 / kTile;
+      float near = inf, far = 0;
+      for (int k = 0; k < kTile; ++k) {
+        near = std::min(near, z_lo[k / 8][k % 8]);
+        far = std::max(far, z_hi[k / 8][k % 8]);
+      }
+      ranges.near_m[t] = near;
+      ranges.far_m[t] = far;
+      for (int c = 0; c < 3; ++c) {
+        float lo = inf, hi = -inf;
+        for (int k = c; k < 3 * kTile; k += 3) {
+          lo = std::min(lo, c_lo[k / 8][k % 8]);
+          hi = std::max(hi, c_hi[k / 8][k % 8]);
+        }
+        ranges.radiance[6 * t + c] = lo;
+        ranges.radiance[6 * t + 3 + c] = hi;
+      }
+    }
+  }
+}
+
 double coc_diameter_m(double focal_length_m, double f_number, double focus_m, double depth_m) {
   const double f = focal_length_m;
   if (!(focus_m > f) || !(depth_m > 0)) return 0;
@@ -314,82 +388,94 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   std::vector<float> tile_near(tile_max.size()), tile_far(tile_max.size());
   // Each tile's smallest and largest value per channel (3 + 3 per tile), for the flat test.
   std::vector<float> tile_range(6 * tile_max.size());
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
-    const float inf = std::numeric_limits<float>::infinity();
-    // Per tile column, running minima and maxima over the tile's rows: of the depth by lane
-    // (kTile) and of the interleaved colour by value (3·kTile), folded per tile at the end. Plain
-    // element-wise loops over contiguous values, which the compiler vectorises.
-    constexpr int kValues = 3 * kTile;
-    std::vector<float> z_lo(kTile * tiles_x), z_hi(kTile * tiles_x);
-    std::vector<float> c_lo(kValues * tiles_x), c_hi(kValues * tiles_x);
-    std::vector<float> range(6 * tiles_x);
-    for (int ty = r.begin(); ty < r.end(); ++ty) {
-      std::fill(z_lo.begin(), z_lo.end(), inf);
-      std::fill(z_hi.begin(), z_hi.end(), 0.0f);
-      std::fill(c_lo.begin(), c_lo.end(), inf);
-      std::fill(c_hi.begin(), c_hi.end(), -inf);
-      for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
-        const float* row = &depth_m[static_cast<std::size_t>(y) * w];
-        const float* colour = &rgb[3 * static_cast<std::size_t>(y) * w];
-        const int full_tiles = w / kTile;
-        for (int tx = 0; tx < full_tiles; ++tx) {
-          const float* zr = row + tx * kTile;
-          float* zl = &z_lo[kTile * tx];
-          float* zh = &z_hi[kTile * tx];
-          for (int k = 0; k < kTile; ++k) {
-            const float z = zr[k] > 0 ? zr[k] : inf;  // unknown depth: background
-            zl[k] = std::min(zl[k], z);
-            zh[k] = std::max(zh[k], z);
-          }
-          const float* cr = colour + kValues * tx;
-          float* cl = &c_lo[kValues * tx];
-          float* ch = &c_hi[kValues * tx];
-          for (int k = 0; k < kValues; ++k) {
-            cl[k] = std::min(cl[k], cr[k]);
-            ch[k] = std::max(ch[k], cr[k]);
-          }
-        }
-        for (int x = full_tiles * kTile; x < w; ++x) {  // the last, partial tile
-          const int tx = full_tiles, k = x - tx * kTile;
-          const float z = row[x] > 0 ? row[x] : inf;
-          z_lo[kTile * tx + k] = std::min(z_lo[kTile * tx + k], z);
-          z_hi[kTile * tx + k] = std::max(z_hi[kTile * tx + k], z);
-          for (int c = 0; c < 3; ++c) {
-            float& lo = c_lo[kValues * tx + 3 * k + c];
-            float& hi = c_hi[kValues * tx + 3 * k + c];
-            lo = std::min(lo, colour[3 * x + c]);
-            hi = std::max(hi, colour[3 * x + c]);
-          }
-        }
-      }
-      std::vector<float> near(tiles_x, inf), far(tiles_x, 0.0f);
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        for (int k = 0; k < kTile; ++k) {
-          near[tx] = std::min(near[tx], z_lo[kTile * tx + k]);
-          far[tx] = std::max(far[tx], z_hi[kTile * tx + k]);
-        }
-        for (int c = 0; c < 3; ++c) {
-          float lo = inf, hi = -inf;
-          for (int k = 0; k < kTile; ++k) {
-            lo = std::min(lo, c_lo[kValues * tx + 3 * k + c]);
-            hi = std::max(hi, c_hi[kValues * tx + 3 * k + c]);
-          }
-          range[6 * tx + c] = lo;
-          range[6 * tx + 3 + c] = hi;
-        }
-      }
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-        std::copy_n(&range[6 * tx], 6, &tile_range[6 * t]);
-        tile_near[t] = near[tx];
-        tile_far[t] = far[tx];
-        const float r_near = radius_at(near[tx]), r_far = radius_at(far[tx]);
-        tile_max[t] = std::max(r_near, r_far);
-        tile_min[t] =
-            near[tx] <= focus && focus <= far[tx] ? radius_at(focus) : std::min(r_near, r_far);
-      }
+  // Discs from the depth range: the radius is smallest at the focus distance.
+  auto set_tile_discs = [&](std::size_t t, float near, float far) {
+    tile_near[t] = near;
+    tile_far[t] = far;
+    const float r_near = radius_at(near), r_far = radius_at(far);
+    tile_max[t] = std::max(r_near, r_far);
+    tile_min[t] = near <= focus && focus <= far ? radius_at(focus) : std::min(r_near, r_far);
+  };
+  const TileRanges* given = level == 0 ? options.tile_ranges : nullptr;
+  static_assert(TileRanges::kTile == kTile);
+  if (given != nullptr && given->fits(w, h)) {
+    std::copy(given->radiance.begin(), given->radiance.end(), tile_range.begin());
+    for (std::size_t t = 0; t < tile_max.size(); ++t) {
+      set_tile_discs(t, given->near_m[t], given->far_m[t]);
     }
-  });
+  } else {
+    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
+      const float inf = std::numeric_limits<float>::infinity();
+      // Per tile column, running minima and maxima over the tile's rows: of the depth by lane
+      // (kTile) and of the interleaved colour by value (3·kTile), folded per tile at the end. Plain
+      // element-wise loops over contiguous values, which the compiler vectorises.
+      constexpr int kValues = 3 * kTile;
+      std::vector<float> z_lo(kTile * tiles_x), z_hi(kTile * tiles_x);
+      std::vector<float> c_lo(kValues * tiles_x), c_hi(kValues * tiles_x);
+      std::vector<float> range(6 * tiles_x);
+      for (int ty = r.begin(); ty < r.end(); ++ty) {
+        std::fill(z_lo.begin(), z_lo.end(), inf);
+        std::fill(z_hi.begin(), z_hi.end(), 0.0f);
+        std::fill(c_lo.begin(), c_lo.end(), inf);
+        std::fill(c_hi.begin(), c_hi.end(), -inf);
+        for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
+          const float* row = &depth_m[static_cast<std::size_t>(y) * w];
+          const float* colour = &rgb[3 * static_cast<std::size_t>(y) * w];
+          const int full_tiles = w / kTile;
+          for (int tx = 0; tx < full_tiles; ++tx) {
+            const float* zr = row + tx * kTile;
+            float* zl = &z_lo[kTile * tx];
+            float* zh = &z_hi[kTile * tx];
+            for (int k = 0; k < kTile; ++k) {
+              const float z = zr[k] > 0 ? zr[k] : inf;  // unknown depth: background
+              zl[k] = std::min(zl[k], z);
+              zh[k] = std::max(zh[k], z);
+            }
+            const float* cr = colour + kValues * tx;
+            float* cl = &c_lo[kValues * tx];
+            float* ch = &c_hi[kValues * tx];
+            for (int k = 0; k < kValues; ++k) {
+              cl[k] = std::min(cl[k], cr[k]);
+              ch[k] = std::max(ch[k], cr[k]);
+            }
+          }
+          for (int x = full_tiles * kTile; x < w; ++x) {  // the last, partial tile
+            const int tx = full_tiles, k = x - tx * kTile;
+            const float z = row[x] > 0 ? row[x] : inf;
+            z_lo[kTile * tx + k] = std::min(z_lo[kTile * tx + k], z);
+            z_hi[kTile * tx + k] = std::max(z_hi[kTile * tx + k], z);
+            for (int c = 0; c < 3; ++c) {
+              float& lo = c_lo[kValues * tx + 3 * k + c];
+              float& hi = c_hi[kValues * tx + 3 * k + c];
+              lo = std::min(lo, colour[3 * x + c]);
+              hi = std::max(hi, colour[3 * x + c]);
+            }
+          }
+        }
+        std::vector<float> near(tiles_x, inf), far(tiles_x, 0.0f);
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          for (int k = 0; k < kTile; ++k) {
+            near[tx] = std::min(near[tx], z_lo[kTile * tx + k]);
+            far[tx] = std::max(far[tx], z_hi[kTile * tx + k]);
+          }
+          for (int c = 0; c < 3; ++c) {
+            float lo = inf, hi = -inf;
+            for (int k = 0; k < kTile; ++k) {
+              lo = std::min(lo, c_lo[kValues * tx + 3 * k + c]);
+              hi = std::max(hi, c_hi[kValues * tx + 3 * k + c]);
+            }
+            range[6 * tx + c] = lo;
+            range[6 * tx + 3 + c] = hi;
+          }
+        }
+        for (int tx = 0; tx < tiles_x; ++tx) {
+          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+          std::copy_n(&range[6 * tx], 6, &tile_range[6 * t]);
+          set_tile_discs(t, near[tx], far[tx]);
+        }
+      }
+    });
+  }
   std::vector<float> reach(tile_max.size(), 0.5f);
   float reach_max = 0.5f;
   for (int ty = 0; ty < tiles_y; ++ty) {

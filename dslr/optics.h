@@ -46,7 +46,15 @@ struct DepthOfFieldOptions {
   bool taps_per_group = true;
   // If set, receives how many groups gathered fewer taps than their tile.
   std::int64_t* groups_with_fewer_taps = nullptr;
+  // If set and the frame's size, the ranges of `rgb` and `depth_m` (LinearFrame::tile_ranges):
+  // the frame is not scanned for them.
+  const TileRanges* tile_ranges = nullptr;
 };
+// Fills `ranges` (sized by resize_for) for the tiles inside [x0, x1) x [y0, y1) of a frame
+// `width` pixels wide: x0 and y0 multiples of TileRanges::kTile, x1 and y1 too or the frame's
+// edges.
+void record_tile_ranges(const float* rgb, const float* depth_m, int width, int x0, int y0, int x1,
+                        int y1, TileRanges& ranges);
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
                           const std::vector<float>& depth_m, std::vector<float>& out,

@@ -73,7 +73,12 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
   const Intrinsics sensor = sensor_intrinsics(camera, scale);
   std::vector<float> scratch = take_floats(work.size());
   if (camera.effects.depth_of_field && !frame.depth_m.empty()) {
-    apply_depth_of_field(camera, shot.focus_distance_m, canvas, work, frame.depth_m, scratch);
+    // The frame's tile ranges describe its own values: those of `work` only when no exposure
+    // pass has scaled them.
+    DepthOfFieldOptions options;
+    if (frame.rgb_clean) options.tile_ranges = &frame.tile_ranges;
+    apply_depth_of_field(camera, shot.focus_distance_m, canvas, work, frame.depth_m, scratch,
+                         options);
     work.swap(scratch);
   }
   result.timings.depth_of_field_ms = clock.lap_ms();

@@ -80,6 +80,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
       if (k == subframes / 2) frame = std::move(sub);
     }
     for (size_t i = 0; i < sum.size(); ++i) frame.rgb[i] = static_cast<float>(sum[i] / subframes);
+    frame.tile_ranges = {};  // they described the middle sub-frame alone
   }
   if (linear_out) *linear_out = frame;
   dslr::ShotParams params;

@@ -15,6 +15,7 @@
 #include "dslr/buffer_pool.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
+#include "dslr/optics.h"
 #include "tests/test_support.h"
 
 namespace rigc::preview {
@@ -269,6 +270,70 @@ TEST(Preview, QuadsTakingABlocksAlbedosShadeAsTheirOwn) {
   std::size_t differing = 0;
   for (std::size_t i = 0; i < with.rgb.size(); ++i) differing += with.rgb[i] != without.rgb[i];
   EXPECT_EQ(differing, 0u);
+}
+
+// The renderer hands the depth of field each 16-pixel tile's depth and radiance ranges, taken
+// tile by tile (plain studio tiles too) while the pixels are in cache: they must be exactly the
+// frame's, and the depth of field given them must equal the one that scans the frame itself.
+TEST(Preview, TileRangesAreTheFramesOwnAndTheDepthOfFieldAlike) {
+  const ir::Scene scene = paper_scene();
+  ASSERT_FALSE(scene.shots.empty());
+  const StudioScene studio = prepare_studio_scene(scene);
+  FrameRequest request;
+  request.world_from_camera = scene.shots[3].world_from_camera;
+  request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
+  request.canvas = dslr::render_geometry_for(scene.camera, 0.3);
+  request.shadow_map_size = 1024;
+  const dslr::LinearFrame frame = render_frame(scene, studio, request);
+  const dslr::TileRanges& ranges = frame.tile_ranges;
+  ASSERT_TRUE(ranges.fits(frame.width, frame.height));
+  constexpr int kTile = dslr::TileRanges::kTile;
+  const float inf = std::numeric_limits<float>::infinity();
+  std::size_t wrong = 0;
+  for (int ty = 0; ty < ranges.tiles_y; ++ty) {
+    for (int tx = 0; tx < ranges.tiles_x; ++tx) {
+      float near = inf, far = 0, lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+      for (int y = ty * kTile; y < std::min(frame.height, (ty + 1) * kTile); ++y) {
+        for (int x = tx * kTile; x < std::min(frame.width, (tx + 1) * kTile); ++x) {
+          const std::size_t p = static_cast<std::size_t>(y) * frame.width + x;
+          const float z = frame.depth_m[p] > 0 ? frame.depth_m[p] : inf;
+          near = std::min(near, z);
+          far = std::max(far, z);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], frame.rgb[3 * p + c]);
+            hi[c] = std::max(hi[c], frame.rgb[3 * p + c]);
+          }
+        }
+      }
+      const std::size_t t = static_cast<std::size_t>(ty) * ranges.tiles_x + tx;
+      wrong += ranges.near_m[t] != near || ranges.far_m[t] != far;
+      for (int c = 0; c < 3; ++c) {
+        wrong += ranges.radiance[6 * t + c] != lo[c] || ranges.radiance[6 * t + 3 + c] != hi[c];
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0u);
+
+  const dslr::Intrinsics canvas = frame.intrinsics();
+  const double focus = scene.shots[3].focus_distance_m;
+  std::vector<float> scanned, given, misled;
+  dslr::apply_depth_of_field(scene.camera, focus, canvas, frame.rgb, frame.depth_m, scanned);
+  dslr::DepthOfFieldOptions options;
+  options.tile_ranges = &ranges;
+  dslr::apply_depth_of_field(scene.camera, focus, canvas, frame.rgb, frame.depth_m, given, options);
+  ASSERT_EQ(given.size(), scanned.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < given.size(); ++i) differing += given[i] != scanned[i];
+  EXPECT_EQ(differing, 0u);
+  // The ranges are what decides: claiming every tile lies at the focus leaves the frame sharp.
+  dslr::TileRanges in_focus = ranges;
+  std::fill(in_focus.near_m.begin(), in_focus.near_m.end(), static_cast<float>(focus));
+  std::fill(in_focus.far_m.begin(), in_focus.far_m.end(), static_cast<float>(focus));
+  options.tile_ranges = &in_focus;
+  dslr::apply_depth_of_field(scene.camera, focus, canvas, frame.rgb, frame.depth_m, misled,
+                             options);
+  EXPECT_EQ(misled, frame.rgb);
+  EXPECT_NE(scanned, frame.rgb);
 }
 
 // At full resolution the studio planes are lit at sparse corners (every 8 or 16 pixels where

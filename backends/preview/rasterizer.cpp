@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "dslr/buffer_pool.h"
+#include "dslr/optics.h"
 #include "dslr/simd.h"
 
 namespace rigc::preview {
@@ -942,6 +943,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   frame.mask = dslr::take_bytes(pixel_count);
   // Shading sums non-negative light with finite weights (GGX's roughness is floored).
   frame.rgb_clean = true;
+  // Each finished tile's ranges for the depth of field, taken while its pixels are in cache.
+  static_assert(kTileSize % dslr::TileRanges::kTile == 0);
+  frame.tile_ranges.resize_for(canvas.width, canvas.height);
+  auto record_ranges = [&frame](int x0, int y0, int x1, int y1) {
+    dslr::record_tile_ranges(frame.rgb.data(), frame.depth_m.data(), frame.width, x0, y0, x1, y1,
+                             frame.tile_ranges);
+  };
 
   const FrameContext context(scene, studio, request);
   const Matrix3f& object_rot = context.object_rot;
@@ -1410,8 +1418,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     }
     return true;
   };
+  auto plain_studio_tile_recorded = [&](int x0, int y0, int x1, int y1, std::int32_t id) {
+    if (!plain_studio_tile(x0, y0, x1, y1, id)) return false;
+    record_ranges(x0, y0, x1, y1);
+    return true;
+  };
   rasterize_tiles<kSamples>(
-      setup, canvas, plain_studio_tile,
+      setup, canvas, plain_studio_tile_recorded,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         auto at = [&](int px, int py) { return ((py - y0) * kTileSize + (px - x0)) * kSamples; };
         // 2 x 2 quads inside one surface sum the lights once, at the quad's centre, and take the
@@ -1709,6 +1722,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           quads_with_block_albedos.fetch_add(tile_quads_with_block_albedos,
                                              std::memory_order_relaxed);
         }
+        record_ranges(x0, y0, x1, y1);
       });
   if (timings) {
     timings->raster_ms += ms_since(raster_start);
