@@ -190,6 +190,16 @@ ir::Scene paper_scene() {
   return compile(testing::read_text(testing::source_path("scenes/paper-turntable.yaml")));
 }
 
+// The frame of one of the scene's shots at `scale` of the sensor, with 1024-texel shadow maps.
+FrameRequest shot_request(const ir::Scene& scene, int shot, double scale) {
+  FrameRequest request;
+  request.world_from_camera = scene.shots[shot].world_from_camera;
+  request.turntable_angle_rad = scene.shots[shot].turntable_angle_rad;
+  request.canvas = dslr::render_geometry_for(scene.camera, scale);
+  request.shadow_map_size = 1024;
+  return request;
+}
+
 // How far a frame's shading strays from per-pixel lighting's, over the object's pixels or the
 // studio's (the masks must agree): the summed difference over the summed per-pixel radiance,
 // and each pixel's relative difference, sorted.
@@ -227,11 +237,7 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
   for (double scale : {0.15, 0.4}) {
-    FrameRequest request;
-    request.world_from_camera = scene.shots[3].world_from_camera;
-    request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
-    request.canvas = dslr::render_geometry_for(scene.camera, scale);
-    request.shadow_map_size = 1024;
+    FrameRequest request = shot_request(scene, 3, scale);
     const dslr::LinearFrame quad = render_frame(scene, studio, request);
     request.per_pixel_lighting = true;
     const dslr::LinearFrame pixel = render_frame(scene, studio, request);
@@ -254,11 +260,7 @@ TEST(Preview, QuadsTakingABlocksAlbedosShadeAsTheirOwn) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request;
-  request.world_from_camera = scene.shots[3].world_from_camera;
-  request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
-  request.canvas = dslr::render_geometry_for(scene.camera, 0.7);
-  request.shadow_map_size = 1024;
+  FrameRequest request = shot_request(scene, 3, 0.7);
   RasterTimings reused;
   const dslr::LinearFrame with = render_frame(scene, studio, request, &reused);
   request.reuse_block_albedos = false;
@@ -279,11 +281,7 @@ TEST(Preview, TileRangesAreTheFramesOwnAndTheDepthOfFieldAlike) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
   const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request;
-  request.world_from_camera = scene.shots[3].world_from_camera;
-  request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
-  request.canvas = dslr::render_geometry_for(scene.camera, 0.3);
-  request.shadow_map_size = 1024;
+  FrameRequest request = shot_request(scene, 3, 0.3);
   const dslr::LinearFrame frame = render_frame(scene, studio, request);
   const dslr::TileRanges& ranges = frame.tile_ranges;
   ASSERT_TRUE(ranges.fits(frame.width, frame.height));
