@@ -396,85 +396,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     tile_max[t] = std::max(r_near, r_far);
     tile_min[t] = near <= focus && focus <= far ? radius_at(focus) : std::min(r_near, r_far);
   };
-  const TileRanges* given = level == 0 ? options.tile_ranges : nullptr;
+  // The renderer's ranges where it handed them over (the top level only: below it the frame is
+  // the half-size one made here); otherwise each row of tiles is scanned for them.
   static_assert(TileRanges::kTile == kTile);
-  if (given != nullptr && given->fits(w, h)) {
-    std::copy(given->radiance.begin(), given->radiance.end(), tile_range.begin());
-    for (std::size_t t = 0; t < tile_max.size(); ++t) {
-      set_tile_discs(t, given->near_m[t], given->far_m[t]);
-    }
-  } else {
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& r) {
-      const float inf = std::numeric_limits<float>::infinity();
-      // Per tile column, running minima and maxima over the tile's rows: of the depth by lane
-      // (kTile) and of the interleaved colour by value (3·kTile), folded per tile at the end. Plain
-      // element-wise loops over contiguous values, which the compiler vectorises.
-      constexpr int kValues = 3 * kTile;
-      std::vector<float> z_lo(kTile * tiles_x), z_hi(kTile * tiles_x);
-      std::vector<float> c_lo(kValues * tiles_x), c_hi(kValues * tiles_x);
-      std::vector<float> range(6 * tiles_x);
-      for (int ty = r.begin(); ty < r.end(); ++ty) {
-        std::fill(z_lo.begin(), z_lo.end(), inf);
-        std::fill(z_hi.begin(), z_hi.end(), 0.0f);
-        std::fill(c_lo.begin(), c_lo.end(), inf);
-        std::fill(c_hi.begin(), c_hi.end(), -inf);
-        for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
-          const float* row = &depth_m[static_cast<std::size_t>(y) * w];
-          const float* colour = &rgb[3 * static_cast<std::size_t>(y) * w];
-          const int full_tiles = w / kTile;
-          for (int tx = 0; tx < full_tiles; ++tx) {
-            const float* zr = row + tx * kTile;
-            float* zl = &z_lo[kTile * tx];
-            float* zh = &z_hi[kTile * tx];
-            for (int k = 0; k < kTile; ++k) {
-              const float z = zr[k] > 0 ? zr[k] : inf;  // unknown depth: background
-              zl[k] = std::min(zl[k], z);
-              zh[k] = std::max(zh[k], z);
-            }
-            const float* cr = colour + kValues * tx;
-            float* cl = &c_lo[kValues * tx];
-            float* ch = &c_hi[kValues * tx];
-            for (int k = 0; k < kValues; ++k) {
-              cl[k] = std::min(cl[k], cr[k]);
-              ch[k] = std::max(ch[k], cr[k]);
-            }
-          }
-          for (int x = full_tiles * kTile; x < w; ++x) {  // the last, partial tile
-            const int tx = full_tiles, k = x - tx * kTile;
-            const float z = row[x] > 0 ? row[x] : inf;
-            z_lo[kTile * tx + k] = std::min(z_lo[kTile * tx + k], z);
-            z_hi[kTile * tx + k] = std::max(z_hi[kTile * tx + k], z);
-            for (int c = 0; c < 3; ++c) {
-              float& lo = c_lo[kValues * tx + 3 * k + c];
-              float& hi = c_hi[kValues * tx + 3 * k + c];
-              lo = std::min(lo, colour[3 * x + c]);
-              hi = std::max(hi, colour[3 * x + c]);
-            }
-          }
-        }
-        std::vector<float> near(tiles_x, inf), far(tiles_x, 0.0f);
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          for (int k = 0; k < kTile; ++k) {
-            near[tx] = std::min(near[tx], z_lo[kTile * tx + k]);
-            far[tx] = std::max(far[tx], z_hi[kTile * tx + k]);
-          }
-          for (int c = 0; c < 3; ++c) {
-            float lo = inf, hi = -inf;
-            for (int k = 0; k < kTile; ++k) {
-              lo = std::min(lo, c_lo[kValues * tx + 3 * k + c]);
-              hi = std::max(hi, c_hi[kValues * tx + 3 * k + c]);
-            }
-            range[6 * tx + c] = lo;
-            range[6 * tx + 3 + c] = hi;
-          }
-        }
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-          std::copy_n(&range[6 * tx], 6, &tile_range[6 * t]);
-          set_tile_discs(t, near[tx], far[tx]);
-        }
-      }
+  const TileRanges* given = level == 0 ? options.tile_ranges : nullptr;
+  TileRanges scanned;
+  if (given == nullptr || !given->fits(w, h)) {
+    scanned.resize_for(w, h);
+    tbb::parallel_for(0, tiles_y, [&](int ty) {
+      record_tile_ranges(rgb.data(), depth_m.data(), w, 0, ty * kTile, w,
+                         std::min(h, (ty + 1) * kTile), scanned);
     });
+    given = &scanned;
+  }
+  std::copy(given->radiance.begin(), given->radiance.end(), tile_range.begin());
+  for (std::size_t t = 0; t < tile_max.size(); ++t) {
+    set_tile_discs(t, given->near_m[t], given->far_m[t]);
   }
   std::vector<float> reach(tile_max.size(), 0.5f);
   float reach_max = 0.5f;
