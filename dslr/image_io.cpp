@@ -6,13 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <system_error>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/mask_png.h"
+#include "io/atomic_file.h"
 
 namespace rigc::dslr {
 
@@ -57,27 +56,6 @@ bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pi
   if (!out->write_image(spec.format, pixels)) return fail(out->geterror());
   if (!out->close()) return fail(out->geterror());
   out.reset();
-  fs::rename(temporary, path, ec);
-  if (ec) return fail(ec.message());
-  return true;
-}
-
-// Writes `bytes` to a temporary file beside `path`, then renames it into place.
-bool write_bytes_atomically(const fs::path& path, const std::string& bytes, std::string* error) {
-  const fs::path temporary = temporary_path_for(path);
-  std::error_code ec;
-  auto fail = [&](const std::string& why) {
-    fs::remove(temporary, ec);
-    set_error(error, "cannot write " + path.string() + ": " + why);
-    return false;
-  };
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (file == nullptr) return fail(std::system_category().message(errno));
-  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-  const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) {
-    return fail(std::system_category().message(written ? errno : write_errno));
-  }
   fs::rename(temporary, path, ec);
   if (ec) return fail(ec.message());
   return true;
@@ -160,7 +138,7 @@ bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (extension == ".png") {
     // Encoded by runs: about a tenth of zlib's time on a mask (see mask_png.h).
-    return write_bytes_atomically(path, encode_mask_png(mask.data(), width, height), error);
+    return write_file_atomically(path, encode_mask_png(mask.data(), width, height), error);
   }
   // Any other format OpenImageIO writes (the backends name masks .png).
   return write_atomically(path, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8),

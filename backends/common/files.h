@@ -9,15 +9,14 @@
 #include <string>
 #include <string_view>
 
+#include "io/atomic_file.h"
+
 struct evp_md_ctx_st;  // OpenSSL's EVP_MD_CTX
 
 namespace rigc::backends {
 
-// Writes `bytes` to a temporary file beside `path` (unique suffix), then renames it over `path`.
-// The folder must exist. On failure removes the temporary file, sets `error` (if not null) to
-// one line naming the path and returns false. Never throws.
-bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
-                           std::string* error);
+// write_file_atomically, where the backends have always called it.
+using rigc::write_file_atomically;
 
 // Incremental SHA-256 (FIPS 180-4), for hashing large arrays without copying them. OpenSSL's
 // implementation: it uses the CPU's SHA instructions where there are any, and the scene hash of

@@ -1,0 +1,81 @@
+#include "io/atomic_file.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <system_error>
+
+namespace rigc {
+namespace {
+
+std::string errno_text(int code) {
+  return std::system_category().message(code);
+}
+
+void set_error(std::string* error, std::string text) {
+  if (error != nullptr) *error = std::move(text);
+}
+
+// A suffix no other writer (thread or process) uses at the same time.
+std::string unique_suffix() {
+  static std::atomic<std::uint64_t> counter{0};
+  const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
+  return fmt::format(".tmp.{}.{}.{:x}", static_cast<long>(::getpid()), counter.fetch_add(1),
+                     static_cast<std::uint64_t>(ticks) & 0xffffff);
+}
+
+bool write_all(int fd, std::string_view bytes) {
+  const char* data = bytes.data();
+  std::size_t left = bytes.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, data, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    data += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           std::string* error) {
+  try {
+    if (path.filename().empty()) {
+      set_error(error, fmt::format("cannot write '{}': not a file name", path.string()));
+      return false;
+    }
+    std::string temp;
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+      temp = path.string() + unique_suffix();
+      fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      if (fd < 0 && errno != EEXIST) break;
+    }
+    if (fd < 0) {
+      set_error(error, fmt::format("cannot write {}: {}", path.string(), errno_text(errno)));
+      return false;
+    }
+    const bool written = write_all(fd, bytes);
+    int code = written ? 0 : errno;
+    if (::close(fd) != 0 && code == 0) code = errno;
+    if (written && code == 0 && std::rename(temp.c_str(), path.c_str()) == 0) return true;
+    if (code == 0) code = errno;
+    ::unlink(temp.c_str());
+    set_error(error, fmt::format("cannot write {}: {}", path.string(), errno_text(code)));
+    return false;
+  } catch (const std::exception& e) {
+    set_error(error, fmt::format("cannot write {}: {}", path.string(), e.what()));
+    return false;
+  }
+}
+
+}  // namespace rigc
