@@ -61,6 +61,13 @@ bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pi
   return true;
 }
 
+// ".jpg" for "shot.JPG": the file type the name asks for.
+std::string lowercase_extension(const fs::path& path) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
+}
+
 }  // namespace
 
 bool write_image(const fs::path& path, const DevelopResult& result, const ir::Camera& camera,
@@ -72,8 +79,7 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
     set_error(error, "cannot write " + path.string() + ": the image is empty or malformed");
     return false;
   }
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string extension = lowercase_extension(path);
   const bool jpeg = extension == ".jpg" || extension == ".jpeg";
   const bool eight_bits = jpeg || result.bits == 8;
 
@@ -133,10 +139,7 @@ bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int
     set_error(error, "cannot write " + path.string() + ": the mask is empty or malformed");
     return false;
   }
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension == ".png") {
+  if (lowercase_extension(path) == ".png") {
     // Encoded by runs: about a tenth of zlib's time on a mask (see mask_png.h).
     return write_file_atomically(path, encode_mask_png(mask.data(), width, height), error);
   }
