@@ -83,24 +83,14 @@ void BM_Exposure(benchmark::State& state) {
   for (auto _ : state) rigc::dslr::expose_in_place(f.scene.camera, work);
 }
 
+// Argument 1: as the pipeline runs it on a preview frame, with the tile ranges the renderer
+// recorded, so the frame is not scanned for them; 0: the frame scanned (other renderers).
 void BM_DepthOfField(benchmark::State& state) {
   Fixture& f = fixture();
   std::vector<float> out(f.frame.rgb.size());
   const double focus = f.scene.shots[3].focus_distance_m;
-  for (auto _ : state) {
-    rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
-                                     f.frame.depth_m, out);
-  }
-}
-
-// As the pipeline runs it on a preview frame: with the tile ranges the renderer recorded, so the
-// frame is not scanned for them.
-void BM_DepthOfFieldWithTileRanges(benchmark::State& state) {
-  Fixture& f = fixture();
-  std::vector<float> out(f.frame.rgb.size());
-  const double focus = f.scene.shots[3].focus_distance_m;
   rigc::dslr::DepthOfFieldOptions options;
-  options.tile_ranges = &f.frame.tile_ranges;
+  if (state.range(0) != 0) options.tile_ranges = &f.frame.tile_ranges;
   for (auto _ : state) {
     rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
                                      f.frame.depth_m, out, options);
@@ -206,8 +196,7 @@ void BM_WriteJpegAndMask(benchmark::State& state) {
 
 BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Exposure)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_DepthOfField)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_DepthOfFieldWithTileRanges)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DepthOfField)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Diffraction)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DistortionVignetting)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SensorNoise)->Unit(benchmark::kMillisecond)->UseRealTime();
