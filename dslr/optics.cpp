@@ -975,6 +975,27 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
   const std::size_t row_values = 3 * static_cast<std::size_t>(w);
   constexpr int kBandRows = 96;
   const int bands = (h + kBandRows - 1) / kBandRows;
+  // fn(std::integral_constant<int, taps>) where the tap count is one of the common ones (radius
+  // 1 to 4: f/5.6 to f/22 on a 6D), so its loops unroll with the weights and rows in registers;
+  // the generic loops after it run otherwise.
+  auto with_taps = [taps = static_cast<int>(kernel.size())](auto&& fn) {
+    switch (taps) {
+      case 3:
+        fn(std::integral_constant<int, 3>{});
+        break;
+      case 5:
+        fn(std::integral_constant<int, 5>{});
+        break;
+      case 7:
+        fn(std::integral_constant<int, 7>{});
+        break;
+      case 9:
+        fn(std::integral_constant<int, 9>{});
+        break;
+      default:
+        break;
+    }
+  };
   auto blur_row = [&](int y, float* dst) {
     const float* row = &rgb[row_values * std::clamp(y, 0, h - 1)];
     // On interleaved rows a tap k is an offset of 3k values, so the interior is one contiguous
@@ -982,6 +1003,20 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
     const int inner_begin = std::min(w, radius), inner_end = std::max(inner_begin, w - radius);
     // Eight values at a time, summed over the taps in a register and stored once.
     int i = 3 * inner_begin;
+    with_taps([&](auto fixed) {
+      // Weights as locals: a float store could alias the kernel vector's floats.
+      constexpr int kFixed = decltype(fixed)::value;
+      constexpr int kFixedRadius = kFixed / 2;
+      std::array<float, kFixed> weight;
+      std::copy_n(kernel.begin(), kFixed, weight.begin());
+      for (; i + kLanes <= 3 * inner_end; i += kLanes) {
+        Floats acc = {};
+        for (int k = -kFixedRadius; k <= kFixedRadius; ++k) {
+          acc += weight[k + kFixedRadius] * load8(row + i + 3 * k);
+        }
+        std::memcpy(dst + i, &acc, sizeof acc);
+      }
+    });
     for (; i + kLanes <= 3 * inner_end; i += kLanes) {
       Floats acc = {};
       for (int k = -radius; k <= radius; ++k) acc += kernel[k + radius] * load8(row + i + 3 * k);
@@ -1017,6 +1052,18 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
         float* dst = &scratch[row_values * y];
         for (int k = -radius; k <= radius; ++k) rows[k + radius] = ring_row(y + k);
         std::size_t i = 0;
+        with_taps([&](auto fixed) {
+          constexpr int kFixed = decltype(fixed)::value;
+          std::array<float, kFixed> weight;
+          std::array<const float*, kFixed> source;
+          std::copy_n(kernel.begin(), kFixed, weight.begin());
+          std::copy_n(rows.begin(), kFixed, source.begin());
+          for (; i + kLanes <= row_values; i += kLanes) {
+            Floats acc = {};
+            for (int t = 0; t < kFixed; ++t) acc += weight[t] * load8(source[t] + i);
+            std::memcpy(dst + i, &acc, sizeof acc);
+          }
+        });
         for (; i + kLanes <= row_values; i += kLanes) {
           Floats acc = {};
           for (int t = 0; t < taps; ++t) acc += kernel[t] * load8(rows[t] + i);
