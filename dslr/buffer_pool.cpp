@@ -64,14 +64,15 @@ void advise_huge_pages(const void* data, std::size_t bytes) {
 // asks for over a GB). The kernel populates the pages itself where it can (Linux 5.14 and
 // later): the pages come zeroed, so a memset over them would only write them a second time.
 void first_touch(void* data, std::size_t bytes) {
-  // Pieces of one huge page each, aligned as the kernel's huge pages are (madvise needs a page
-  // boundary; populating the start of the page that `data` shares changes no byte).
-  constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20;
+  // Pieces within the huge pages' 2 MB boundaries. madvise needs a page boundary: the first
+  // piece starts at the page holding `data` (populating a page changes none of its bytes).
+  constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20, kPage = 4096;
   const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t end = start + bytes;
   const std::uintptr_t first = start & ~(kPiece - 1);
   tbb::parallel_for(std::uintptr_t{0}, (end - first + kPiece - 1) / kPiece, [&](std::uintptr_t k) {
-    const std::uintptr_t piece = first + k * kPiece, piece_end = std::min(end, piece + kPiece);
+    const std::uintptr_t piece = std::max(first + k * kPiece, start & ~(kPage - 1));
+    const std::uintptr_t piece_end = std::min(end, first + (k + 1) * kPiece);
 #ifdef MADV_POPULATE_WRITE
     if (madvise(reinterpret_cast<void*>(piece), piece_end - piece, MADV_POPULATE_WRITE) == 0) {
       return;
