@@ -384,21 +384,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // below it. The output elsewhere is left as it is.
   auto active = [&](std::size_t t) { return needed_tiles == nullptr || (*needed_tiles)[t]; };
   std::vector<float> tile_min(tile_max.size(), static_cast<float>(kMaxCocRadiusPx));
-  // The radius falls towards the focus distance and grows away from it on both sides, so a
-  // tile's depth range gives its smallest and largest disc without a radius per pixel.
-  std::vector<float> tile_near(tile_max.size()), tile_far(tile_max.size());
-  // Each tile's smallest and largest value per channel (3 + 3 per tile), for the flat test.
-  std::vector<float> tile_range(6 * tile_max.size());
-  // Discs from the depth range: the radius is smallest at the focus distance.
-  auto set_tile_discs = [&](std::size_t t, float near, float far) {
-    tile_near[t] = near;
-    tile_far[t] = far;
-    const float r_near = radius_at(near), r_far = radius_at(far);
-    tile_max[t] = std::max(r_near, r_far);
-    tile_min[t] = near <= focus && focus <= far ? radius_at(focus) : std::min(r_near, r_far);
-  };
-  // The renderer's ranges where it handed them over (the top level only: below it the frame is
-  // the half-size one made here); otherwise each row of tiles is scanned for them.
+  // Each tile's nearest and furthest depth and its smallest and largest value per channel: the
+  // renderer's ranges where it handed them over (the top level only: below it the frame is the
+  // half-size one made here); otherwise each row of tiles is scanned for them.
   static_assert(TileRanges::kTile == kTile);
   const TileRanges* given = level == 0 ? options.tile_ranges : nullptr;
   TileRanges scanned;
@@ -410,9 +398,16 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     });
     given = &scanned;
   }
-  std::copy(given->radiance.begin(), given->radiance.end(), tile_range.begin());
+  const std::vector<float>& tile_near = given->near_m;
+  const std::vector<float>& tile_far = given->far_m;
+  const std::vector<float>& tile_range = given->radiance;  // 3 smallest, 3 largest per tile
+  // The radius falls towards the focus distance and grows away from it on both sides, so a
+  // tile's depth range gives its smallest and largest disc without a radius per pixel.
   for (std::size_t t = 0; t < tile_max.size(); ++t) {
-    set_tile_discs(t, given->near_m[t], given->far_m[t]);
+    const float near = tile_near[t], far = tile_far[t];
+    const float r_near = radius_at(near), r_far = radius_at(far);
+    tile_max[t] = std::max(r_near, r_far);
+    tile_min[t] = near <= focus && focus <= far ? radius_at(focus) : std::min(r_near, r_far);
   }
   std::vector<float> reach(tile_max.size(), 0.5f);
   float reach_max = 0.5f;
