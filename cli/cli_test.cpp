@@ -52,7 +52,13 @@ TEST(Cli, CompileEmitsIrJsonAtomically) {
   auto ir = nlohmann::json::parse(testing::read_text(out));
   EXPECT_EQ(ir["shots"].size(), 18u);
   EXPECT_EQ(ir["camera"]["width_px"], 5472);
-  EXPECT_FALSE(std::filesystem::exists(out + ".tmp"));
+  // Only the IR itself is left in the folder: no temporary file beside it.
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file(""))) {
+    ++files;
+    EXPECT_EQ(entry.path().filename(), "paper.ir.json");
+  }
+  EXPECT_EQ(files, 1);
   // An unwritable destination is a clear user error, with nothing left behind.
   auto bad = run_rigc({"compile", source_path("scenes/paper-turntable.yaml"), "-o",
                        dir.file("no/such/folder/ir.json")});

@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +19,7 @@
 #include "compiler/ir_json.h"
 #include "compiler/units.h"
 #include "eval/eval.h"
+#include "io/atomic_file.h"
 
 namespace rigc::cli {
 namespace {
@@ -52,32 +52,6 @@ nlohmann::json diagnostics_json(const DiagnosticEngine& diag) {
                    {"message", d.message}});
   }
   return out;
-}
-
-// Writes text to `path` atomically: a temporary file beside it, then a rename.
-bool write_file_atomically(const std::string& path, const std::string& text, std::string* error) {
-  const fs::path target(path);
-  const fs::path temporary = target.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) {
-      *error = fmt::format("{}: cannot write (does the folder exist and is it writable?)", path);
-      return false;
-    }
-    out << text;
-    if (!out.flush()) {
-      *error = fmt::format("{}: write failed", path);
-      return false;
-    }
-  }
-  std::error_code ec;
-  fs::rename(temporary, target, ec);
-  if (ec) {
-    fs::remove(temporary, ec);
-    *error = fmt::format("{}: cannot rename the temporary file into place", path);
-    return false;
-  }
-  return true;
 }
 
 int run_check(std::vector<std::string> args) {
@@ -169,7 +143,7 @@ int run_compile(std::vector<std::string> args) {
     return kExitOk;
   }
   std::string error;
-  if (!write_file_atomically(output, text, &error)) {
+  if (!rigc::write_file_atomically(output, text, &error)) {
     std::cerr << "rigc: error: " << error << '\n';
     return kExitUserError;
   }
