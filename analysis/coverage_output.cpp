@@ -12,6 +12,7 @@
 #include "backends/common/files.h"
 #include "backends/preview/rasterizer.h"
 #include "dslr/lens.h"
+#include "io/atomic_file.h"
 
 namespace rigc::analysis {
 namespace {
@@ -130,7 +131,7 @@ bool write_face_color_glb(const fs::path& path, const preview::Geometry& mesh,
   model.defaultScene = 0;
   model.asset.version = "2.0";
   model.asset.generator = "RigC coverage";
-  const fs::path temporary = path.string() + ".tmp.glb";
+  const fs::path temporary = temporary_path_beside(path);
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToFile(&model, temporary.string(), true, true, false, true)) {
     *error = fmt::format("{}: cannot write the GLB", path.string());
@@ -152,8 +153,9 @@ bool write_png(const fs::path& path, const std::vector<float>& rgb, int width, i
                std::string* error) {
   std::vector<std::uint8_t> pixels(rgb.size());
   for (size_t i = 0; i < rgb.size(); ++i) pixels[i] = to_srgb8(rgb[i]);
-  const fs::path temporary = path.string() + ".tmp.png";
-  auto out = OIIO::ImageOutput::create(temporary.string());
+  // The writer for the final name's format, opened on a temporary name beside it.
+  const fs::path temporary = temporary_path_beside(path);
+  auto out = OIIO::ImageOutput::create(path.string());
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   if (!out || !out->open(temporary.string(), spec) ||
       !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close()) {

@@ -54,7 +54,7 @@ TEST(Cli, CompileEmitsIrJsonAtomically) {
   EXPECT_EQ(ir["camera"]["width_px"], 5472);
   // Only the IR itself is left in the folder: no temporary file beside it.
   int files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir.file(""))) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
     ++files;
     EXPECT_EQ(entry.path().filename(), "paper.ir.json");
   }

@@ -32,6 +32,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/atomic_file.h"
+
 namespace rigc {
 namespace {
 
@@ -1701,7 +1703,7 @@ bool write_ply(const std::string& path, const ir::Mesh& mesh, std::string* error
   header += fmt::format("element face {}\n", mesh.triangles.size());
   header += "property list uchar uint vertex_indices\nend_header\n";
 
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = temporary_path_beside(path).string();
   std::FILE* file = std::fopen(tmp.c_str(), "wb");
   if (!file) return failed(fmt::format("cannot write: {}", std::strerror(errno)));
   bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size();

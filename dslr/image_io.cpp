@@ -1,10 +1,8 @@
 #include "dslr/image_io.h"
 
 #include <OpenImageIO/imageio.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <system_error>
@@ -23,19 +21,6 @@ void set_error(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
 }
 
-// A name in the same folder (so the rename is atomic), hidden, unique per process and call.
-fs::path temporary_path_for(const fs::path& path) {
-  static std::atomic<unsigned> counter{0};
-  // Appended piece by piece: GCC 12 at -O3 warns falsely (-Wrestrict) on "." + std::string.
-  std::string name = ".";
-  name += path.filename().string();
-  name += ".tmp";
-  name += std::to_string(::getpid());
-  name += "_";
-  name += std::to_string(counter++);
-  return path.parent_path() / name;
-}
-
 // Writes pixels to a temporary file with the final name's format, then renames it into place.
 bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pixels,
                       std::string* error) {
@@ -44,7 +29,7 @@ bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pi
     set_error(error, "cannot write " + path.string() + ": " + OIIO::geterror());
     return false;
   }
-  const fs::path temporary = temporary_path_for(path);
+  const fs::path temporary = temporary_path_beside(path);
   std::error_code ec;
   auto fail = [&](const std::string& why) {
     out.reset();  // closes the file before it is removed

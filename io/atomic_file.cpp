@@ -46,6 +46,10 @@ bool write_all(int fd, std::string_view bytes) {
 
 }  // namespace
 
+std::filesystem::path temporary_path_beside(const std::filesystem::path& path) {
+  return path.parent_path() / ("." + path.filename().string() + unique_suffix());
+}
+
 bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            std::string* error) {
   try {
@@ -56,7 +60,7 @@ bool write_file_atomically(const std::filesystem::path& path, std::string_view b
     std::string temp;
     int fd = -1;
     for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-      temp = path.string() + unique_suffix();
+      temp = temporary_path_beside(path).string();
       fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
       if (fd < 0 && errno != EEXIST) break;
     }
