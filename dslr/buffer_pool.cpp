@@ -63,8 +63,8 @@ void advise_huge_pages(const void* data, std::size_t bytes) {
 // one core and 1.0 s per GB shared by two (a one-off per page, but a full-resolution shot first
 // asks for over a GB). The kernel populates the pages itself where it can (Linux 5.14 and
 // later): the pages come zeroed, so a memset over them would only write them a second time.
-// 4 KB pages fault in for far less than 2 MB ones there: with the codes and the fixed pattern
-// (170 MB) on 4 KB pages, a run of 6 full-size shots spent 0.66-0.73 -> 0.39-0.40 s in the kernel.
+// 4 KB pages fault in for far less than 2 MB ones there: a run of 6 full-size shots spent 0.5 s
+// less system time with its byte buffers (codes, fixed pattern, masks) on 4 KB pages.
 void first_touch(void* data, std::size_t bytes) {
   // Pieces within the huge pages' 2 MB boundaries. madvise needs a page boundary: the first
   // piece starts at the page holding `data` (populating a page changes none of its bytes).
