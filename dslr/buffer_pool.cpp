@@ -63,8 +63,6 @@ void advise_huge_pages(const void* data, std::size_t bytes) {
 // one core and 1.0 s per GB shared by two (a one-off per page, but a full-resolution shot first
 // asks for over a GB). The kernel populates the pages itself where it can (Linux 5.14 and
 // later): the pages come zeroed, so a memset over them would only write them a second time.
-// 4 KB pages fault in for far less than 2 MB ones there: a run of 6 full-size shots spent 0.5 s
-// less system time with its byte buffers (codes, fixed pattern, masks) on 4 KB pages.
 void first_touch(void* data, std::size_t bytes) {
   // Pieces within the huge pages' 2 MB boundaries. madvise needs a page boundary: the first
   // piece starts at the page holding `data` (populating a page changes none of its bytes).
@@ -86,12 +84,12 @@ void first_touch(void* data, std::size_t bytes) {
 }
 
 template <typename T>
-void resize_huge(std::vector<T>& buffer, std::size_t size, Access access = Access::kTiled) {
+void resize_huge(std::vector<T>& buffer, std::size_t size) {
   static_assert(std::is_trivially_copyable_v<T>);
   if (size > buffer.capacity() && size * sizeof(T) >= kMinPooledBytes) {
     std::vector<T> bigger;
     bigger.reserve(size);  // allocated, not yet touched: the advice applies to its first faults
-    if (access == Access::kTiled) advise_huge_pages(bigger.data(), size * sizeof(T));
+    advise_huge_pages(bigger.data(), size * sizeof(T));
     // Trivial element type: the allocation's bytes may be written before the elements exist
     // (a container-overflow checker would flag it; resize then zeroes them again, warm).
     first_touch(bigger.data(), size * sizeof(T));
@@ -102,7 +100,7 @@ void resize_huge(std::vector<T>& buffer, std::size_t size, Access access = Acces
 }
 
 template <typename T>
-std::vector<T> take(std::size_t size, Access access = Access::kTiled) {
+std::vector<T> take(std::size_t size) {
   std::vector<T> out;
   if (size * sizeof(T) >= kMinPooledBytes) {
     Pool& p = pool();
@@ -122,7 +120,7 @@ std::vector<T> take(std::size_t size, Access access = Access::kTiled) {
     }
   }
   // Only the part past the old size is written (value-initialised) here.
-  resize_huge(out, size, access);
+  resize_huge(out, size);
   return out;
 }
 
@@ -157,11 +155,11 @@ void give_back(std::vector<T>&& buffer) {
 std::vector<float> take_floats(std::size_t size) {
   return take<float>(size);
 }
-std::vector<std::uint8_t> take_bytes(std::size_t size, Access access) {
-  return take<std::uint8_t>(size, access);
+std::vector<std::uint8_t> take_bytes(std::size_t size) {
+  return take<std::uint8_t>(size);
 }
-std::vector<std::uint16_t> take_words(std::size_t size, Access access) {
-  return take<std::uint16_t>(size, access);
+std::vector<std::uint16_t> take_words(std::size_t size) {
+  return take<std::uint16_t>(size);
 }
 void recycle(std::vector<float>&& buffer) {
   give_back(std::move(buffer));
@@ -176,14 +174,14 @@ void recycle(std::vector<std::uint16_t>&& buffer) {
 void resize_frame_buffer(std::vector<float>& buffer, std::size_t size) {
   resize_huge(buffer, size);
 }
-void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size, Access access) {
-  resize_huge(buffer, size, access);
+void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
 }
-void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size, Access access) {
-  resize_huge(buffer, size, access);
+void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
 }
-void resize_frame_buffer(std::vector<std::uint16_t>& buffer, std::size_t size, Access access) {
-  resize_huge(buffer, size, access);
+void resize_frame_buffer(std::vector<std::uint16_t>& buffer, std::size_t size) {
+  resize_huge(buffer, size);
 }
 
 std::size_t pooled_bytes() {

@@ -2,11 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdint>
-#include <fstream>
-#include <sstream>
-#include <string>
-
 namespace rigc::dslr {
 namespace {
 
@@ -58,43 +53,6 @@ TEST(BufferPool, GrowsABufferThatIsTooSmall) {
   EXPECT_EQ(bigger.size(), std::size_t{3} << 20);
   EXPECT_EQ(bigger.back(), 0.0f);  // the part past a reused buffer's old size is zeroed
   release_pooled_buffers();
-}
-
-// The VmFlags of the mapping holding `address` (from /proc/self/smaps; "hg": advised huge pages).
-std::string vm_flags_at(const void* address) {
-  const auto wanted = reinterpret_cast<std::uintptr_t>(address);
-  std::ifstream smaps("/proc/self/smaps");
-  std::string line;
-  bool inside = false;
-  while (std::getline(smaps, line)) {
-    std::uintptr_t begin = 0, end = 0;
-    char dash = 0;
-    std::istringstream range(line);
-    if (range >> std::hex >> begin >> dash >> end && dash == '-') {
-      inside = begin <= wanted && wanted < end;
-    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
-      return line;
-    }
-  }
-  return {};
-}
-
-TEST(BufferPool, StreamedBuffersStayOnSmallPagesAndTiledOnesAskForHugePages) {
-  release_pooled_buffers();
-  constexpr std::size_t kBytes = std::size_t{64} << 20;  // past malloc's mmap threshold
-  const std::vector<std::uint8_t> tiled = take_bytes(kBytes);
-  const std::string tiled_flags = vm_flags_at(tiled.data() + kBytes / 2);
-  ASSERT_FALSE(tiled_flags.empty()) << "no mapping found for the buffer";
-  if (tiled_flags.find(" hg") == std::string::npos) {
-    GTEST_SKIP() << "this kernel takes no huge-page advice: " << tiled_flags;
-  }
-  const std::vector<std::uint8_t> streamed = take_bytes(kBytes, Access::kStreamed);
-  EXPECT_EQ(vm_flags_at(streamed.data() + kBytes / 2).find(" hg"), std::string::npos);
-  std::vector<std::int8_t> pattern;
-  resize_frame_buffer(pattern, kBytes, Access::kStreamed);
-  EXPECT_EQ(vm_flags_at(pattern.data() + kBytes / 2).find(" hg"), std::string::npos);
-  const std::vector<float> frame = take_floats(kBytes / sizeof(float));
-  EXPECT_NE(vm_flags_at(frame.data() + kBytes / 8).find(" hg"), std::string::npos);
 }
 
 }  // namespace

@@ -100,8 +100,7 @@ SrgbEncoding srgb_encoding(const std::array<double, 3>& gains, int bits) {
 std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
                                        const std::array<double, 3>& gains, int bits) {
   const SrgbEncoding encode = srgb_encoding(gains, bits);
-  std::vector<std::uint16_t> out =
-      take_words(linear.size(), Access::kStreamed);  // every value is written
+  std::vector<std::uint16_t> out = take_words(linear.size());  // every value is written
   const std::size_t n = linear.size() / 3;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {

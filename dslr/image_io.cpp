@@ -99,8 +99,7 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
 
   if (bytes_only) return write_atomically(path, spec, result.encoded_bytes.data(), error);
   if (eight_bits) {
-    std::vector<std::uint8_t> pixels =
-        take_bytes(values, Access::kStreamed);  // every value is written
+    std::vector<std::uint8_t> pixels = take_bytes(values);  // every value is written
     // Plain pointers and one loop per case: stores through a byte pointer may alias anything,
     // so indexing the vectors reloads their data pointers on every value and nothing vectorises.
     const std::uint16_t* codes = result.encoded.data();

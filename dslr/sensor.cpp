@@ -154,9 +154,8 @@ std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t
   pattern->key = key;
   pattern->values = values;
   const std::size_t groups = (values + kNoiseLanes - 1) / kNoiseLanes;
-  // Read front to back once per shot.
-  resize_frame_buffer(pattern->prnu, groups * kNoiseLanes, Access::kStreamed);
-  resize_frame_buffer(pattern->dsnu, groups * kNoiseLanes, Access::kStreamed);
+  resize_frame_buffer(pattern->prnu, groups * kNoiseLanes);
+  resize_frame_buffer(pattern->dsnu, groups * kNoiseLanes);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t group = range.begin(); group < range.end(); ++group) {
@@ -351,9 +350,9 @@ std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int hei
   // From the pool (a writer hands it back); every value is written.
   std::vector<Code> encoded;
   if constexpr (sizeof(Code) == 1) {
-    encoded = take_bytes(signal.size(), Access::kStreamed);
+    encoded = take_bytes(signal.size());
   } else {
-    encoded = take_words(signal.size(), Access::kStreamed);
+    encoded = take_words(signal.size());
   }
   Code* codes = encoded.data();
   // Value i is channel i % 3: a group starting at value `first` has the gains of phase first % 3.
