@@ -1,9 +1,7 @@
 #include "compiler/mesh_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -12,36 +10,17 @@
 #include <vector>
 
 #include "compiler/primitives.h"
+#include "tests/test_support.h"
 
 namespace rigc {
 namespace {
 
 namespace fs = std::filesystem;
 using Eigen::Vector3f;
+using rigc::testing::TempDir;
 
 // The Debian package assimp-testmodels is a build dependency: a missing file is a failure.
 const std::string kModels = "/usr/share/assimp/models/";
-
-// A fresh directory for one test's files, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("rigc_mesh_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 void write_file(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
