@@ -445,6 +445,10 @@ shots:
   EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "cloud_signed_distance.ply"));
   EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "heatmap.png"));
   EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "histogram.png"));
+  // Every file was renamed into place: no hidden temporary is left beside them.
+  for (const auto& entry : fs::directory_iterator(run.run_dir / "eval")) {
+    EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
+  }
 }
 
 TEST(EvalEndToEnd, SlowUntexturedObjectReportsTheFailure) {

@@ -3,15 +3,14 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
 #include "backends/common/files.h"
+#include "io/atomic_file.h"
 
 namespace rigc::eval {
 
@@ -72,10 +71,8 @@ bool write_canvas(const fs::path& path, const Canvas& canvas, const std::vector<
     // Needs a font (fonts-dejavu); without one the picture just has no text.
     OIIO::ImageBufAlgo::render_text(copy, l.x, l.y, l.text, l.size, "DejaVuSans", colour, l.align);
   }
-  static std::atomic<unsigned> counter{0};
-  const fs::path temporary =
-      path.parent_path() / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
-                            "_" + std::to_string(counter++) + ".png");
+  // PNG named explicitly: the temporary name's suffix does not say it.
+  const fs::path temporary = temporary_path_beside(path);
   if (!copy.write(temporary.string(), OIIO::TypeDesc::UINT8, "png")) {
     *error = fmt::format("cannot write {}: {}", path.string(), copy.geterror());
     std::error_code ec;
