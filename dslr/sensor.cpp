@@ -143,8 +143,46 @@ struct FixedPattern {
   std::vector<std::int8_t> prnu, dsnu;  // padded to a multiple of kNoiseLanes
 };
 
-std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t values,
-                                                  const float* table) {
+// The pattern's byte for each entry of the normal table: z·32 rounded, within ±127. Three bytes
+// of padding: a lane reads its byte as the lowest of four (an integer gather has no byte form).
+const std::array<std::int8_t, 65536 + 3>& pattern_table() {
+  static const std::array<std::int8_t, 65536 + 3> bytes = [] {
+    const auto& normal = normal_table();
+    std::array<std::int8_t, 65536 + 3> out{};
+    for (int k = 0; k < 65536; ++k) {
+      const float steps = std::floor(normal[k] * (1 / kPatternStep) + 0.5f);
+      out[k] = static_cast<std::int8_t>(std::clamp(steps, -127.0f, 127.0f));
+    }
+    return out;
+  }();
+  return bytes;
+}
+
+// bytes[index[k]] in each lane k, as eight signed bytes.
+inline I8x8 gather_bytes(const std::int8_t* bytes, U32x8 index) {
+#if defined(__AVX2__)
+  // Four bytes from each lane's index, of which the first (little-endian) is the one. GCC
+  // narrows a vector to bytes one lane at a time in general registers: shuffled here instead,
+  // each half's four first bytes to its front, then both fronts together.
+  const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(bytes),
+                                               reinterpret_cast<__m256i>(index), 1);
+  const __m256i fronts = _mm256_shuffle_epi8(
+      words, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8,
+                              12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
+  const __m256i packed =
+      _mm256_permutevar8x32_epi32(fronts, _mm256_setr_epi32(0, 4, 0, 0, 0, 0, 0, 0));
+  I8x8 out;
+  const long long low = _mm_cvtsi128_si64(_mm256_castsi256_si128(packed));
+  std::memcpy(&out, &low, sizeof(out));
+  return out;
+#else
+  I8x8 out;
+  for (int k = 0; k < 8; ++k) out[k] = bytes[index[k]];
+  return out;
+#endif
+}
+
+std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t values) {
   static std::mutex mutex;
   static std::shared_ptr<const FixedPattern> kept;
   std::lock_guard lock(mutex);
@@ -156,23 +194,24 @@ std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t
   const std::size_t groups = (values + kNoiseLanes - 1) / kNoiseLanes;
   resize_frame_buffer(pattern->prnu, groups * kNoiseLanes);
   resize_frame_buffer(pattern->dsnu, groups * kNoiseLanes);
+  // The bytes are looked up already rounded and narrowed by shuffles, with the output pointers
+  // held in registers: the same bytes in about half the time (64 against 33-41 ms for a
+  // full-resolution frame, drawn once per run).
+  const std::int8_t* bytes = pattern_table().data();
+  // Plain pointers: stores through a byte pointer may alias anything, so the vectors' data
+  // pointers would be reloaded for every group.
+  std::int8_t* const prnu_out = pattern->prnu.data();
+  std::int8_t* const dsnu_out = pattern->dsnu.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t group = range.begin(); group < range.end(); ++group) {
                         const std::size_t first = group * kNoiseLanes;
                         const U32x8 index = static_cast<std::uint32_t>(first) + kLaneIndex;
                         const U32x8 bits = lowbias32(index ^ key);
-                        auto quantise = [](F32x8 z) {
-                          F32x8 steps = simd::floor(z * (1 / kPatternStep) + 0.5f);
-                          steps = steps < -127.0f ? F32x8{} - 127.0f : steps;
-                          steps = steps > 127.0f ? F32x8{} + 127.0f : steps;
-                          return __builtin_convertvector(__builtin_convertvector(steps, I32x8),
-                                                         I8x8);
-                        };
-                        const I8x8 prnu = quantise(lookup(table, bits & 0xFFFF));
-                        const I8x8 dsnu = quantise(lookup(table, bits >> 16));
-                        std::memcpy(&pattern->prnu[first], &prnu, sizeof(prnu));
-                        std::memcpy(&pattern->dsnu[first], &dsnu, sizeof(dsnu));
+                        const I8x8 prnu = gather_bytes(bytes, bits & 0xFFFF);
+                        const I8x8 dsnu = gather_bytes(bytes, bits >> 16);
+                        std::memcpy(prnu_out + first, &prnu, sizeof(prnu));
+                        std::memcpy(dsnu_out + first, &dsnu, sizeof(dsnu));
                       }
                     });
   kept = std::move(pattern);
@@ -270,7 +309,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const std::uint32_t fixed_key32 = static_cast<std::uint32_t>(fixed_key ^ (fixed_key >> 32));
   const std::uint32_t shot_key32 = static_cast<std::uint32_t>(shot_key ^ (shot_key >> 32));
   const float* table = normal.data();
-  const std::shared_ptr<const FixedPattern> pattern = fixed_pattern(fixed_key32, values, table);
+  const std::shared_ptr<const FixedPattern> pattern = fixed_pattern(fixed_key32, values);
   const std::int8_t* prnu_pattern = pattern->prnu.data();
   const std::int8_t* dsnu_pattern = pattern->dsnu.data();
   const float read_variance = read_f * read_f;
