@@ -1058,16 +1058,18 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     sp.footprint_m = depth / fx / std::max(std::abs(sp.n.dot(sp.v)), 0.2f);
     return sp;
   };
-  // The shading normal alone, turned towards the viewer as surface_at turns it.
-  auto normal_at = [&](const ScreenTriangle& s, float px, float py) -> Vector3f {
+  // Whether the shading normal at (px, py), turned towards the viewer, lies within
+  // kQuadNormalCos of the unit normal of `centre`, a point of the same surface under a pixel away.
+  // The viewer's side is taken from the centre's view direction instead of the pixel's own (they
+  // differ by a pixel's angle), which spares the pixel's surface point; and the cosine is compared
+  // squared, which spares a square root and a division.
+  auto normal_agrees = [&](const ScreenTriangle& s, float px, float py,
+                           const SurfacePoint& centre) {
     const SourceTriangle source = source_of(s);
-    const bool is_object = source.is_object;
-    const Vector3f b = source_bary_at(s, px, py);
-    const Vector3f n_local = source.at(source.g.normals, b);
-    const Vector3f n = unit(is_object ? Vector3f(object_rot * n_local) : n_local);
-    const Vector3f p_local = source.at(source.g.positions, b);
-    const Vector3f p = is_object ? Vector3f(object_rot * p_local + object_t) : p_local;
-    return n.dot(eye - p) < 0 ? Vector3f(-n) : n;
+    const Vector3f n_local = source.at(source.g.normals, source_bary_at(s, px, py));
+    const Vector3f n = source.is_object ? Vector3f(object_rot * n_local) : n_local;
+    const float along = n.dot(centre.v) < 0 ? -n.dot(centre.n) : n.dot(centre.n);
+    return along > 0 && along * along >= kQuadNormalCos * kQuadNormalCos * n.squaredNorm();
   };
   // Base colour x texture at (px, py) on the screen triangle, and where on the object (in its
   // own frame) the surface pattern is to be read, when it has one.
@@ -1509,9 +1511,8 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           // shading normals agree with its normal (a smooth patch), else per pixel.
           bool smooth = true;
           for (int i = 0; i < 4 && smooth; ++i) {
-            smooth = normal_at(screen_tris[quad[i].triangle[0]], qx + (i & 1) + 0.5f,
-                               qy + (i >> 1) + 0.5f)
-                         .dot(centre.n) >= kQuadNormalCos;
+            smooth = normal_agrees(screen_tris[quad[i].triangle[0]], qx + (i & 1) + 0.5f,
+                                   qy + (i >> 1) + 0.5f, centre);
           }
           std::array<int, 4> tris, pxs, pys;
           for (int i = 0; i < 4; ++i) {
