@@ -1223,17 +1223,23 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     int object_samples = 0;
     float nearest = 0;  // largest 1/z
   };
-  auto group_samples = [&](const float* inv_z, const std::int32_t* tri) {
+  // A pixel whose samples all hold screen triangle `id` (object_samples: kSamples on the
+  // object, 0 on the studio), as group_samples finds it.
+  auto single_surface = [](const float* inv_z, std::int32_t id, int object_samples) {
     PixelSurfaces out;
+    out.nearest = std::max({inv_z[0], inv_z[1], inv_z[2], inv_z[3]});
+    out.count = 1;
+    out.triangle[0] = id;
+    out.samples[0] = kSamples;
+    out.object_samples = object_samples;
+    return out;
+  };
+  auto group_samples = [&](const float* inv_z, const std::int32_t* tri) {
     if (tri[0] >= 0 && tri[0] == tri[1] && tri[0] == tri[2] && tri[0] == tri[3]) {
       // Inside one triangle, as most pixels are.
-      out.nearest = std::max({inv_z[0], inv_z[1], inv_z[2], inv_z[3]});
-      out.count = 1;
-      out.triangle[0] = tri[0];
-      out.samples[0] = kSamples;
-      out.object_samples = screen_tris[tri[0]].source < object_tris ? kSamples : 0;
-      return out;
+      return single_surface(inv_z, tri[0], screen_tris[tri[0]].source < object_tris ? kSamples : 0);
     }
+    PixelSurfaces out;
     std::array<int, kSamples> surface{-1, -1, -1, -1};
     for (int k = 0; k < kSamples; ++k) {
       const std::int32_t id = tri[k];
@@ -1555,23 +1561,33 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         // depth steps, and its corner normals within kBlockNormalCos of each other (or within
         // kBlockBumpyNormalCos and its light nearly linear). False (and nothing written)
         // otherwise.
-        auto shade_object_block = [&](int bx, int by) -> bool {
+        // `single_id`: the screen triangle that holds all of the block's samples, if one does
+        // (-1 otherwise); its pixels then need no grouping and its material no lookup per pixel.
+        auto shade_object_block = [&](int bx, int by, std::int32_t single_id) -> bool {
           failed_block.valid = false;
           std::array<PixelSurfaces, kBlock * kBlock> block;
           int material = -1;
+          if (single_id >= 0) {
+            if (screen_tris[single_id].source >= object_tris) return false;
+            material = source_of(screen_tris[single_id]).material();
+          }
           for (int i = 0; i < kBlock * kBlock; ++i) {
             const int px = bx + i % kBlock, py = by + i / kBlock;
-            block[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+            if (single_id >= 0) {
+              block[i] = single_surface(inv_z + at(px, py), single_id, kSamples);
+            } else {
+              block[i] = group_samples(inv_z + at(px, py), tri + at(px, py));
+            }
             const PixelSurfaces& b = block[i];
-            if (b.count != 1 || b.samples[0] != kSamples || b.object_samples != kSamples) {
-              return false;
+            if (single_id < 0) {
+              if (b.count != 1 || b.samples[0] != kSamples || b.object_samples != kSamples) {
+                return false;
+              }
+              const int m = source_of(screen_tris[b.triangle[0]]).material();
+              if (i == 0) material = m;
+              if (m != material) return false;
             }
-            const int m = source_of(screen_tris[b.triangle[0]]).material();
-            if (i == 0) material = m;
-            if (m != material ||
-                std::abs(b.nearest - block[0].nearest) > 0.01f * block[0].nearest) {
-              return false;
-            }
+            if (std::abs(b.nearest - block[0].nearest) > 0.01f * block[0].nearest) return false;
           }
           std::array<const ObjectCorner*, 4> corner;
           for (int k = 0; k < 4; ++k) {
@@ -1663,15 +1679,11 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
               for (int k = 0; k < kBlock * kSamples; ++k) differ |= ids[k] ^ first_id;
               one_triangle = differ == 0;
             }
+            const std::int32_t single_id = one_triangle ? first_id : -1;
             if (one_triangle && first_id >= 0 && plain_studio(screen_tris[first_id])) {
               for (int i = 0; i < kBlock * kBlock; ++i) {
-                const float* z = inv_z + at(bx + i % kBlock, by + i / kBlock);
-                PixelSurfaces& b = block[i];
-                b.count = 1;
-                b.triangle[0] = first_id;
-                b.samples[0] = kSamples;
-                b.object_samples = 0;
-                b.nearest = std::max({z[0], z[1], z[2], z[3]});
+                block[i] =
+                    single_surface(inv_z + at(bx + i % kBlock, by + i / kBlock), first_id, 0);
               }
               plane_triangle = first_id;
             } else {
@@ -1695,7 +1707,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
                            std::abs(b.nearest - block[0].nearest) <= 0.02f * block[0].nearest;
             }
             if (!flat_block && use_blocks && bx + kBlock <= x1 && by + kBlock <= y1 &&
-                shade_object_block(bx, by)) {
+                shade_object_block(bx, by, single_id)) {
               continue;
             }
             if (!flat_block) {
