@@ -194,9 +194,7 @@ std::shared_ptr<const FixedPattern> fixed_pattern(std::uint32_t key, std::size_t
   const std::size_t groups = (values + kNoiseLanes - 1) / kNoiseLanes;
   resize_frame_buffer(pattern->prnu, groups * kNoiseLanes);
   resize_frame_buffer(pattern->dsnu, groups * kNoiseLanes);
-  // The bytes are looked up already rounded and narrowed by shuffles, with the output pointers
-  // held in registers: the same bytes in about half the time (64 against 33-41 ms for a
-  // full-resolution frame, drawn once per run).
+  // The bytes are looked up already rounded (pattern_table) and narrowed by shuffles.
   const std::int8_t* bytes = pattern_table().data();
   // Plain pointers: stores through a byte pointer may alias anything, so the vectors' data
   // pointers would be reloaded for every group.
