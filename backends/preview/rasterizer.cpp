@@ -796,7 +796,9 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
             if constexpr (Samples == kSamples) {
               // Two pixels' eight samples per step (one 8-lane register), the odd last one on
               // four lanes. The lanes of the second pixel compute px + (1 + offset), which is
-              // exactly (px + 1) + offset in floats: the same coverage and depths.
+              // exactly (px + 1) + offset in floats: the same coverage and depths. Every step
+              // stores, hit or not: a branch on "any hit" mispredicts at each row's two edges
+              // (the stores go to the tile's own buffers, in L1).
               for (int py = py0; py <= py1; ++py) {
                 const Float8 sy = static_cast<float>(py) + lane_y8;
                 const Float8 w0_row = s.w0_plane[1] * sy;
@@ -812,7 +814,6 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                   Float8 nearest;
                   std::memcpy(&nearest, sample_inv_z + base, sizeof(nearest));
                   const Int8 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-                  if (!simd::any(hit)) continue;
                   Int8 ids;
                   std::memcpy(&ids, sample_tri + base, sizeof(ids));
                   const Float8 new_z = hit ? inv_z : nearest;
