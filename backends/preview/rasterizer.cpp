@@ -780,7 +780,8 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
               }
               continue;
             }
-            // Four lanes at (px, py): edge and depth tests, nearest depth and triangle kept.
+            // Four lanes at (px, py): edge and depth tests, nearest depth and triangle kept
+            // (stored hit or not, as below).
             auto test4 = [&](int px, int py, Float4 w0_row, Float4 w1_row, Float4 iz_row) {
               const Float4 sx = static_cast<float>(px) + lane_x;
               const Float4 w0 = s.w0_plane[0] * sx + w0_row + s.w0_plane[2];
@@ -789,7 +790,6 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
               const int base = ((py - y0) * kTileSize + (px - x0)) * Samples;
               const Float4 nearest = load4(sample_inv_z + base);
               const Int4 hit = (w0 >= 0) & (w1 >= 0) & (w0 + w1 <= 1) & (inv_z > nearest);
-              if (!simd::any(hit)) return;
               store4(sample_inv_z + base, hit ? inv_z : nearest);
               store4(sample_tri + base, hit ? id4 : load4(sample_tri + base));
             };
