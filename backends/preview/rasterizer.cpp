@@ -276,28 +276,51 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     }
     return simd::gather(depth.data(), iv * size + iu);
   };
+  // Each tap's distance from the centre, in disc radii.
+  static constexpr Float8 kDiscDistance[2] = {
+      {1.0216f, 1.2229f, 0.9343f, 0.4469f, 1.0286f, 1.1960f, 0.4720f, 1.2323f},
+      {1.0742f, 1.0410f, 0.6539f, 0.8956f, 0.8125f, 1.1681f, 0.4031f, 0.5142f}};
   // The receiver's depth less the bias under the disc's eight taps (half `half`).
   auto receiver_at = [&](int half, float radius) {
     return receiver + (kDiscU[half] * slope_u + kDiscV[half] * slope_v) * radius;
   };
+  // A texel d texels from the point, at depth z, can hide part of an area light only from
+  // inside the cone from the point to the light: d <= C (1/z - 1/z_r), C the light's
+  // half-diagonal over a texel's angle, plus a texel for the lookup's truncation. The
+  // statue's own relief a few millimetres above its surface, anywhere in a 24-texel disc,
+  // counted as blockers before; only within a texel or two of the point can it hide the light.
+  const float z_r = local.z();
+  const float cone = focal * light_size_m * 0.70710678f;
+  auto can_hide = [&](float z, float d) { return (d - 1) * z * z_r <= cone * (z_r - z); };
+  // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
+  // (A point light's cone is a line: its taps only smooth a hard edge.)
+  const bool area_light = light_size_m > 0 && !orthographic;
+  auto blocks8 = [&](const Float8& z, int half, float radius) {
+    const Int8 below = z < receiver_at(half, radius);
+    if (!area_light) return below;
+    const Float8 d = kDiscDistance[half] * radius - 1;
+    return below & (d * z * z_r <= cone * (z_r - z));
+  };
   float radius = 1.5f;
-  if (light_size_m > 0 && !orthographic) {
+  if (area_light) {
     // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
     const float search =
         std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f, 2.0f, 24.0f);
     // Most points are plainly lit: five taps over the search area settle them cheaply.
     const float rise = search * (slope_u + slope_v), fall = search * (slope_u - slope_v);
-    if (lookup(u, v) >= receiver && lookup(u - search, v - search) >= receiver - rise &&
-        lookup(u + search, v - search) >= receiver + fall &&
-        lookup(u - search, v + search) >= receiver - fall &&
-        lookup(u + search, v + search) >= receiver + rise) {
+    const float corner = search * std::numbers::sqrt2_v<float>;
+    auto clear = [&](float z, float threshold) { return z >= threshold || !can_hide(z, corner); };
+    if (lookup(u, v) >= receiver && clear(lookup(u - search, v - search), receiver - rise) &&
+        clear(lookup(u + search, v - search), receiver + fall) &&
+        clear(lookup(u - search, v + search), receiver - fall) &&
+        clear(lookup(u + search, v + search), receiver + rise)) {
       return 1;
     }
     int blockers = 0;
     Float8 blocker_sum = {};
     for (int half = 0; half < 2; ++half) {
       const Float8 z = disc8(half, search);
-      const Int8 blocks = z < receiver_at(half, search);
+      const Int8 blocks = blocks8(z, half, search);
       blockers += simd::count(blocks);
       blocker_sum += blocks ? z : Float8{};
     }
@@ -309,7 +332,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   }
   int lit = 0;
   for (int half = 0; half < 2; ++half) {
-    lit += simd::count(disc8(half, radius) >= receiver_at(half, radius));
+    lit += 8 - simd::count(blocks8(disc8(half, radius), half, radius));
   }
   return static_cast<float>(lit) / 16;
 }
