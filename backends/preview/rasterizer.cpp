@@ -233,7 +233,9 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     const Vector3f m = light_from_world * normal;
     // Orthographic: z = L.z - (m.x dx + m.y dy) / m.z with dx = du / focal. Perspective, along the
     // ray through texel (u + du, v + dv), to first order: L.z - L.z^2 (m.x du + m.y dv) / (focal
-    // m.L). (The second-order term is under a micrometre for 24 texels.)
+    // m.L). The plane lies deeper than that by the second-order term, which errs towards lit and
+    // stays within the bias up to the slope limit below (24 texels out: 1.6 mm at tan 6.6 on the
+    // paper scene's 2048 map, against a 2 mm bias).
     const float along =
         orthographic ? m.z() * focal : m.dot(local) * focal / (local.z() * local.z());
     // Steeper than kMaxSlope (light grazing the surface) the plane is not followed: the bias's
