@@ -187,6 +187,11 @@ struct ShadowMap {
   float softness_texels_per_m = 0;  // area lights: penumbra growth
   float light_size_m = 0;
   std::vector<float> depth;  // light-space z, +inf where empty
+  // The nearest depth in each kBlock x kBlock block of texels (row-major, blocks_per_row a
+  // row): a texel's lower bound, read from a map small enough to stay in cache.
+  static constexpr int kBlock = 16;
+  int blocks_per_row = 0;
+  std::vector<float> block_nearest;
 
   // Fraction of light reaching a world point with geometric normal `normal`, which faces the
   // light at cos_theta.
@@ -311,11 +316,25 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     // Most points are plainly lit: five taps over the search area settle them cheaply.
     const float rise = search * (slope_u + slope_v), fall = search * (slope_u - slope_v);
     const float corner = search * std::numbers::sqrt2_v<float>;
-    auto clear = [&](float z, float threshold) { return z >= threshold || !can_hide(z, corner); };
-    if (lookup(u, v) >= receiver && clear(lookup(u - search, v - search), receiver - rise) &&
-        clear(lookup(u + search, v - search), receiver + fall) &&
-        clear(lookup(u - search, v + search), receiver - fall) &&
-        clear(lookup(u + search, v + search), receiver + rise)) {
+    // Only a texel nearer the light than this can hide it from a corner's distance (can_hide
+    // solved for z, with a margin for rounding): where its block holds none, the corner's texel
+    // is not read. The corners are the five taps' far ones, and their texels are mostly out of
+    // cache; the blocks' nearest depths mostly in it.
+    const float hiding_depth = z_r * cone / (cone + (corner - 1) * z_r) * (1 + 1e-5f);
+    auto clear = [&](float su, float sv, float threshold) {
+      int iu = static_cast<int>(su), iv = static_cast<int>(sv);
+      if (!interior) {
+        iu = std::clamp(iu, 0, size - 1);
+        iv = std::clamp(iv, 0, size - 1);
+      }
+      if (block_nearest[(iv / kBlock) * blocks_per_row + iu / kBlock] > hiding_depth) return true;
+      const float z = depth[static_cast<size_t>(iv) * size + iu];
+      return z >= threshold || !can_hide(z, corner);
+    };
+    if (lookup(u, v) >= receiver && clear(u - search, v - search, receiver - rise) &&
+        clear(u + search, v - search, receiver + fall) &&
+        clear(u - search, v + search, receiver - fall) &&
+        clear(u + search, v + search, receiver + rise)) {
       return 1;
     }
     int blockers = 0;
@@ -437,6 +456,8 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   });
   const float empty = -std::numeric_limits<float>::infinity();
   map.depth = dslr::take_floats(static_cast<size_t>(size) * size);  // every band fills its rows
+  map.blocks_per_row = (size + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
+  map.block_nearest.assign(static_cast<size_t>(map.blocks_per_row) * map.blocks_per_row, 0.0f);
   tbb::parallel_for(0, bands, [&](int band) {
     const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
     float* key_rows = map.depth.data() + static_cast<size_t>(row0) * size;
@@ -473,6 +494,29 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       for (float* key = key_rows; key != keys_end; ++key) *key = -*key;
     } else {
       for (float* key = key_rows; key != keys_end; ++key) *key = *key > 0 ? 1 / *key : inf;
+    }
+    // The band's blocks' nearest depths, while its rows are in cache (a band is whole blocks
+    // high; the map is whole groups of eight texels wide).
+    static_assert(kBandRows % ShadowMap::kBlock == 0 && ShadowMap::kBlock % 8 == 0);
+    const float* depth = map.depth.data();
+    for (int block_row0 = row0; block_row0 < row1; block_row0 += ShadowMap::kBlock) {
+      const int block_row1 = std::min(row1, block_row0 + ShadowMap::kBlock);
+      float* nearest = &map.block_nearest[static_cast<size_t>(block_row0 / ShadowMap::kBlock) *
+                                          map.blocks_per_row];
+      for (int block = 0; block < map.blocks_per_row; ++block) {
+        const int x0 = block * ShadowMap::kBlock, x1 = std::min(size, x0 + ShadowMap::kBlock);
+        Float8 least = Float8{} + inf;
+        for (int y = block_row0; y < block_row1; ++y) {
+          for (int x = x0; x < x1; x += 8) {
+            Float8 z;
+            std::memcpy(&z, depth + static_cast<size_t>(y) * size + x, sizeof(z));
+            least = z < least ? z : least;
+          }
+        }
+        float m = least[0];
+        for (int k = 1; k < 8; ++k) m = std::min(m, least[k]);
+        nearest[block] = m;
+      }
     }
   });
 }
