@@ -192,6 +192,9 @@ struct ShadowMap {
   static constexpr int kBlock = 16;
   int blocks_per_row = 0;
   std::vector<float> block_nearest;
+  // The nearest depth in the 5 x 5 blocks around each block: all that a tap 24 texels or less
+  // from a texel of the middle block can read.
+  std::vector<float> reach_nearest;
 
   // Fraction of light reaching a world point with geometric normal `normal`, which faces the
   // light at cos_theta.
@@ -331,10 +334,14 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       const float z = depth[static_cast<size_t>(iv) * size + iu];
       return z >= threshold || !can_hide(z, corner);
     };
-    if (lookup(u, v) >= receiver && clear(u - search, v - search, receiver - rise) &&
-        clear(u + search, v - search, receiver + fall) &&
-        clear(u - search, v + search, receiver - fall) &&
-        clear(u + search, v + search, receiver + rise)) {
+    // One lookup settles all four corners where nothing within their reach can hide the light.
+    const bool corners_clear = reach_nearest[(static_cast<int>(v) / kBlock) * blocks_per_row +
+                                             static_cast<int>(u) / kBlock] > hiding_depth;
+    if (lookup(u, v) >= receiver &&
+        (corners_clear || (clear(u - search, v - search, receiver - rise) &&
+                           clear(u + search, v - search, receiver + fall) &&
+                           clear(u - search, v + search, receiver - fall) &&
+                           clear(u + search, v + search, receiver + rise)))) {
       return 1;
     }
     int blockers = 0;
@@ -519,6 +526,29 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       }
     }
   });
+  // Two passes of 5 (rows, then columns), clamped at the map's edges.
+  const int blocks = map.blocks_per_row;
+  std::vector<float> across(map.block_nearest.size());
+  auto at = [blocks](int bx, int by) { return static_cast<size_t>(by) * blocks + bx; };
+  for (int by = 0; by < blocks; ++by) {
+    for (int bx = 0; bx < blocks; ++bx) {
+      float m = map.block_nearest[at(bx, by)];
+      for (int k = std::max(0, bx - 2); k <= std::min(blocks - 1, bx + 2); ++k) {
+        m = std::min(m, map.block_nearest[at(k, by)]);
+      }
+      across[at(bx, by)] = m;
+    }
+  }
+  map.reach_nearest.resize(across.size());
+  for (int by = 0; by < blocks; ++by) {
+    for (int bx = 0; bx < blocks; ++bx) {
+      float m = across[at(bx, by)];
+      for (int k = std::max(0, by - 2); k <= std::min(blocks - 1, by + 2); ++k) {
+        m = std::min(m, across[at(bx, k)]);
+      }
+      map.reach_nearest[at(bx, by)] = m;
+    }
+  }
 }
 
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
