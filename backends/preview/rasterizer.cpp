@@ -463,8 +463,12 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   });
   const float empty = -std::numeric_limits<float>::infinity();
   map.depth = dslr::take_floats(static_cast<size_t>(size) * size);  // every band fills its rows
-  map.blocks_per_row = (size + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
-  map.block_nearest.assign(static_cast<size_t>(map.blocks_per_row) * map.blocks_per_row, 0.0f);
+  // The block maps serve the soft shadows' far taps only (see ShadowMap::visibility).
+  const bool soft = map.light_size_m > 0 && !map.orthographic;
+  if (soft) {
+    map.blocks_per_row = (size + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
+    map.block_nearest.assign(static_cast<size_t>(map.blocks_per_row) * map.blocks_per_row, 0.0f);
+  }
   tbb::parallel_for(0, bands, [&](int band) {
     const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
     float* key_rows = map.depth.data() + static_cast<size_t>(row0) * size;
@@ -505,6 +509,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     // The band's blocks' nearest depths, while its rows are in cache (a band is whole blocks
     // high; the map is whole groups of eight texels wide).
     static_assert(kBandRows % ShadowMap::kBlock == 0 && ShadowMap::kBlock % 8 == 0);
+    if (!soft) return;
     const float* depth = map.depth.data();
     for (int block_row0 = row0; block_row0 < row1; block_row0 += ShadowMap::kBlock) {
       const int block_row1 = std::min(row1, block_row0 + ShadowMap::kBlock);
@@ -526,6 +531,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       }
     }
   });
+  if (!soft) return;
   // Two passes of 5 (rows, then columns), clamped at the map's edges.
   const int blocks = map.blocks_per_row;
   std::vector<float> across(map.block_nearest.size());
