@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/optics.h"
@@ -257,12 +258,17 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   }
   // Taps reach at most 24 texels from (u, v): away from the map's border they need no clamping.
   const bool interior = u >= 25 && v >= 25 && u < size - 25 && v < size - 25;
-  auto lookup = [&](float su, float sv) {
-    if (interior) {
-      return depth[static_cast<size_t>(static_cast<int>(sv)) * size + static_cast<int>(su)];
+  // The texel (column, row) a tap at (su, sv) reads.
+  auto texel_of = [&](float su, float sv) {
+    int iu = static_cast<int>(su), iv = static_cast<int>(sv);
+    if (!interior) {
+      iu = std::clamp(iu, 0, size - 1);
+      iv = std::clamp(iv, 0, size - 1);
     }
-    const int iu = std::clamp(static_cast<int>(su), 0, size - 1);
-    const int iv = std::clamp(static_cast<int>(sv), 0, size - 1);
+    return std::pair{iu, iv};
+  };
+  auto lookup = [&](float su, float sv) {
+    const auto [iu, iv] = texel_of(su, sv);
     return depth[static_cast<size_t>(iv) * size + iu];
   };
   // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels. Its taps are
@@ -301,15 +307,15 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   // counted as blockers before; only within a texel or two of the point can it hide the light.
   const float z_r = local.z();
   const float cone = focal * light_size_m * 0.70710678f;
-  auto can_hide = [&](float z, float d) { return (d - 1) * z * z_r <= cone * (z_r - z); };
+  // For one tap (float) or eight (Float8), with the same operations.
+  auto can_hide = [&](auto z, auto d) { return (d - 1) * z * z_r <= cone * (z_r - z); };
   // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
   // (A point light's cone is a line: its taps only smooth a hard edge.)
   const bool area_light = light_size_m > 0 && !orthographic;
   auto blocks8 = [&](const Float8& z, int half, float radius) {
     const Int8 below = z < receiver_at(half, radius);
     if (!area_light) return below;
-    const Float8 d = kDiscDistance[half] * radius - 1;
-    return below & (d * z * z_r <= cone * (z_r - z));
+    return below & can_hide(z, kDiscDistance[half] * radius);
   };
   float radius = 1.5f;
   if (area_light) {
@@ -324,19 +330,16 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     // is not read. The corners are the five taps' far ones, and their texels are mostly out of
     // cache; the blocks' nearest depths mostly in it.
     const float hiding_depth = z_r * cone / (cone + (corner - 1) * z_r) * (1 + 1e-5f);
+    auto block_of = [&](int iu, int iv) { return (iv / kBlock) * blocks_per_row + iu / kBlock; };
     auto clear = [&](float su, float sv, float threshold) {
-      int iu = static_cast<int>(su), iv = static_cast<int>(sv);
-      if (!interior) {
-        iu = std::clamp(iu, 0, size - 1);
-        iv = std::clamp(iv, 0, size - 1);
-      }
-      if (block_nearest[(iv / kBlock) * blocks_per_row + iu / kBlock] > hiding_depth) return true;
+      const auto [iu, iv] = texel_of(su, sv);
+      if (block_nearest[block_of(iu, iv)] > hiding_depth) return true;
       const float z = depth[static_cast<size_t>(iv) * size + iu];
       return z >= threshold || !can_hide(z, corner);
     };
     // One lookup settles all four corners where nothing within their reach can hide the light.
-    const bool corners_clear = reach_nearest[(static_cast<int>(v) / kBlock) * blocks_per_row +
-                                             static_cast<int>(u) / kBlock] > hiding_depth;
+    const bool corners_clear =
+        reach_nearest[block_of(static_cast<int>(u), static_cast<int>(v))] > hiding_depth;
     if (lookup(u, v) >= receiver &&
         (corners_clear || (clear(u - search, v - search, receiver - rise) &&
                            clear(u + search, v - search, receiver + fall) &&
@@ -532,29 +535,24 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     }
   });
   if (!soft) return;
-  // Two passes of 5 (rows, then columns), clamped at the map's edges.
+  // Two passes of 5 (along rows, then along columns), clamped at the map's edges.
   const int blocks = map.blocks_per_row;
-  std::vector<float> across(map.block_nearest.size());
-  auto at = [blocks](int bx, int by) { return static_cast<size_t>(by) * blocks + bx; };
-  for (int by = 0; by < blocks; ++by) {
-    for (int bx = 0; bx < blocks; ++bx) {
-      float m = map.block_nearest[at(bx, by)];
-      for (int k = std::max(0, bx - 2); k <= std::min(blocks - 1, bx + 2); ++k) {
-        m = std::min(m, map.block_nearest[at(k, by)]);
+  auto nearest_of_five = [blocks](const std::vector<float>& from, bool along_rows) {
+    std::vector<float> to(from.size());
+    for (int by = 0; by < blocks; ++by) {
+      for (int bx = 0; bx < blocks; ++bx) {
+        const int at = along_rows ? bx : by;
+        float m = std::numeric_limits<float>::infinity();
+        for (int k = std::max(0, at - 2); k <= std::min(blocks - 1, at + 2); ++k) {
+          m = std::min(
+              m, from[static_cast<size_t>(along_rows ? by : k) * blocks + (along_rows ? k : bx)]);
+        }
+        to[static_cast<size_t>(by) * blocks + bx] = m;
       }
-      across[at(bx, by)] = m;
     }
-  }
-  map.reach_nearest.resize(across.size());
-  for (int by = 0; by < blocks; ++by) {
-    for (int bx = 0; bx < blocks; ++bx) {
-      float m = across[at(bx, by)];
-      for (int k = std::max(0, by - 2); k <= std::min(blocks - 1, by + 2); ++k) {
-        m = std::min(m, across[at(bx, k)]);
-      }
-      map.reach_nearest[at(bx, by)] = m;
-    }
-  }
+    return to;
+  };
+  map.reach_nearest = nearest_of_five(nearest_of_five(map.block_nearest, true), false);
 }
 
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
