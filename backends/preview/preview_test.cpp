@@ -425,6 +425,79 @@ shots:
   EXPECT_NEAR(soft / small, 1.0, 0.05);
 }
 
+// A box face lit by a softbox keeps its light down to the turntable top it stands on. In the
+// light's map the top in front of the face lies nearer the light than the face's plane, inside
+// the soft shadow's 24-texel search, yet below every ray from the face to the light: only texels
+// inside the cone from a point to the light can hide part of it. Counting the whole search disc,
+// the bottom of the face came out darker than its middle, a false dark line along the foot of
+// every lit face. The face's bottom-to-middle ratio must match that under a 1 cm light of the
+// same power, whose search stays within a texel or two.
+TEST(Preview, SoftboxLightsABoxFaceDownToItsFoot) {
+  auto foot_to_middle = [](const std::string& light_size) {
+    const ir::Scene scene = compile(R"(rigc: 1
+object:
+  primitive: {shape: box}
+  fit: {size: 20cm}
+  surface: {pattern: none, color: [0.8, 0.8, 0.8]}
+studio:
+  turntable: {diameter: 80cm, height: 50cm, color: [0.6, 0.6, 0.6]}
+  backdrop: {green_screen: false}
+  floor: {color: [0, 0, 0]}
+  lights:
+    - {type: area, position: [0.5m, -1.0m, 0.95m], size: [)" +
+                                    light_size + ", " + light_size + R"(], power: 80W}
+  ambient: 0lx
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm}
+  exposure: {aperture: f/8, shutter: 1/125, iso: 200}
+shots:
+  - turntable: {steps: 1, step: 20deg, camera: {distance: 70cm, height: 15cm}}
+)");
+    const StudioScene studio = prepare_studio_scene(scene);
+    FrameRequest request = shot_request(scene, 0, 0.15);
+    request.shadow_map_size = 2048;
+    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    const int width = frame.width, height = frame.height;
+    // Per row, the object's mean radiance over the middle fifth of the frame's columns.
+    std::vector<double> row_mean(height, -1);
+    int bottom = -1, top = height;
+    for (int y = 0; y < height; ++y) {
+      double sum = 0;
+      int count = 0;
+      for (int x = width * 2 / 5; x < width * 3 / 5; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * width + x;
+        if (frame.mask[p] == 0) continue;
+        sum += frame.rgb[3 * p + 1];
+        ++count;
+      }
+      if (count == width / 5) {
+        row_mean[y] = sum / count;
+        bottom = std::max(bottom, y);
+        top = std::min(top, y);
+      }
+    }
+    // The face fills the middle columns from its top edge to its foot on the turntable top.
+    const int rows = bottom - top + 1;
+    if (rows < height / 2) {
+      ADD_FAILURE() << "the face spans " << rows << " of " << height << " rows";
+      return 0.0;
+    }
+    auto band_mean = [&](int from, int to) {  // rows [from, to]
+      double sum = 0;
+      for (int y = from; y <= to; ++y) sum += row_mean[y];
+      return sum / (to - from + 1);
+    };
+    const double middle = band_mean(top + rows * 2 / 5, top + rows * 3 / 5);
+    const double foot = band_mean(bottom - rows * 3 / 100, bottom);
+    EXPECT_GT(middle, 0);
+    return foot / middle;
+  };
+  const double soft = foot_to_middle("50cm"), small = foot_to_middle("1cm");
+  // 1.000 with the cone (the face's own falloff cancels out); 0.869 counting the whole disc.
+  EXPECT_NEAR(soft / small, 1.0, 0.02);
+}
+
 // Every pixel is written, also in the odd last column and row of a canvas (quads and blocks
 // that the canvas cuts): in the paper scene every ray meets the studio, so no depth stays
 // infinite.
