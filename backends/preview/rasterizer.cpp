@@ -271,19 +271,38 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     const auto [iu, iv] = texel_of(su, sv);
     return depth[static_cast<size_t>(iv) * size + iu];
   };
-  // A fixed 16-tap disc: deterministic, so the same scene gives the same pixels. Its taps are
-  // looked up eight at a time (two thirds of the calls reach the disc loops, at full resolution).
+  // Fixed tap discs, in disc radii: deterministic, so the same scene gives the same pixels. Taps
+  // are looked up eight at a time (two thirds of the calls reach the disc loops, at full
+  // resolution). The blocker search takes 16; the filter of an area light's penumbra 64, since
+  // its light level moves in steps of one tap: 16 left 17 levels, bands a few pixels wide
+  // across a wide penumbra, with the map's texel stairs along each.
   using Float8 = simd::F32x8;
   using Int8 = simd::I32x8;
-  static constexpr Float8 kDiscU[2] = {
-      {-0.94f, 0.95f, -0.09f, 0.34f, -0.92f, -0.81f, -0.38f, 0.97f},
-      {0.44f, 0.54f, -0.26f, -0.10f, 0.79f, -0.62f, 0.20f, -0.50f}};
-  static constexpr Float8 kDiscV[2] = {
-      {-0.40f, -0.77f, -0.93f, 0.29f, 0.46f, -0.88f, 0.28f, 0.76f},
-      {-0.98f, 0.89f, -0.60f, 0.89f, 0.19f, 0.99f, -0.35f, -0.12f}};
-  // Depths at the disc's eight taps (half `half`) scaled by `radius` around (u, v).
-  auto disc8 = [&](int half, float radius) {
-    const Float8 su = u + kDiscU[half] * radius, sv = v + kDiscV[half] * radius;
+  struct TapGroup {
+    Float8 u, v, distance;  // eight taps, and their distance from the centre
+  };
+  static constexpr TapGroup kSearchTaps[2] = {
+      {{-0.94f, 0.95f, -0.09f, 0.34f, -0.92f, -0.81f, -0.38f, 0.97f},
+       {-0.40f, -0.77f, -0.93f, 0.29f, 0.46f, -0.88f, 0.28f, 0.76f},
+       {1.0216f, 1.2229f, 0.9343f, 0.4469f, 1.0286f, 1.1960f, 0.4720f, 1.2323f}},
+      {{0.44f, 0.54f, -0.26f, -0.10f, 0.79f, -0.62f, 0.20f, -0.50f},
+       {-0.98f, 0.89f, -0.60f, 0.89f, 0.19f, 0.99f, -0.35f, -0.12f},
+       {1.0742f, 1.0410f, 0.6539f, 0.8956f, 0.8125f, 1.1681f, 0.4031f, 0.5142f}}};
+  static const std::array<TapGroup, 8> filter_taps = [] {
+    // A Vogel spiral: tap k at radius √((k + ½) / 64), turned by the golden angle, fills the disc
+    // evenly with no two taps on one line through it.
+    std::array<TapGroup, 8> groups{};
+    for (int k = 0; k < 64; ++k) {
+      const float r = std::sqrt((k + 0.5f) / 64), angle = k * 2.39996323f;
+      groups[k / 8].u[k % 8] = r * std::cos(angle);
+      groups[k / 8].v[k % 8] = r * std::sin(angle);
+      groups[k / 8].distance[k % 8] = r;
+    }
+    return groups;
+  }();
+  // Depths at a group's eight taps scaled by `radius` around (u, v).
+  auto disc8 = [&](const TapGroup& taps, float radius) {
+    const Float8 su = u + taps.u * radius, sv = v + taps.v * radius;
     Int8 iu = __builtin_convertvector(su, Int8), iv = __builtin_convertvector(sv, Int8);
     if (!interior) {
       const Int8 zero = {}, last = zero + (size - 1);
@@ -292,30 +311,32 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     }
     return simd::gather(depth.data(), iv * size + iu);
   };
-  // Each tap's distance from the centre, in disc radii.
-  static constexpr Float8 kDiscDistance[2] = {
-      {1.0216f, 1.2229f, 0.9343f, 0.4469f, 1.0286f, 1.1960f, 0.4720f, 1.2323f},
-      {1.0742f, 1.0410f, 0.6539f, 0.8956f, 0.8125f, 1.1681f, 0.4031f, 0.5142f}};
-  // The receiver's depth less the bias under the disc's eight taps (half `half`).
-  auto receiver_at = [&](int half, float radius) {
-    return receiver + (kDiscU[half] * slope_u + kDiscV[half] * slope_v) * radius;
+  // The receiver's depth less the bias under a group's eight taps.
+  auto receiver_at = [&](const TapGroup& taps, float radius) {
+    return receiver + (taps.u * slope_u + taps.v * slope_v) * radius;
   };
   // A texel d texels from the point, at depth z, can hide part of an area light only from
   // inside the cone from the point to the light: d <= C (1/z - 1/z_r), C the light's
-  // half-diagonal over a texel's angle, plus a texel for the lookup's truncation. The
-  // statue's own relief a few millimetres above its surface, anywhere in a 24-texel disc,
-  // counted as blockers before; only within a texel or two of the point can it hide the light.
+  // half-diagonal over a texel's angle, widened by the filter's smallest radius (1.5 texels,
+  // which also covers the lookup's truncation). The statue's own relief a few millimetres above
+  // its surface, anywhere in a 24-texel disc, counted as blockers before; only within a texel or
+  // two of the point can it hide the light. The width matters where the cone is narrower than
+  // that (a small light, or a blocker just above the surface, as at a contact): the smallest
+  // filter is there to smooth the map's texel stairs, and with only 1 texel of margin its outer
+  // taps counted as lit, which opened a lit gap in a contact shadow and the shadow of a 1 cm
+  // light.
+  constexpr float kConeMargin = 1.5f;
   const float z_r = local.z();
   const float cone = focal * light_size_m * 0.70710678f;
   // For one tap (float) or eight (Float8), with the same operations.
-  auto can_hide = [&](auto z, auto d) { return (d - 1) * z * z_r <= cone * (z_r - z); };
+  auto can_hide = [&](auto z, auto d) { return (d - kConeMargin) * z * z_r <= cone * (z_r - z); };
   // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
   // (A point light's cone is a line: its taps only smooth a hard edge.)
   const bool area_light = light_size_m > 0 && !orthographic;
-  auto blocks8 = [&](const Float8& z, int half, float radius) {
-    const Int8 below = z < receiver_at(half, radius);
+  auto blocks8 = [&](const Float8& z, const TapGroup& taps, float radius) {
+    const Int8 below = z < receiver_at(taps, radius);
     if (!area_light) return below;
-    return below & can_hide(z, kDiscDistance[half] * radius);
+    return below & can_hide(z, taps.distance * radius);
   };
   float radius = 1.5f;
   if (area_light) {
@@ -329,7 +350,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     // solved for z, with a margin for rounding): where its block holds none, the corner's texel
     // is not read. The corners are the five taps' far ones, and their texels are mostly out of
     // cache; the blocks' nearest depths mostly in it.
-    const float hiding_depth = z_r * cone / (cone + (corner - 1) * z_r) * (1 + 1e-5f);
+    const float hiding_depth = z_r * cone / (cone + (corner - kConeMargin) * z_r) * (1 + 1e-5f);
     auto block_of = [&](int iu, int iv) { return (iv / kBlock) * blocks_per_row + iu / kBlock; };
     auto clear = [&](float su, float sv, float threshold) {
       const auto [iu, iv] = texel_of(su, sv);
@@ -349,9 +370,9 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     }
     int blockers = 0;
     Float8 blocker_sum = {};
-    for (int half = 0; half < 2; ++half) {
-      const Float8 z = disc8(half, search);
-      const Int8 blocks = blocks8(z, half, search);
+    for (const TapGroup& taps : kSearchTaps) {
+      const Float8 z = disc8(taps, search);
+      const Int8 blocks = blocks8(z, taps, search);
       blockers += simd::count(blocks);
       blocker_sum += blocks ? z : Float8{};
     }
@@ -360,10 +381,15 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     const float blocker = simd::sum(blocker_sum) / static_cast<float>(blockers);
     const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
     radius = std::clamp(penumbra_m / texel, 1.5f, 24.0f);
+    int lit = 0;
+    for (const TapGroup& taps : filter_taps) {
+      lit += 8 - simd::count(blocks8(disc8(taps, radius), taps, radius));
+    }
+    return static_cast<float>(lit) / 64;
   }
   int lit = 0;
-  for (int half = 0; half < 2; ++half) {
-    lit += 8 - simd::count(blocks8(disc8(half, radius), half, radius));
+  for (const TapGroup& taps : kSearchTaps) {
+    lit += 8 - simd::count(blocks8(disc8(taps, radius), taps, radius));
   }
   return static_cast<float>(lit) / 16;
 }
