@@ -272,10 +272,10 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     return depth[static_cast<size_t>(iv) * size + iu];
   };
   // Fixed tap discs, in disc radii: deterministic, so the same scene gives the same pixels. Taps
-  // are looked up eight at a time (two thirds of the calls reach the disc loops, at full
-  // resolution). The blocker search takes 16; the filter of an area light's penumbra 64, since
-  // its light level moves in steps of one tap: 16 left 17 levels, bands a few pixels wide
-  // across a wide penumbra, with the map's texel stairs along each.
+  // are looked up eight at a time. The blocker search and the filter of a hard edge take 16; the
+  // filter of an area light's penumbra 64, since its light level moves in steps of one tap: 16
+  // left 17 levels, bands a few pixels wide across a wide penumbra, with the map's texel stairs
+  // along each.
   using Float8 = simd::F32x8;
   using Int8 = simd::I32x8;
   struct TapGroup {
@@ -317,19 +317,20 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   };
   // A texel d texels from the point, at depth z, can hide part of an area light only from
   // inside the cone from the point to the light: d <= C (1/z - 1/z_r), C the light's
-  // half-diagonal over a texel's angle, widened by the filter's smallest radius (1.5 texels,
-  // which also covers the lookup's truncation). The statue's own relief a few millimetres above
-  // its surface, anywhere in a 24-texel disc, counted as blockers before; only within a texel or
-  // two of the point can it hide the light. The width matters where the cone is narrower than
-  // that (a small light, or a blocker just above the surface, as at a contact): the smallest
-  // filter is there to smooth the map's texel stairs, and with only 1 texel of margin its outer
-  // taps counted as lit, which opened a lit gap in a contact shadow and the shadow of a 1 cm
-  // light.
-  constexpr float kConeMargin = 1.5f;
+  // half-diagonal over a texel's angle, widened by the smallest filter's radius (which also
+  // covers the lookup's truncation). The statue's own relief a few millimetres above its
+  // surface, anywhere in a 24-texel disc, counted as blockers before; only within a texel or two
+  // of the point can it hide the light. Where the cone is narrower than the smallest filter (a
+  // small light, or a blocker just above the surface at a contact), that filter's taps must all
+  // count: it smooths the map's texel stairs, and with a 1-texel margin its outer taps came out
+  // lit, opening a lit gap between a box's foot and its shadow.
+  constexpr float kSmallestFilter = 1.5f;  // texels
   const float z_r = local.z();
   const float cone = focal * light_size_m * 0.70710678f;
   // For one tap (float) or eight (Float8), with the same operations.
-  auto can_hide = [&](auto z, auto d) { return (d - kConeMargin) * z * z_r <= cone * (z_r - z); };
+  auto can_hide = [&](auto z, auto d) {
+    return (d - kSmallestFilter) * z * z_r <= cone * (z_r - z);
+  };
   // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
   // (A point light's cone is a line: its taps only smooth a hard edge.)
   const bool area_light = light_size_m > 0 && !orthographic;
@@ -338,7 +339,6 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     if (!area_light) return below;
     return below & can_hide(z, taps.distance * radius);
   };
-  float radius = 1.5f;
   if (area_light) {
     // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
     const float search =
@@ -350,7 +350,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     // solved for z, with a margin for rounding): where its block holds none, the corner's texel
     // is not read. The corners are the five taps' far ones, and their texels are mostly out of
     // cache; the blocks' nearest depths mostly in it.
-    const float hiding_depth = z_r * cone / (cone + (corner - kConeMargin) * z_r) * (1 + 1e-5f);
+    const float hiding_depth = z_r * cone / (cone + (corner - kSmallestFilter) * z_r) * (1 + 1e-5f);
     auto block_of = [&](int iu, int iv) { return (iv / kBlock) * blocks_per_row + iu / kBlock; };
     auto clear = [&](float su, float sv, float threshold) {
       const auto [iu, iv] = texel_of(su, sv);
@@ -380,16 +380,17 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     if (blockers == 16) return 0;  // the whole search area blocks: umbra
     const float blocker = simd::sum(blocker_sum) / static_cast<float>(blockers);
     const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
-    radius = std::clamp(penumbra_m / texel, 1.5f, 24.0f);
+    const float radius = std::clamp(penumbra_m / texel, kSmallestFilter, 24.0f);
     int lit = 0;
     for (const TapGroup& taps : filter_taps) {
       lit += 8 - simd::count(blocks8(disc8(taps, radius), taps, radius));
     }
     return static_cast<float>(lit) / 64;
   }
+  // Other lights: a hard edge, smoothed over the smallest filter.
   int lit = 0;
   for (const TapGroup& taps : kSearchTaps) {
-    lit += 8 - simd::count(blocks8(disc8(taps, radius), taps, radius));
+    lit += 8 - simd::count(blocks8(disc8(taps, kSmallestFilter), taps, kSmallestFilter));
   }
   return static_cast<float>(lit) / 16;
 }
