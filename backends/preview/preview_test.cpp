@@ -425,16 +425,11 @@ shots:
   EXPECT_NEAR(soft / small, 1.0, 0.05);
 }
 
-// A box face lit by a softbox keeps its light down to the turntable top it stands on. In the
-// light's map the top in front of the face lies nearer the light than the face's plane, inside
-// the soft shadow's 24-texel search, yet below every ray from the face to the light: only texels
-// inside the cone from a point to the light can hide part of it. Counting the whole search disc,
-// the bottom of the face came out darker than its middle, a false dark line along the foot of
-// every lit face. The face's bottom-to-middle ratio must match that under a 1 cm light of the
-// same power, whose search stays within a texel or two.
-TEST(Preview, SoftboxLightsABoxFaceDownToItsFoot) {
-  auto foot_to_middle = [](const std::string& light_size) {
-    const ir::Scene scene = compile(R"(rigc: 1
+// A 20 cm box on a turntable, lit by one light (a YAML flow map) front right, seen head-on from
+// 70 cm, a little above the turntable top; its frame at `scale`, with a shadow map of
+// `map_size` texels.
+dslr::LinearFrame box_frame(const std::string& light, double scale, int map_size) {
+  const ir::Scene scene = compile(R"(rigc: 1
 object:
   primitive: {shape: box}
   fit: {size: 20cm}
@@ -444,8 +439,7 @@ studio:
   backdrop: {green_screen: false}
   floor: {color: [0, 0, 0]}
   lights:
-    - {type: area, position: [0.5m, -1.0m, 0.95m], size: [)" +
-                                    light_size + ", " + light_size + R"(], power: 80W}
+    - )" + light + R"(
   ambient: 0lx
 camera:
   body: canon-6d
@@ -454,10 +448,40 @@ camera:
 shots:
   - turntable: {steps: 1, step: 20deg, camera: {distance: 70cm, height: 15cm}}
 )");
-    const StudioScene studio = prepare_studio_scene(scene);
-    FrameRequest request = shot_request(scene, 0, 0.15);
-    request.shadow_map_size = 2048;
-    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+  const StudioScene studio = prepare_studio_scene(scene);
+  FrameRequest request = shot_request(scene, 0, scale);
+  request.shadow_map_size = map_size;
+  return render_frame(scene, studio, request);
+}
+
+std::string area_light_front_right(const std::string& size) {
+  return "{type: area, position: [0.5m, -1.0m, 0.95m], size: [" + size + ", " + size +
+         "], power: 80W}";
+}
+
+// fn(row, box_left) for each row of box_frame across the turntable top left of the box, where
+// the box's shadow falls (70-90 % of the height): `row` its first pixel, `box_left` the box's
+// first column (the top lies left of it).
+template <typename Fn>
+void for_rows_left_of_box(const dslr::LinearFrame& frame, const Fn& fn) {
+  for (int y = frame.height * 7 / 10; y < frame.height * 9 / 10; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * frame.width;
+    int box_left = 0;
+    while (box_left < frame.width / 2 && frame.mask[row + box_left] == 0) ++box_left;
+    fn(row, box_left);
+  }
+}
+
+// A box face lit by a softbox keeps its light down to the turntable top it stands on. In the
+// light's map the top in front of the face lies nearer the light than the face's plane, inside
+// the soft shadow's 24-texel search, yet below every ray from the face to the light: only texels
+// inside the cone from a point to the light can hide part of it. Counting the whole search disc,
+// the bottom of the face came out darker than its middle, a false dark line along the foot of
+// every lit face. The face's bottom-to-middle ratio must match that under a 1 cm light of the
+// same power, whose search stays within a texel or two.
+TEST(Preview, SoftboxLightsABoxFaceDownToItsFoot) {
+  auto foot_to_middle = [](const std::string& light_size) {
+    const dslr::LinearFrame frame = box_frame(area_light_front_right(light_size), 0.15, 2048);
     const int width = frame.width, height = frame.height;
     // Per row, the object's mean radiance over the middle fifth of the frame's columns.
     std::vector<double> row_mean(height, -1);
@@ -505,53 +529,24 @@ shots:
 // shadowed pixels then, 0.992 now).
 TEST(Preview, SmallAreaLightShadowsLikeAPointLight) {
   auto shadowed_pixels = [](const std::string& light) {
-    const ir::Scene scene = compile(R"(rigc: 1
-object:
-  primitive: {shape: box}
-  fit: {size: 20cm}
-  surface: {pattern: none, color: [0.8, 0.8, 0.8]}
-studio:
-  turntable: {diameter: 80cm, height: 50cm, color: [0.6, 0.6, 0.6]}
-  backdrop: {green_screen: false}
-  floor: {color: [0, 0, 0]}
-  lights:
-    - )" + light + R"(
-  ambient: 0lx
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/8, shutter: 1/125, iso: 200}
-shots:
-  - turntable: {steps: 1, step: 20deg, camera: {distance: 70cm, height: 15cm}}
-)");
-    const StudioScene studio = prepare_studio_scene(scene);
-    FrameRequest request = shot_request(scene, 0, 0.25);
-    request.shadow_map_size = 684;  // as a 0.25-scale render has it
-    const dslr::LinearFrame frame = render_frame(scene, studio, request);
-    // The turntable top left of the box, below the top's far edge: the box's shadow falls there
-    // from the box's front corner back to the left. Shadowed: under half the brightest level
-    // of the same row there (the top's lit part).
-    const int width = frame.width, height = frame.height;
+    const dslr::LinearFrame frame = box_frame(light, 0.25, 684);  // a 0.25-scale render's map
+    // Shadowed: under half the brightest level of the row's top (its lit part).
     int shadowed = 0, top_pixels = 0;
-    for (int y = height * 7 / 10; y < height * 9 / 10; ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * width;
-      int box_left = 0;  // the box's first column in this row
-      while (box_left < width / 2 && frame.mask[row + box_left] == 0) ++box_left;
+    for_rows_left_of_box(frame, [&](std::size_t row, int box_left) {
       float brightest = 0;
-      for (int x = 0; x < box_left; ++x)
-        brightest = std::max(brightest, frame.rgb[3 * (row + x) + 1]);
       for (int x = 0; x < box_left; ++x) {
-        const std::size_t p = row + x;
-        if (frame.mask[p] != 0 || !std::isfinite(frame.depth_m[p])) continue;
-        ++top_pixels;
-        shadowed += frame.rgb[3 * p + 1] < 0.5f * brightest;
+        brightest = std::max(brightest, frame.rgb[3 * (row + x) + 1]);
       }
-    }
+      for (int x = 0; x < box_left; ++x) {
+        if (!std::isfinite(frame.depth_m[row + x])) continue;
+        ++top_pixels;
+        shadowed += frame.rgb[3 * (row + x) + 1] < 0.5f * brightest;
+      }
+    });
     EXPECT_GT(top_pixels, 10000);
     return shadowed;
   };
-  const int area =
-      shadowed_pixels("{type: area, position: [0.5m, -1.0m, 0.95m], size: [1cm, 1cm], power: 80W}");
+  const int area = shadowed_pixels(area_light_front_right("1cm"));
   const int point = shadowed_pixels("{type: point, position: [0.5m, -1.0m, 0.95m], power: 80W}");
   ASSERT_GT(point, 1000);
   EXPECT_NEAR(static_cast<double>(area) / point, 1.0, 0.03);
@@ -561,37 +556,11 @@ shots:
 // 16 taps left 17 levels, bands several pixels wide across the turntable top, with the map's
 // texel stairs along each (false features for SfM, where a real penumbra has none).
 TEST(Preview, SoftShadowPenumbraIsNotBanded) {
-  const ir::Scene scene = compile(R"(rigc: 1
-object:
-  primitive: {shape: box}
-  fit: {size: 20cm}
-  surface: {pattern: none, color: [0.8, 0.8, 0.8]}
-studio:
-  turntable: {diameter: 80cm, height: 50cm, color: [0.6, 0.6, 0.6]}
-  backdrop: {green_screen: false}
-  floor: {color: [0, 0, 0]}
-  lights:
-    - {type: area, position: [0.5m, -1.0m, 0.95m], size: [50cm, 50cm], power: 80W}
-  ambient: 0lx
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/8, shutter: 1/125, iso: 200}
-shots:
-  - turntable: {steps: 1, step: 20deg, camera: {distance: 70cm, height: 15cm}}
-)");
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request = shot_request(scene, 0, 0.5);
-  request.shadow_map_size = 1368;  // as a 0.5-scale render has it
-  const dslr::LinearFrame frame = render_frame(scene, studio, request);
-  // Rows across the turntable top left of the box, where its penumbra falls: each step between
-  // horizontal neighbours inside the penumbra, over the row's lit level.
-  const int width = frame.width, height = frame.height;
+  const dslr::LinearFrame frame =
+      box_frame(area_light_front_right("50cm"), 0.5, 1368);  // a 0.5-scale render's map
+  // Each step between horizontal neighbours inside the penumbra, over the row's lit level.
   std::vector<double> steps;
-  for (int y = height * 7 / 10; y < height * 9 / 10; ++y) {
-    const std::size_t row = static_cast<std::size_t>(y) * width;
-    int box_left = 0;
-    while (box_left < width / 2 && frame.mask[row + box_left] == 0) ++box_left;
+  for_rows_left_of_box(frame, [&](std::size_t row, int box_left) {
     float lit = 0;
     for (int x = 0; x < box_left; ++x) lit = std::max(lit, frame.rgb[3 * (row + x) + 1]);
     for (int x = 0; x + 1 < box_left; ++x) {
@@ -603,7 +572,7 @@ shots:
         steps.push_back(std::abs(a - b) / lit);
       }
     }
-  }
+  });
   ASSERT_GT(steps.size(), 50000u);
   // A band's edge is a step of 1/16 of the light, less where the lighting is interpolated: over
   // 1.5 % for 1.0 % of the pairs with 16 taps, 0.25 % with 64. (The largest steps, in both, are
