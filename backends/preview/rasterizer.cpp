@@ -188,6 +188,9 @@ struct ShadowMap {
   float softness_texels_per_m = 0;  // area lights: penumbra growth
   float light_size_m = 0;
   std::vector<float> depth;  // light-space z, +inf where empty
+  // An area light's map: its shadows are soft (a cone rule, a blocker search, a penumbra filter),
+  // and only its map keeps the block maps below.
+  bool soft() const { return light_size_m > 0 && !orthographic; }
   // The nearest depth in each kBlock x kBlock block of texels (row-major, blocks_per_row a
   // row): a texel's lower bound, read from a map small enough to stay in cache.
   static constexpr int kBlock = 16;
@@ -333,7 +336,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   };
   // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
   // (A point light's cone is a line: its taps only smooth a hard edge.)
-  const bool area_light = light_size_m > 0 && !orthographic;
+  const bool area_light = soft();
   auto blocks8 = [&](const Float8& z, const TapGroup& taps, float radius) {
     const Int8 below = z < receiver_at(taps, radius);
     if (!area_light) return below;
@@ -494,7 +497,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   const float empty = -std::numeric_limits<float>::infinity();
   map.depth = dslr::take_floats(static_cast<size_t>(size) * size);  // every band fills its rows
   // The block maps serve the soft shadows' far taps only (see ShadowMap::visibility).
-  const bool soft = map.light_size_m > 0 && !map.orthographic;
+  const bool soft = map.soft();
   if (soft) {
     map.blocks_per_row = (size + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
     map.block_nearest.assign(static_cast<size_t>(map.blocks_per_row) * map.blocks_per_row, 0.0f);
