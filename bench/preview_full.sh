@@ -14,24 +14,27 @@ table=./build/bench/preview_table
 [[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "preview_full: RUNS must be a positive integer" >&2; exit 2; }
 
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
-printf '%-5s %9s %9s %12s %10s %8s %11s %9s %9s %9s\n' run "total s" "cpu s" raster+shade dof \
-  noise encode+write shadows distortion "peak MB"
+printf '%-5s %9s %9s %12s %10s %8s %11s %9s %9s %9s %13s %12s\n' run "total s" "cpu s" \
+  raster+shade dof noise encode+write shadows distortion "peak MB" "first shot ms" "others ms"
 totals=()
 for ((k = 1; k <= runs; ++k)); do
   out=$("$table" --full)
   # The full-resolution rows: totals, then milliseconds per shot by stage.
   read -r total cpu < <(grep '^full res' <<<"$out" | head -1 | awk '{print $6, $8}')
   header=$(grep '^ms per shot' <<<"$out" | head -1)
-  ms=$(grep '^full res' <<<"$out" | tail -1)
+  ms=$(grep '^full res' <<<"$out" | grep -v 'first shot' | tail -1)
   stage() {  # the value under stage $1 in the ms-per-shot rows
     awk -v name="$1" -v header="$header" -v row="$ms" 'BEGIN {
       n = split(header, h, " +"); m = split(row, r, " +");
       for (i = 1; i <= n; ++i) if (h[i] == name) { print r[m - (n - i)]; exit } }'
   }
   peak=$(grep '^peak memory' <<<"$out" | awk '{print $3}')
-  printf '%-5s %9s %9s %12s %10s %8s %11s %9s %9s %9s\n' "$k" "$total" "$cpu" \
+  # "full res, N tris first shot A ms, other shots median B ms"
+  read -r first others < <(grep '^full res.*first shot' <<<"$out" |
+    sed -E 's/.*first shot ([0-9]+) ms, other shots median ([0-9]+) ms/\1 \2/')
+  printf '%-5s %9s %9s %12s %10s %8s %11s %9s %9s %9s %13s %12s\n' "$k" "$total" "$cpu" \
     "$(stage raster+shade)" "$(stage dof)" "$(stage noise+develop)" "$(stage encode+write)" \
-    "$(stage shadows)" "$(stage distortion)" "$peak"
+    "$(stage shadows)" "$(stage distortion)" "$peak" "$first" "$others"
   totals+=("$total")
 done
 sorted=$(printf '%s\n' "${totals[@]}" | sort -g)
