@@ -575,10 +575,51 @@ TEST(Preview, SoftShadowPenumbraIsNotBanded) {
   });
   ASSERT_GT(steps.size(), 50000u);
   // A band's edge is a step of 1/16 of the light, less where the lighting is interpolated: over
-  // 1.5 % for 1.0 % of the pairs with 16 taps, 0.25 % with 64. (The largest steps, in both, are
-  // where the blocker search's 24-texel reach ends near the box's foot.)
+  // 1.5 % for 1.0 % of the pairs with 16 taps, 0.25 % with 64. (The largest steps, in both, were
+  // along the penumbra's outer edge near the box's foot: see the next test.)
   const auto banded = std::count_if(steps.begin(), steps.end(), [](double s) { return s > 0.015; });
   EXPECT_LT(static_cast<double>(banded) / steps.size(), 0.005) << banded << " of " << steps.size();
+}
+
+// A softbox's penumbra fades out smoothly at its outer edge, also near the box's foot, where the
+// blocker is the box's low edge, a few centimetres above the turntable top. Four far taps used to
+// declare such points lit without reading anything between them and the point, and the
+// penumbra's outer edge became a step from full light to half along a line on the top.
+TEST(Preview, SoftShadowFadesOutWithoutAStepNearTheFoot) {
+  const dslr::LinearFrame frame =
+      box_frame(area_light_front_right("50cm"), 0.5, 1368);  // a 0.5-scale render's map
+  float lit = 0;                                             // the top's lit level
+  for_rows_left_of_box(frame, [&](std::size_t row, int box_left) {
+    for (int x = 0; x < box_left; ++x) lit = std::max(lit, frame.rgb[3 * (row + x) + 1]);
+  });
+  ASSERT_GT(lit, 0);
+  // The largest step between neighbours on the top (across a column or a row), over the lit
+  // level, where one of the two lies in the penumbra: in the half of the top next to the box
+  // (the other half reaches the turntable's rim), clear of the contact, where the penumbra is
+  // narrow and steep (3 % of the width left of the box).
+  const int clearance = frame.width * 3 / 100;
+  double largest = 0;
+  int at_x = -1, at_y = -1, pairs = 0;
+  for_rows_left_of_box(frame, [&](std::size_t row, int box_left) {
+    for (int x = box_left / 2; x + clearance < box_left; ++x) {
+      const std::size_t here = row + x;
+      for (const std::size_t next : {here + 1, here + frame.width}) {
+        const float a = frame.rgb[3 * here + 1], b = frame.rgb[3 * next + 1];
+        const float za = frame.depth_m[here], zb = frame.depth_m[next];
+        if (!(std::abs(za - zb) < 0.01f * za)) continue;  // both on the top
+        if (std::min(a, b) > 0.95f * lit || std::max(a, b) < 0.05f * lit) continue;
+        ++pairs;
+        if (std::abs(a - b) / lit > largest) {
+          largest = std::abs(a - b) / lit;
+          at_x = x;
+          at_y = static_cast<int>(row / frame.width);
+        }
+      }
+    }
+  });
+  ASSERT_GT(pairs, 50000);
+  // 0.086 with the four taps (a line along the penumbra's outer edge), 0.041 now.
+  EXPECT_LT(largest, 0.06) << "at (" << at_x << ", " << at_y << ")";
 }
 
 // Every pixel is written, also in the odd last column and row of a canvas (quads and blocks
