@@ -11,6 +11,8 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <span>
+#include <type_traits>
 #include <utility>
 
 #include "dslr/buffer_pool.h"
@@ -197,6 +199,23 @@ struct ShadowMap {
   static constexpr int kBlock = 16;
   int blocks_per_row = 0;
   std::vector<float> reach_nearest;
+  // Coarser maps for penumbrae wider than the taps' reach of 24 texels (a softbox's shadow cast
+  // from far above the receiver spans hundreds): level k (coarse[k - 1]) holds, per texel, the
+  // nearest depth of the 2^k x 2^k texels of `depth` under it, and its own reach map over blocks
+  // of kBlock of its texels. A tap at level k reads the texel of `depth` it falls on, shifted
+  // right by k; the search and the filter run at the level where their radius spans 24 texels.
+  struct Level {
+    int size = 0;
+    std::vector<float> depth;
+    // The fraction of those texels that hold a caster: a penumbra filter weighs a coarse texel's
+    // block by it, or a blocker would grow by up to a coarse texel all round (a ball hiding a
+    // sixth of a softbox hid a quarter).
+    std::vector<float> coverage;
+    int blocks_per_row = 0;
+    std::vector<float> reach_nearest;
+  };
+  std::vector<Level> coarse;
+  float nearest_depth = std::numeric_limits<float>::infinity();  // over the whole map
 
   // Fraction of light reaching a world point with geometric normal `normal`, which faces the
   // light at cos_theta.
@@ -229,7 +248,10 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     v = local.y() / local.z() * focal + size / 2.0f;
     texel = texel_m_per_z * local.z();
   }
-  if (u < 0 || v < 0 || u >= size || v >= size) return 1;
+  // Outside the map nothing casts a hard shadow; an area light's penumbra reaches further (the
+  // map covers the casters, a wide penumbra the receivers around them too).
+  const bool outside = u < 0 || v < 0 || u >= size || v >= size;
+  if (outside && !soft()) return 1;
   const float tan_theta =
       std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)) / std::max(cos_theta, 0.15f);
   const float bias = texel * (1.5f + 2.0f * tan_theta) + 0.002f;
@@ -257,19 +279,16 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       slope_v = -m.y() / along;
     }
   }
-  // Taps reach at most 24 texels from (u, v): away from the map's border they need no clamping.
+  // Taps reach at most kReach texels of their level from (u, v): away from the map's border a
+  // level-0 disc needs no clamping.
+  constexpr float kReach = 24;
   const bool interior = u >= 25 && v >= 25 && u < size - 25 && v < size - 25;
-  // The texel (column, row) a tap at (su, sv) reads.
-  auto texel_of = [&](float su, float sv) {
+  auto lookup = [&](float su, float sv) {
     int iu = static_cast<int>(su), iv = static_cast<int>(sv);
     if (!interior) {
       iu = std::clamp(iu, 0, size - 1);
       iv = std::clamp(iv, 0, size - 1);
     }
-    return std::pair{iu, iv};
-  };
-  auto lookup = [&](float su, float sv) {
-    const auto [iu, iv] = texel_of(su, sv);
     return depth[static_cast<size_t>(iv) * size + iu];
   };
   // Fixed tap discs, in disc radii: deterministic, so the same scene gives the same pixels. Taps
@@ -289,32 +308,58 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       {{0.44f, 0.54f, -0.26f, -0.10f, 0.79f, -0.62f, 0.20f, -0.50f},
        {-0.98f, 0.89f, -0.60f, 0.89f, 0.19f, 0.99f, -0.35f, -0.12f},
        {1.0742f, 1.0410f, 0.6539f, 0.8956f, 0.8125f, 1.1681f, 0.4031f, 0.5142f}}};
-  static const std::array<TapGroup, 8> filter_taps = [] {
-    // A Vogel spiral: tap k at radius √((k + ½) / 64), turned by the golden angle, fills the disc
-    // evenly with no two taps on one line through it.
-    std::array<TapGroup, 8> groups{};
-    for (int k = 0; k < 64; ++k) {
-      const float r = std::sqrt((k + 0.5f) / 64), angle = k * 2.39996323f;
+  // A Vogel spiral of 8 x Groups taps: tap k at radius √((k + ½) / n), turned by the golden
+  // angle, fills the disc evenly with no two taps on one line through it.
+  auto spiral = []<std::size_t Groups>(std::integral_constant<std::size_t, Groups>) {
+    constexpr int n = 8 * Groups;
+    std::array<TapGroup, Groups> groups{};
+    for (int k = 0; k < n; ++k) {
+      const float r = std::sqrt((k + 0.5f) / n), angle = k * 2.39996323f;
       groups[k / 8].u[k % 8] = r * std::cos(angle);
       groups[k / 8].v[k % 8] = r * std::sin(angle);
       groups[k / 8].distance[k % 8] = r;
     }
     return groups;
-  }();
-  // Depths at a group's eight taps scaled by `radius` around (u, v).
-  auto disc8 = [&](const TapGroup& taps, float radius) {
+  };
+  static const std::array<TapGroup, 8> filter_taps =
+      spiral(std::integral_constant<std::size_t, 8>{});
+  // The search beyond the map's own texels: its disc is wider than the filters it leads to, and
+  // 16 taps missed a blocker that filled a sixth of it (the penumbra's outer part then ended in
+  // a step from a tenth of the light hidden to none).
+  static const std::array<TapGroup, 4> wide_search_taps =
+      spiral(std::integral_constant<std::size_t, 4>{});
+  // Depths at a group's eight taps scaled by `radius` (texels of level 0) around (u, v), read
+  // at `level`.
+  auto disc8 = [&](const TapGroup& taps, float radius, int level, bool coverage = false) {
     const Float8 su = u + taps.u * radius, sv = v + taps.v * radius;
     Int8 iu = __builtin_convertvector(su, Int8), iv = __builtin_convertvector(sv, Int8);
-    if (!interior) {
-      const Int8 zero = {}, last = zero + (size - 1);
-      iu = iu < zero ? zero : (iu > last ? last : iu);
-      iv = iv < zero ? zero : (iv > last ? last : iv);
+    if (level == 0 && interior) return simd::gather(depth.data(), iv * size + iu);
+    // Off the map there is nothing: the map's frustum holds every caster with a margin, so its
+    // edge texels are empty too, except where a caster leaves the frustum (the turntable's
+    // stand), which the taps would otherwise repeat outwards in streaks.
+    const Int8 zero = {}, last = zero + (size - 1);
+    const Int8 off_map = (iu < zero) | (iu > last) | (iv < zero) | (iv > last);
+    iu = iu < zero ? zero : (iu > last ? last : iu);
+    iv = iv < zero ? zero : (iv > last ? last : iv);
+    if (level == 0) {
+      const Float8 z = simd::gather(depth.data(), iv * size + iu);
+      return off_map ? Float8{} + std::numeric_limits<float>::infinity() : z;
     }
-    return simd::gather(depth.data(), iv * size + iu);
+    // A coarser level: its depths, or (`coverage`) how much of each texel holds a caster.
+    const Level& coarser = coarse[level - 1];
+    const Int8 at = (iv >> level) * coarser.size + (iu >> level);
+    if (coverage) return off_map ? Float8{} : simd::gather(coarser.coverage.data(), at);
+    const Float8 z = simd::gather(coarser.depth.data(), at);
+    return off_map ? Float8{} + std::numeric_limits<float>::infinity() : z;
   };
-  // The receiver's depth less the bias under a group's eight taps.
-  auto receiver_at = [&](const TapGroup& taps, float radius) {
-    return receiver + (taps.u * slope_u + taps.v * slope_v) * radius;
+  // The receiver's depth less the bias under a group's eight taps. A texel of level k holds the
+  // nearest of 2^k x 2^k: on the receiver's own plane up to 2^k texels' slope nearer, so the
+  // bias grows with it.
+  auto receiver_at = [&](const TapGroup& taps, float radius, int level) {
+    const float coarser_bias =
+        static_cast<float>((1 << level) - 1) *
+        (texel * (1.5f + 2.0f * tan_theta) + std::abs(slope_u) + std::abs(slope_v));
+    return receiver - coarser_bias + (taps.u * slope_u + taps.v * slope_v) * radius;
   };
   // A texel d texels from the point, at depth z, can hide part of an area light only from
   // inside the cone from the point to the light: d <= C (1/z - 1/z_r), C the light's
@@ -324,63 +369,138 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   // of the point can it hide the light. Where the cone is narrower than the smallest filter (a
   // small light, or a blocker just above the surface at a contact), that filter's taps must all
   // count: it smooths the map's texel stairs, and with a 1-texel margin its outer taps came out
-  // lit, opening a lit gap between a box's foot and its shadow.
+  // lit, opening a lit gap between a box's foot and its shadow. A coarser level's texel may
+  // hold a depth from anywhere in its 2^k texels: the margin grows alike.
   constexpr float kSmallestFilter = 1.5f;  // texels
   const float z_r = local.z();
   const float cone = focal * light_size_m * 0.70710678f;
   // For one tap (float) or eight (Float8), with the same operations.
-  auto can_hide = [&](auto z, auto d) {
-    return (d - kSmallestFilter) * z * z_r <= cone * (z_r - z);
+  auto can_hide = [&](auto z, auto d, float margin) {
+    return (d - margin) * z * z_r <= cone * (z_r - z);
   };
   // Eight taps at once: z below the receiver's plane and, for an area light, inside the cone.
   // (A point light's cone is a line: its taps only smooth a hard edge.)
   const bool area_light = soft();
-  auto blocks8 = [&](const Float8& z, const TapGroup& taps, float radius) {
-    const Int8 below = z < receiver_at(taps, radius);
+  auto blocks8 = [&](const Float8& z, const TapGroup& taps, float radius, int level) {
+    const Int8 below = z < receiver_at(taps, radius, level);
     if (!area_light) return below;
-    return below & can_hide(z, taps.distance * radius);
+    return below & can_hide(z, taps.distance * radius, kSmallestFilter * (1 << level));
   };
   if (area_light) {
     // Percentage-closer soft shadows: the penumbra grows with the receiver-blocker distance.
-    const float search =
-        std::clamp(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f, 2.0f, 24.0f);
-    // Most points are plainly lit, and one test settles them: the centre tap is lit, and
-    // nothing within the taps' reach (the 5 x 5 blocks around the point's) is near enough the
-    // light to hide any of it from the search radius's distance (can_hide solved for z, with a
-    // margin for rounding). Every other point goes to the search, which samples the whole disc.
-    // Four far taps at the search area's corners (from a threshold at their own distance, √2
-    // times the radius) used to settle many more, but they missed blockers between them and the
-    // centre: at a box's low edge near its contact with the turntable the penumbra's outer edge
-    // came out as a step from full light to half, and in a paper frame 17 k of the 30 k points
-    // they settled were in a penumbra. Only blockers lower still, inside the radius and missed
-    // by the centre tap, are left lit.
-    const float hiding_depth = z_r * cone / (cone + (search - kSmallestFilter) * z_r) * (1 + 1e-5f);
-    const int reach_block =
-        (static_cast<int>(v) / kBlock) * blocks_per_row + static_cast<int>(u) / kBlock;
-    if (lookup(u, v) >= receiver && reach_nearest[reach_block] > hiding_depth) return 1;
-    int blockers = 0;
-    Float8 blocker_sum = {};
-    for (const TapGroup& taps : kSearchTaps) {
-      const Float8 z = disc8(taps, search);
-      const Int8 blocks = blocks8(z, taps, search);
-      blockers += simd::count(blocks);
-      blocker_sum += blocks ? z : Float8{};
+    // The search covers where a blocker could hide part of the light; it starts in the map's
+    // own texels, within kReach of the point, and goes on at the level where the rest fits.
+    const int most_coarse = static_cast<int>(coarse.size());
+    const float widest = kReach * static_cast<float>(1 << most_coarse);
+    // No farther than the map's nearest caster could hide any of the light from (can_hide
+    // solved for d): on the object itself that is a few centimetres, on the backdrop behind it
+    // tens.
+    const float cone_of_nearest =
+        nearest_depth < z_r ? cone * (z_r - nearest_depth) / (nearest_depth * z_r) : 0.0f;
+    const float full_search =
+        std::clamp(std::min(light_size_m / std::max(local.z(), 0.05f) * focal * 0.5f,
+                            cone_of_nearest + kSmallestFilter),
+                   2.0f, widest);
+    const float search = std::min(full_search, kReach);
+    // The level at which `radius` (texels of level 0) spans kReach texels or less.
+    auto level_for = [&](float radius) {
+      int level = 0;
+      while (level < most_coarse && radius > kReach * static_cast<float>(1 << level)) ++level;
+      return level;
+    };
+    // The filter over a disc of `radius`, once the search has found blockers.
+    auto filter = [&](float radius) {
+      const int level = level_for(radius);
+      if (level == 0) {
+        int lit = 0;
+        for (const TapGroup& taps : filter_taps) {
+          lit += 8 - simd::count(blocks8(disc8(taps, radius, 0), taps, radius, 0));
+        }
+        return static_cast<float>(lit) / 64;
+      }
+      Float8 hidden = {};
+      for (const TapGroup& taps : filter_taps) {
+        const Float8 coverage = disc8(taps, radius, level, true);
+        hidden += blocks8(disc8(taps, radius, level), taps, radius, level) ? coverage : Float8{};
+      }
+      return 1 - simd::sum(hidden) / 64;
+    };
+    // Blockers among `taps` over `radius` at `level`: their count and mean depth.
+    auto search_blockers = [&](std::span<const TapGroup> tap_groups, float radius, int level,
+                               float& mean_depth) {
+      int blockers = 0;
+      Float8 blocker_sum = {};
+      for (const TapGroup& taps : tap_groups) {
+        const Float8 z = disc8(taps, radius, level);
+        const Int8 blocks = blocks8(z, taps, radius, level);
+        blockers += simd::count(blocks);
+        blocker_sum += blocks ? z : Float8{};
+      }
+      mean_depth = blockers > 0 ? simd::sum(blocker_sum) / static_cast<float>(blockers) : 0;
+      return blockers;
+    };
+    // The filter's radius: the light seen from the receiver through the blockers' depth, as a
+    // disc of the light's area (a square of side L: radius L / √π), so that a blocker wholly
+    // inside hides the fraction of the light that it hides from the receiver.
+    auto penumbra_texels = [&](float blocker) {
+      constexpr float kDiscOfSquare = 0.56418958f;  // 1 / √π
+      const float penumbra_m =
+          kDiscOfSquare * light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
+      return std::clamp(penumbra_m / texel, kSmallestFilter, widest);
+    };
+    // Whether nothing a reach map holds can hide the light from `distance` texels away, or
+    // more: `nearest` is beyond the depth that can_hide allows there (solved for z; a margin
+    // for rounding).
+    auto clear_from = [&](float nearest, float distance) {
+      return nearest * (cone + (distance - kSmallestFilter) * z_r) > z_r * cone * (1 + 1e-5f);
+    };
+    // Most points are plainly lit, and one test settles the map's own texels: the centre tap
+    // is lit, and nothing within the taps' reach (the 5 x 5 blocks around the point's) is near
+    // enough the light to hide any of it from the search radius's distance. Only blockers lower
+    // still, inside the radius and missed by the centre tap, are left lit. (Four far taps at the
+    // search area's corners used to settle many more, but they missed blockers between them and
+    // the centre: near a box's foot the penumbra's outer edge came out as a step.) A point
+    // outside the map is judged at the nearest texel inside: nothing in the map is nearer the
+    // point than that texel is (a square is convex), and all of it is `outside_by` away or more.
+    const float outside_by = std::max(
+        {-u, -v, u - static_cast<float>(size - 1), v - static_cast<float>(size - 1), 0.0f});
+    if (outside_by > full_search) return 1;
+    const int inside_u = std::clamp(static_cast<int>(u), 0, size - 1);
+    const int inside_v = std::clamp(static_cast<int>(v), 0, size - 1);
+    const int reach_block = (inside_v / kBlock) * blocks_per_row + inside_u / kBlock;
+    const bool near_clear = lookup(u, v) >= receiver &&
+                            clear_from(reach_nearest[reach_block], std::max(search, outside_by));
+    if (!near_clear) {
+      float blocker = 0;
+      const int blockers = search_blockers(kSearchTaps, search, 0, blocker);
+      if (blockers > 0) {
+        const float radius = penumbra_texels(blocker);
+        // The whole search area blocks, and the penumbra is no wider: umbra.
+        if (blockers == 16 && radius <= kReach) return 0;
+        return filter(radius);
+      }
     }
-    if (blockers == 0) return 1;
-    if (blockers == 16) return 0;  // the whole search area blocks: umbra
-    const float blocker = simd::sum(blocker_sum) / static_cast<float>(blockers);
-    const float penumbra_m = light_size_m * (receiver - blocker) / std::max(blocker, 0.01f);
-    const float radius = std::clamp(penumbra_m / texel, kSmallestFilter, 24.0f);
-    int lit = 0;
-    for (const TapGroup& taps : filter_taps) {
-      lit += 8 - simd::count(blocks8(disc8(taps, radius), taps, radius));
+    // Farther out: level k's reach map covers the 5 x 5 of its blocks (16 texels of level k)
+    // around the point's, and anything outside level k - 1's lies 2 of its blocks away or more.
+    const int search_level = level_for(full_search);
+    bool far_clear = true;
+    for (int level = 1; level <= search_level && far_clear; ++level) {
+      const Level& coarser = coarse[level - 1];
+      const int block =
+          (inside_v >> (4 + level)) * coarser.blocks_per_row + (inside_u >> (4 + level));
+      far_clear = clear_from(coarser.reach_nearest[block],
+                             std::max(static_cast<float>(16 << level), outside_by));
     }
-    return static_cast<float>(lit) / 64;
+    static_assert(kBlock == 16);
+    if (far_clear) return 1;
+    float blocker = 0;
+    if (search_blockers(wide_search_taps, full_search, search_level, blocker) == 0) return 1;
+    return filter(penumbra_texels(blocker));
   }
   // Other lights: a hard edge, smoothed over the smallest filter.
   int lit = 0;
   for (const TapGroup& taps : kSearchTaps) {
-    lit += 8 - simd::count(blocks8(disc8(taps, kSmallestFilter), taps, kSmallestFilter));
+    lit += 8 - simd::count(blocks8(disc8(taps, kSmallestFilter, 0), taps, kSmallestFilter, 0));
   }
   return static_cast<float>(lit) / 16;
 }
@@ -555,8 +675,7 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   });
   if (!soft) return;
   // Two passes of 5 (along rows, then along columns), clamped at the map's edges.
-  const int blocks = map.blocks_per_row;
-  auto nearest_of_five = [blocks](const std::vector<float>& from, bool along_rows) {
+  auto nearest_of_five = [](const std::vector<float>& from, int blocks, bool along_rows) {
     std::vector<float> to(from.size());
     for (int by = 0; by < blocks; ++by) {
       for (int bx = 0; bx < blocks; ++bx) {
@@ -571,7 +690,73 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     }
     return to;
   };
-  map.reach_nearest = nearest_of_five(nearest_of_five(block_nearest, true), false);
+  auto reach_of = [&](const std::vector<float>& nearest, int blocks) {
+    return nearest_of_five(nearest_of_five(nearest, blocks, true), blocks, false);
+  };
+  map.reach_nearest = reach_of(block_nearest, map.blocks_per_row);
+  for (const float nearest : block_nearest)
+    map.nearest_depth = std::min(map.nearest_depth, nearest);
+
+  // The coarser levels, down to 16 texels a side or 2^6 texels of `depth` a texel (taps reaching
+  // 24 x 64 = 1536 texels, as far as the map is wide). Each texel and block is the nearest of
+  // the 2 x 2 under it (an odd last row or column alone).
+  constexpr int kMostCoarseLevels = 6;
+  const float* finer = map.depth.data();
+  int finer_size = size;
+  int finer_blocks = map.blocks_per_row;
+  while (static_cast<int>(map.coarse.size()) < kMostCoarseLevels && finer_size / 2 >= 16) {
+    ShadowMap::Level& level = map.coarse.emplace_back();
+    level.size = (finer_size + 1) / 2;
+    level.depth = dslr::take_floats(static_cast<size_t>(level.size) * level.size);
+    const int n = level.size;
+    level.coverage = dslr::take_floats(static_cast<size_t>(n) * n);
+    const float* finer_coverage =
+        map.coarse.size() > 1 ? map.coarse[map.coarse.size() - 2].coverage.data() : nullptr;
+    tbb::parallel_for(tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& rows) {
+      // Rows 2y and 2y + 1 merged, then pairs of columns.
+      std::vector<float> pair_depth(static_cast<size_t>(2 * n)), pair_coverage(2 * n);
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        const size_t top = static_cast<size_t>(2 * y) * finer_size;
+        const size_t bottom = static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
+        for (int x = 0; x < finer_size; ++x) {
+          pair_depth[x] = std::min(finer[top + x], finer[bottom + x]);
+          // Level 0 holds a caster where its depth is finite.
+          pair_coverage[x] = finer_coverage
+                                 ? finer_coverage[top + x] + finer_coverage[bottom + x]
+                                 : static_cast<float>(std::isfinite(finer[top + x])) +
+                                       static_cast<float>(std::isfinite(finer[bottom + x]));
+        }
+        if (finer_size % 2 != 0) {
+          pair_depth[finer_size] = pair_depth[finer_size - 1];
+          pair_coverage[finer_size] = pair_coverage[finer_size - 1];
+        }
+        float* out = level.depth.data() + static_cast<size_t>(y) * n;
+        float* covered = level.coverage.data() + static_cast<size_t>(y) * n;
+        for (int x = 0; x < n; ++x) {
+          out[x] = std::min(pair_depth[2 * x], pair_depth[2 * x + 1]);
+          covered[x] = 0.25f * (pair_coverage[2 * x] + pair_coverage[2 * x + 1]);
+        }
+      }
+    });
+    level.blocks_per_row = (n + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
+    std::vector<float> nearest(static_cast<size_t>(level.blocks_per_row) * level.blocks_per_row);
+    for (int by = 0; by < level.blocks_per_row; ++by) {
+      for (int bx = 0; bx < level.blocks_per_row; ++bx) {
+        float m = std::numeric_limits<float>::infinity();
+        for (int fy = 2 * by; fy <= std::min(2 * by + 1, finer_blocks - 1); ++fy) {
+          for (int fx = 2 * bx; fx <= std::min(2 * bx + 1, finer_blocks - 1); ++fx) {
+            m = std::min(m, block_nearest[static_cast<size_t>(fy) * finer_blocks + fx]);
+          }
+        }
+        nearest[static_cast<size_t>(by) * level.blocks_per_row + bx] = m;
+      }
+    }
+    level.reach_nearest = reach_of(nearest, level.blocks_per_row);
+    block_nearest = std::move(nearest);
+    finer = level.depth.data();
+    finer_size = n;
+    finer_blocks = level.blocks_per_row;
+  }
 }
 
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
@@ -1146,7 +1331,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   struct RecycleMaps {
     std::vector<ShadowMap>& maps;
     ~RecycleMaps() {
-      for (ShadowMap& map : maps) dslr::recycle(std::move(map.depth));
+      for (ShadowMap& map : maps) {
+        dslr::recycle(std::move(map.depth));
+        for (ShadowMap::Level& level : map.coarse) {
+          dslr::recycle(std::move(level.depth));
+          dslr::recycle(std::move(level.coverage));
+        }
+      }
     }
   } recycle_maps{shadow_maps};
   tbb::parallel_for(std::size_t{0}, shadow_maps.size(), [&](std::size_t l) {
