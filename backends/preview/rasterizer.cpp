@@ -216,6 +216,15 @@ struct ShadowMap {
   };
   std::vector<Level> coarse;
   float nearest_depth = std::numeric_limits<float>::infinity();  // over the whole map
+  // The beyond-the-map's-texels part of the lit test, worked out per block: entry
+  // kLevelSlots * block + J is the receiver depth below which the reach maps of levels 1 to J
+  // around `block` (of level 0) hold nothing that can hide the light (see visibility).
+  static constexpr int kLevelSlots = 8;
+  std::vector<float> clear_below;
+  // The smallest penumbra filter's radius, in texels; a margin of the cone rule (see visibility).
+  static constexpr float kSmallestFilter = 1.5f;
+  // An area light's half-diagonal over a texel's angle: the cone rule's constant.
+  float cone() const { return focal * light_size_m * 0.70710678f; }
 
   // Fraction of light reaching a world point with geometric normal `normal`, which faces the
   // light at cos_theta.
@@ -371,9 +380,8 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   // count: it smooths the map's texel stairs, and with a 1-texel margin its outer taps came out
   // lit, opening a lit gap between a box's foot and its shadow. A coarser level's texel may
   // hold a depth from anywhere in its 2^k texels: the margin grows alike.
-  constexpr float kSmallestFilter = 1.5f;  // texels
   const float z_r = local.z();
-  const float cone = focal * light_size_m * 0.70710678f;
+  const float cone = this->cone();
   // For one tap (float) or eight (Float8), with the same operations.
   auto can_hide = [&](auto z, auto d, float margin) {
     return (d - margin) * z * z_r <= cone * (z_r - z);
@@ -483,8 +491,9 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     // Farther out: level k's reach map covers the 5 x 5 of its blocks (16 texels of level k)
     // around the point's, and anything outside level k - 1's lies 2 of its blocks away or more.
     const int search_level = level_for(full_search);
-    bool far_clear = true;
-    for (int level = 1; level <= search_level && far_clear; ++level) {
+    // Inside the map, the per-block bound holds these tests already made.
+    bool far_clear = outside ? true : z_r < clear_below[reach_block * kLevelSlots + search_level];
+    for (int level = 1; outside && level <= search_level && far_clear; ++level) {
       const Level& coarser = coarse[level - 1];
       const int block =
           (inside_v >> (4 + level)) * coarser.blocks_per_row + (inside_u >> (4 + level));
@@ -611,6 +620,18 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     map.blocks_per_row = (size + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
     block_nearest.assign(static_cast<size_t>(map.blocks_per_row) * map.blocks_per_row, 0.0f);
   }
+  // The first coarser level (see below) is made in the bands, while their rows are in cache.
+  constexpr int kMostCoarseLevels = 6;
+  auto wants_level = [&](int finer_size) {
+    return static_cast<int>(map.coarse.size()) < kMostCoarseLevels && finer_size / 2 >= 16;
+  };
+  map.coarse.reserve(kMostCoarseLevels);
+  if (soft && wants_level(size)) {
+    ShadowMap::Level& first = map.coarse.emplace_back();
+    first.size = size / 2;  // a whole number of groups of eight texels
+    first.depth = dslr::take_floats(static_cast<size_t>(first.size) * first.size);
+    first.coverage = dslr::take_floats(static_cast<size_t>(first.size) * first.size);
+  }
   tbb::parallel_for(0, bands, [&](int band) {
     const int row0 = band * kBandRows, row1 = std::min(size, row0 + kBandRows);
     float* key_rows = map.depth.data() + static_cast<size_t>(row0) * size;
@@ -653,6 +674,42 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     static_assert(kBandRows % ShadowMap::kBlock == 0 && ShadowMap::kBlock % 8 == 0);
     if (!soft) return;
     const float* depth = map.depth.data();
+    if (!map.coarse.empty()) {
+      // Level 1 for the band's row pairs: eight texels from sixteen, the nearest of each 2 x 2
+      // and how many of the four hold a caster.
+      ShadowMap::Level& first = map.coarse.front();
+      const Float8 one = Float8{} + 1.0f, none = {};
+      constexpr Int8 kEven = {0, 2, 4, 6, 8, 10, 12, 14}, kOdd = {1, 3, 5, 7, 9, 11, 13, 15};
+      for (int y = row0; y < row1; y += 2) {
+        const float* top = depth + static_cast<size_t>(y) * size;
+        const float* bottom = top + size;
+        float* out = first.depth.data() + static_cast<size_t>(y / 2) * first.size;
+        float* covered = first.coverage.data() + static_cast<size_t>(y / 2) * first.size;
+        int x = 0;
+        for (; x + 16 <= size; x += 16) {
+          const Float8 top0 = simd::load8(top + x), top1 = simd::load8(top + x + 8);
+          const Float8 bottom0 = simd::load8(bottom + x), bottom1 = simd::load8(bottom + x + 8);
+          const Float8 near0 = top0 < bottom0 ? top0 : bottom0;
+          const Float8 near1 = top1 < bottom1 ? top1 : bottom1;
+          const Float8 held0 = (top0 < inf ? one : none) + (bottom0 < inf ? one : none);
+          const Float8 held1 = (top1 < inf ? one : none) + (bottom1 < inf ? one : none);
+          const Float8 even = __builtin_shuffle(near0, near1, kEven);
+          const Float8 odd = __builtin_shuffle(near0, near1, kOdd);
+          const Float8 nearest = even < odd ? even : odd;
+          const Float8 held =
+              (__builtin_shuffle(held0, held1, kEven) + __builtin_shuffle(held0, held1, kOdd)) *
+              0.25f;
+          std::memcpy(out + x / 2, &nearest, sizeof(nearest));
+          std::memcpy(covered + x / 2, &held, sizeof(held));
+        }
+        for (; x < size; x += 2) {  // a last group of eight
+          out[x / 2] = std::min({top[x], top[x + 1], bottom[x], bottom[x + 1]});
+          covered[x / 2] =
+              0.25f * static_cast<float>(std::isfinite(top[x]) + std::isfinite(top[x + 1]) +
+                                         std::isfinite(bottom[x]) + std::isfinite(bottom[x + 1]));
+        }
+      }
+    }
     for (int block_row0 = row0; block_row0 < row1; block_row0 += ShadowMap::kBlock) {
       const int block_row1 = std::min(row1, block_row0 + ShadowMap::kBlock);
       float* nearest =
@@ -700,44 +757,48 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   // The coarser levels, down to 16 texels a side or 2^6 texels of `depth` a texel (taps reaching
   // 24 x 64 = 1536 texels, as far as the map is wide). Each texel and block is the nearest of
   // the 2 x 2 under it (an odd last row or column alone).
-  constexpr int kMostCoarseLevels = 6;
   const float* finer = map.depth.data();
   int finer_size = size;
   int finer_blocks = map.blocks_per_row;
-  while (static_cast<int>(map.coarse.size()) < kMostCoarseLevels && finer_size / 2 >= 16) {
-    ShadowMap::Level& level = map.coarse.emplace_back();
-    level.size = (finer_size + 1) / 2;
-    level.depth = dslr::take_floats(static_cast<size_t>(level.size) * level.size);
-    const int n = level.size;
-    level.coverage = dslr::take_floats(static_cast<size_t>(n) * n);
-    const float* finer_coverage =
-        map.coarse.size() > 1 ? map.coarse[map.coarse.size() - 2].coverage.data() : nullptr;
-    tbb::parallel_for(tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& rows) {
-      // Rows 2y and 2y + 1 merged, then pairs of columns.
-      std::vector<float> pair_depth(static_cast<size_t>(2 * n)), pair_coverage(2 * n);
-      for (int y = rows.begin(); y < rows.end(); ++y) {
-        const size_t top = static_cast<size_t>(2 * y) * finer_size;
-        const size_t bottom = static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
-        for (int x = 0; x < finer_size; ++x) {
-          pair_depth[x] = std::min(finer[top + x], finer[bottom + x]);
-          // Level 0 holds a caster where its depth is finite.
-          pair_coverage[x] = finer_coverage
-                                 ? finer_coverage[top + x] + finer_coverage[bottom + x]
-                                 : static_cast<float>(std::isfinite(finer[top + x])) +
-                                       static_cast<float>(std::isfinite(finer[bottom + x]));
-        }
-        if (finer_size % 2 != 0) {
-          pair_depth[finer_size] = pair_depth[finer_size - 1];
-          pair_coverage[finer_size] = pair_coverage[finer_size - 1];
-        }
-        float* out = level.depth.data() + static_cast<size_t>(y) * n;
-        float* covered = level.coverage.data() + static_cast<size_t>(y) * n;
-        for (int x = 0; x < n; ++x) {
-          out[x] = std::min(pair_depth[2 * x], pair_depth[2 * x + 1]);
-          covered[x] = 0.25f * (pair_coverage[2 * x] + pair_coverage[2 * x + 1]);
-        }
-      }
-    });
+  for (std::size_t k = 0; k < map.coarse.size() || wants_level(finer_size); ++k) {
+    const bool made = k < map.coarse.size();  // level 1, in the bands
+    ShadowMap::Level& level = made ? map.coarse[k] : map.coarse.emplace_back();
+    const int n = made ? level.size : (finer_size + 1) / 2;
+    const float* finer_coverage = k > 0 ? map.coarse[k - 1].coverage.data() : nullptr;
+    if (!made) {
+      level.size = n;
+      level.depth = dslr::take_floats(static_cast<size_t>(n) * n);
+      level.coverage = dslr::take_floats(static_cast<size_t>(n) * n);
+    }
+    if (!made)
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& rows) {
+            // Rows 2y and 2y + 1 merged, then pairs of columns.
+            std::vector<float> pair_depth(static_cast<size_t>(2 * n)), pair_coverage(2 * n);
+            for (int y = rows.begin(); y < rows.end(); ++y) {
+              const size_t top = static_cast<size_t>(2 * y) * finer_size;
+              const size_t bottom =
+                  static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
+              for (int x = 0; x < finer_size; ++x) {
+                pair_depth[x] = std::min(finer[top + x], finer[bottom + x]);
+                // Level 0 holds a caster where its depth is finite.
+                pair_coverage[x] = finer_coverage
+                                       ? finer_coverage[top + x] + finer_coverage[bottom + x]
+                                       : static_cast<float>(std::isfinite(finer[top + x])) +
+                                             static_cast<float>(std::isfinite(finer[bottom + x]));
+              }
+              if (finer_size % 2 != 0) {
+                pair_depth[finer_size] = pair_depth[finer_size - 1];
+                pair_coverage[finer_size] = pair_coverage[finer_size - 1];
+              }
+              float* out = level.depth.data() + static_cast<size_t>(y) * n;
+              float* covered = level.coverage.data() + static_cast<size_t>(y) * n;
+              for (int x = 0; x < n; ++x) {
+                out[x] = std::min(pair_depth[2 * x], pair_depth[2 * x + 1]);
+                covered[x] = 0.25f * (pair_coverage[2 * x] + pair_coverage[2 * x + 1]);
+              }
+            }
+          });
     level.blocks_per_row = (n + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
     std::vector<float> nearest(static_cast<size_t>(level.blocks_per_row) * level.blocks_per_row);
     for (int by = 0; by < level.blocks_per_row; ++by) {
@@ -757,6 +818,29 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     finer_size = n;
     finer_blocks = level.blocks_per_row;
   }
+  // The far lit test's bounds: ShadowMap::visibility's clear_from at each level (distance 16
+  // texels of level 1 at level 1, and so on) solved for the receiver's depth, the least so far.
+  static_assert(kMostCoarseLevels < ShadowMap::kLevelSlots);
+  const int blocks = map.blocks_per_row;
+  const float cone = map.cone(), widened = cone * (1 + 1e-5f);
+  map.clear_below.assign(static_cast<size_t>(blocks) * blocks * ShadowMap::kLevelSlots,
+                         std::numeric_limits<float>::infinity());
+  tbb::parallel_for(0, blocks, [&](int by) {
+    for (int bx = 0; bx < blocks; ++bx) {
+      float* bounds =
+          &map.clear_below[(static_cast<size_t>(by) * blocks + bx) * ShadowMap::kLevelSlots];
+      for (int k = 1; k <= static_cast<int>(map.coarse.size()); ++k) {
+        const ShadowMap::Level& level = map.coarse[k - 1];
+        const float nearest =
+            level.reach_nearest[static_cast<size_t>(by >> k) * level.blocks_per_row + (bx >> k)];
+        const float distance = static_cast<float>(16 << k);
+        const float excess = widened - nearest * (distance - ShadowMap::kSmallestFilter);
+        const float bound =
+            excess > 0 ? nearest * cone / excess : std::numeric_limits<float>::infinity();
+        bounds[k] = std::min(bounds[k - 1], bound);
+      }
+    }
+  });
 }
 
 ShadowMap build_shadow_map(const ir::Light& light, const Vector3f& center, float radius,
