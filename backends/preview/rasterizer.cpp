@@ -339,7 +339,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       spiral(std::integral_constant<std::size_t, 4>{});
   // Depths at a group's eight taps scaled by `radius` (texels of level 0) around (u, v), read
   // at `level`.
-  auto disc8 = [&](const TapGroup& taps, float radius, int level, bool coverage = false) {
+  auto disc8 = [&](const TapGroup& taps, float radius, int level, Float8* held = nullptr) {
     const Float8 su = u + taps.u * radius, sv = v + taps.v * radius;
     Int8 iu = __builtin_convertvector(su, Int8), iv = __builtin_convertvector(sv, Int8);
     if (level == 0 && interior) return simd::gather(depth.data(), iv * size + iu);
@@ -354,10 +354,11 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       const Float8 z = simd::gather(depth.data(), iv * size + iu);
       return off_map ? Float8{} + std::numeric_limits<float>::infinity() : z;
     }
-    // A coarser level: its depths, or (`coverage`) how much of each texel holds a caster.
+    // A coarser level: its depths, and (into `held`, when asked) how much of each texel holds a
+    // caster.
     const Level& coarser = coarse[level - 1];
     const Int8 at = (iv >> level) * coarser.size + (iu >> level);
-    if (coverage) return off_map ? Float8{} : simd::gather(coarser.coverage.data(), at);
+    if (held) *held = off_map ? Float8{} : simd::gather(coarser.coverage.data(), at);
     const Float8 z = simd::gather(coarser.depth.data(), at);
     return off_map ? Float8{} + std::numeric_limits<float>::infinity() : z;
   };
@@ -428,8 +429,9 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       }
       Float8 hidden = {};
       for (const TapGroup& taps : filter_taps) {
-        const Float8 coverage = disc8(taps, radius, level, true);
-        hidden += blocks8(disc8(taps, radius, level), taps, radius, level) ? coverage : Float8{};
+        Float8 held;
+        const Float8 z = disc8(taps, radius, level, &held);
+        hidden += blocks8(z, taps, radius, level) ? held : Float8{};
       }
       return 1 - simd::sum(hidden) / 64;
     };
