@@ -527,6 +527,44 @@ struct CasterMesh {
   std::size_t first_closed = 0;  // triangles from here on bound solids: back faces skipped
 };
 
+// One row of a coarser shadow-map level from two rows of the finer one, `finer_size` texels (an
+// odd last column alone): per texel, the nearest depth of its 2 x 2 and the fraction of them
+// that hold a caster. At level 0 (`top_held` and `bottom_held` null) a caster is a finite depth.
+void halve_rows(const float* top, const float* bottom, const float* top_held,
+                const float* bottom_held, int finer_size, float* nearest, float* held) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const Float8 one = Float8{} + 1.0f, none = {};
+  constexpr Int8 kEven = {0, 2, 4, 6, 8, 10, 12, 14}, kOdd = {1, 3, 5, 7, 9, 11, 13, 15};
+  auto held8 = [&](int x) {  // how many of the two rows' eight columns from x hold a caster
+    if (top_held) return simd::load8(top_held + x) + simd::load8(bottom_held + x);
+    return (simd::load8(top + x) < inf ? one : none) + (simd::load8(bottom + x) < inf ? one : none);
+  };
+  int x = 0;
+  for (; x + 16 <= finer_size; x += 16) {  // eight texels from sixteen
+    const Float8 top0 = simd::load8(top + x), top1 = simd::load8(top + x + 8);
+    const Float8 bottom0 = simd::load8(bottom + x), bottom1 = simd::load8(bottom + x + 8);
+    const Float8 near0 = top0 < bottom0 ? top0 : bottom0;
+    const Float8 near1 = top1 < bottom1 ? top1 : bottom1;
+    const Float8 even = __builtin_shuffle(near0, near1, kEven);
+    const Float8 odd = __builtin_shuffle(near0, near1, kOdd);
+    const Float8 out = even < odd ? even : odd;
+    const Float8 held0 = held8(x), held1 = held8(x + 8);
+    const Float8 fraction =
+        (__builtin_shuffle(held0, held1, kEven) + __builtin_shuffle(held0, held1, kOdd)) * 0.25f;
+    std::memcpy(nearest + x / 2, &out, sizeof(out));
+    std::memcpy(held + x / 2, &fraction, sizeof(fraction));
+  }
+  auto held1 = [&](int x) {
+    if (top_held) return top_held[x] + bottom_held[x];
+    return static_cast<float>(std::isfinite(top[x])) + static_cast<float>(std::isfinite(bottom[x]));
+  };
+  for (; x < finer_size; x += 2) {
+    const int next = std::min(x + 1, finer_size - 1);
+    nearest[x / 2] = std::min({top[x], top[next], bottom[x], bottom[next]});
+    held[x / 2] = 0.25f * (held1(x) + held1(next));
+  }
+}
+
 void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
   const int size = map.size;
   const auto& tris = *casters.triangles;
@@ -677,39 +715,13 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
     if (!soft) return;
     const float* depth = map.depth.data();
     if (!map.coarse.empty()) {
-      // Level 1 for the band's row pairs: eight texels from sixteen, the nearest of each 2 x 2
-      // and how many of the four hold a caster.
+      // Level 1 for the band's row pairs.
       ShadowMap::Level& first = map.coarse.front();
-      const Float8 one = Float8{} + 1.0f, none = {};
-      constexpr Int8 kEven = {0, 2, 4, 6, 8, 10, 12, 14}, kOdd = {1, 3, 5, 7, 9, 11, 13, 15};
       for (int y = row0; y < row1; y += 2) {
         const float* top = depth + static_cast<size_t>(y) * size;
-        const float* bottom = top + size;
-        float* out = first.depth.data() + static_cast<size_t>(y / 2) * first.size;
-        float* covered = first.coverage.data() + static_cast<size_t>(y / 2) * first.size;
-        int x = 0;
-        for (; x + 16 <= size; x += 16) {
-          const Float8 top0 = simd::load8(top + x), top1 = simd::load8(top + x + 8);
-          const Float8 bottom0 = simd::load8(bottom + x), bottom1 = simd::load8(bottom + x + 8);
-          const Float8 near0 = top0 < bottom0 ? top0 : bottom0;
-          const Float8 near1 = top1 < bottom1 ? top1 : bottom1;
-          const Float8 held0 = (top0 < inf ? one : none) + (bottom0 < inf ? one : none);
-          const Float8 held1 = (top1 < inf ? one : none) + (bottom1 < inf ? one : none);
-          const Float8 even = __builtin_shuffle(near0, near1, kEven);
-          const Float8 odd = __builtin_shuffle(near0, near1, kOdd);
-          const Float8 nearest = even < odd ? even : odd;
-          const Float8 held =
-              (__builtin_shuffle(held0, held1, kEven) + __builtin_shuffle(held0, held1, kOdd)) *
-              0.25f;
-          std::memcpy(out + x / 2, &nearest, sizeof(nearest));
-          std::memcpy(covered + x / 2, &held, sizeof(held));
-        }
-        for (; x < size; x += 2) {  // a last group of eight
-          out[x / 2] = std::min({top[x], top[x + 1], bottom[x], bottom[x + 1]});
-          covered[x / 2] =
-              0.25f * static_cast<float>(std::isfinite(top[x]) + std::isfinite(top[x + 1]) +
-                                         std::isfinite(bottom[x]) + std::isfinite(bottom[x + 1]));
-        }
+        halve_rows(top, top + size, nullptr, nullptr, size,
+                   first.depth.data() + static_cast<size_t>(y / 2) * first.size,
+                   first.coverage.data() + static_cast<size_t>(y / 2) * first.size);
       }
     }
     for (int block_row0 = row0; block_row0 < row1; block_row0 += ShadowMap::kBlock) {
@@ -772,35 +784,16 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       level.depth = dslr::take_floats(static_cast<size_t>(n) * n);
       level.coverage = dslr::take_floats(static_cast<size_t>(n) * n);
     }
-    if (!made)
-      tbb::parallel_for(
-          tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& rows) {
-            // Rows 2y and 2y + 1 merged, then pairs of columns.
-            std::vector<float> pair_depth(static_cast<size_t>(2 * n)), pair_coverage(2 * n);
-            for (int y = rows.begin(); y < rows.end(); ++y) {
-              const size_t top = static_cast<size_t>(2 * y) * finer_size;
-              const size_t bottom =
-                  static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
-              for (int x = 0; x < finer_size; ++x) {
-                pair_depth[x] = std::min(finer[top + x], finer[bottom + x]);
-                // Level 0 holds a caster where its depth is finite.
-                pair_coverage[x] = finer_coverage
-                                       ? finer_coverage[top + x] + finer_coverage[bottom + x]
-                                       : static_cast<float>(std::isfinite(finer[top + x])) +
-                                             static_cast<float>(std::isfinite(finer[bottom + x]));
-              }
-              if (finer_size % 2 != 0) {
-                pair_depth[finer_size] = pair_depth[finer_size - 1];
-                pair_coverage[finer_size] = pair_coverage[finer_size - 1];
-              }
-              float* out = level.depth.data() + static_cast<size_t>(y) * n;
-              float* covered = level.coverage.data() + static_cast<size_t>(y) * n;
-              for (int x = 0; x < n; ++x) {
-                out[x] = std::min(pair_depth[2 * x], pair_depth[2 * x + 1]);
-                covered[x] = 0.25f * (pair_coverage[2 * x] + pair_coverage[2 * x + 1]);
-              }
-            }
-          });
+    if (!made) {
+      tbb::parallel_for(0, n, [&](int y) {
+        const size_t top = static_cast<size_t>(2 * y) * finer_size;
+        const size_t bottom = static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
+        halve_rows(finer + top, finer + bottom, finer_coverage ? finer_coverage + top : nullptr,
+                   finer_coverage ? finer_coverage + bottom : nullptr, finer_size,
+                   level.depth.data() + static_cast<size_t>(y) * n,
+                   level.coverage.data() + static_cast<size_t>(y) * n);
+      });
+    }
     level.blocks_per_row = (n + ShadowMap::kBlock - 1) / ShadowMap::kBlock;
     std::vector<float> nearest(static_cast<size_t>(level.blocks_per_row) * level.blocks_per_row);
     for (int by = 0; by < level.blocks_per_row; ++by) {
