@@ -363,12 +363,16 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     return off_map ? Float8{} + std::numeric_limits<float>::infinity() : z;
   };
   // The receiver's depth less the bias under a group's eight taps. A texel of level k holds the
-  // nearest of 2^k x 2^k: on the receiver's own plane up to 2^k texels' slope nearer, so the
-  // bias grows with it.
+  // nearest of 2^k x 2^k: on the receiver's own plane up to 2^k - 1 texels' slope nearer (the
+  // plane's own slope where it is followed, the bias's slope term where not), so the bias grows
+  // by that much and no more. Growing the whole bias with 2^k made a grazing receiver's bias jump
+  // by centimetres where the filter moved to the next level: on a turntable top behind a box, a
+  // hard line where the box's low part stopped counting.
+  const float slope_per_texel =
+      texel * 1.5f + (slope_u != 0 || slope_v != 0 ? std::abs(slope_u) + std::abs(slope_v)
+                                                   : texel * 2.0f * tan_theta);
   auto receiver_at = [&](const TapGroup& taps, float radius, int level) {
-    const float coarser_bias =
-        static_cast<float>((1 << level) - 1) *
-        (texel * (1.5f + 2.0f * tan_theta) + std::abs(slope_u) + std::abs(slope_v));
+    const float coarser_bias = static_cast<float>((1 << level) - 1) * slope_per_texel;
     return receiver - coarser_bias + (taps.u * slope_u + taps.v * slope_v) * radius;
   };
   // A texel d texels from the point, at depth z, can hide part of an area light only from
