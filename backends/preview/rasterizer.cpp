@@ -787,8 +787,6 @@ void rasterize_depth(ShadowMap& map, const CasterMesh& casters) {
       level.size = n;
       level.depth = dslr::take_floats(static_cast<size_t>(n) * n);
       level.coverage = dslr::take_floats(static_cast<size_t>(n) * n);
-    }
-    if (!made) {
       tbb::parallel_for(0, n, [&](int y) {
         const size_t top = static_cast<size_t>(2 * y) * finer_size;
         const size_t bottom = static_cast<size_t>(std::min(2 * y + 1, finer_size - 1)) * finer_size;
