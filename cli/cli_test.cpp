@@ -75,6 +75,44 @@ TEST(Cli, UnknownVerbAndTargetAreUserErrors) {
   EXPECT_EQ(target.exit_code, 1);
 }
 
+// CLI11's range checks let NaN through, and it reads "-1" into an unsigned seed as 2^64 - 1:
+// every number a verb takes is checked to be finite and in range, with a message that says so.
+TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
+  testing::TempDir dir;
+  const std::string scene = source_path("scenes/paper-turntable.yaml");
+  const std::string run = dir.file("run");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"render", scene, "-o", run, "--scale", "nan"}, "--scale: 'nan' is not a finite number"},
+      {{"render", scene, "-o", run, "--backend", "povray", "--scale", "NaN"},
+       "--scale: 'NaN' is not a finite number"},
+      {{"render", scene, "-o", run, "--seed", "-1"}, "--seed: '-1' is negative: give 0 or more"},
+      {{"render", scene, "-o", run, "--samples", "-2"}, "--samples: '-2' is negative"},
+      {{"compile", scene, "--target", "povray", "-o", run, "--samples", "-5"},
+       "--samples: '-5' is negative"},
+      {{"compile", scene, "--target", "povray", "-o", run, "--scale", "inf"},
+       "--scale: 'inf' is not a finite number"},
+      {{"coverage", scene, "-o", run, "--visibility-scale", "nan"},
+       "--visibility-scale: 'nan' is not a finite number"},
+      {{"eval", run, "--tau", "nan"}, "--tau: 'nan' is not a finite number"},
+      {{"eval", run, "--color-range", "-1"}, "--color-range: '-1' is not above 0"},
+      {{"compare", scene, "-o", run, "--scale", "-nan"}, "is not a finite number"},
+  };
+  for (const Case& c : cases) {
+    auto result = run_rigc(c.args);
+    EXPECT_EQ(result.exit_code, 1) << c.args[0] << " " << c.message << "\n" << result.err;
+    EXPECT_NE(result.err.find(c.message), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(run)) << c.message;
+  }
+  // A seed of 0 and the largest one are seeds.
+  auto largest = run_rigc({"render", scene, "-o", run, "--scale", "0.02", "--shots", "0", "--seed",
+                           "18446744073709551615"});
+  EXPECT_EQ(largest.exit_code, 0) << largest.err;
+}
+
 TEST(Cli, VersionAndHelp) {
   auto version = run_rigc({"version"});
   EXPECT_EQ(version.exit_code, 0);

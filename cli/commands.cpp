@@ -11,6 +11,7 @@
 #include "analysis/advice.h"
 #include "analysis/coverage.h"
 #include "analysis/coverage_output.h"
+#include "backends/common/command_line.h"
 #include "backends/common/shots.h"
 #include "backends/cycles/cycles_backend.h"
 #include "backends/povray/povray_backend.h"
@@ -26,18 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Parses a verb's options with CLI11; returns an exit code if parsing ended the run (help, error).
-std::optional<int> parse_options(CLI::App& app, std::vector<std::string> args) {
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  try {
-    app.parse(static_cast<int>(argv.size()), argv.data());
-  } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUserError;
-  }
-  return std::nullopt;
-}
+using backends::finite_number;
+using backends::non_negative_number;
+using backends::parse_options;
 
 nlohmann::json diagnostics_json(const DiagnosticEngine& diag) {
   nlohmann::json out = nlohmann::json::array();
@@ -116,9 +108,11 @@ int run_compile(std::vector<std::string> args) {
                  "output file for ir (default: standard output); folder for povray and cycles "
                  "(default: out/<scene>/<target>/render)");
   app.add_option("--scale", scale, "multiplies the sensor resolution")
+      ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
-  app.add_option("--samples", samples, "renderer samples per pixel (0: the backend's default)");
+  app.add_option("--samples", samples, "renderer samples per pixel (0: the backend's default)")
+      ->check(non_negative_number());
   app.add_flag("--no-geometry", no_geometry, "leave vertex and triangle arrays out of the IR");
   if (auto code = parse_options(app, args)) return *code;
 
@@ -161,13 +155,18 @@ int run_render(std::vector<std::string> args) {
       ->check(CLI::IsMember({"preview", "povray", "cycles"}))
       ->capture_default_str();
   app.add_option("--samples", samples,
-                 "samples per pixel for povray and cycles (0: the backend's default)");
+                 "samples per pixel for povray and cycles (0: the backend's default)")
+      ->check(non_negative_number());
   app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
   app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 (default: all)");
   app.add_option("--scale", scale, "multiplies the sensor resolution, for quick looks")
+      ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
-  app.add_option("--seed", seed, "sensor noise seed")->capture_default_str();
+  // Checked as a number 0 or more: CLI11 reads "-1" into an unsigned seed as 2^64 - 1.
+  app.add_option("--seed", seed, "sensor noise seed")
+      ->check(non_negative_number())
+      ->capture_default_str();
   if (auto code = parse_options(app, args)) return *code;
 
   DiagnosticEngine diag;
@@ -213,6 +212,7 @@ int run_coverage(std::vector<std::string> args) {
       ->capture_default_str();
   app.add_option("--visibility-scale", visibility_scale,
                  "resolution of the visibility buffers relative to the sensor (0: ~1400 px)")
+      ->check(finite_number())
       ->check(CLI::Range(0.0, 1.0));
   if (auto code = parse_options(app, args)) return *code;
 

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "backends/common/command_line.h"
 #include "backends/common/files.h"
 #include "backends/common/manifest.h"
 #include "backends/common/shots.h"
@@ -24,17 +25,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::optional<int> parse_options(CLI::App& app, const std::vector<std::string>& args) {
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  try {
-    app.parse(static_cast<int>(argv.size()), argv.data());
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 1;
-  }
-  return std::nullopt;
-}
+using backends::finite_number;
+using backends::parse_options;
+using backends::positive_number;
 
 void add_eval_options(CLI::App& app, EvalOptions& o) {
   app.add_option("--colmap", o.colmap, "COLMAP executable")->capture_default_str();
@@ -46,6 +39,7 @@ void add_eval_options(CLI::App& app, EvalOptions& o) {
       ->capture_default_str();
   app.add_option("--neighbour-angle", o.neighbour_angle_deg,
                  "neighbours: the widest angle (deg) between the optical axes of a matched pair")
+      ->check(finite_number())
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str();
   app.add_flag("!--no-masks", o.use_masks, "ignore the run's masks/ (object masks)");
@@ -60,14 +54,15 @@ void add_eval_options(CLI::App& app, EvalOptions& o) {
       ->check(CLI::Range(5, 12))
       ->capture_default_str();
   app.add_option("--tau", o.tau_mm, "F-score distance threshold in mm")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   app.add_option("--samples", o.ground_truth_samples,
                  "ground-truth surface samples before the visibility test")
       ->check(CLI::Range(1000, 20000000))
       ->capture_default_str();
   app.add_option("--color-range", o.color_range_mm,
-                 "heat-map range in mm, ± (default: 3 x the RMS distance)");
+                 "heat-map range in mm, ± (default: 3 x the RMS distance)")
+      ->check(positive_number());
 }
 
 // A renderer for `rigc compare`: renders every shot of `scene` into run_dir; returns 0, 1, 2.
@@ -152,6 +147,7 @@ int run_compare_command(std::vector<std::string> args) {
   app.add_option("--backends", backends_text, "comma-separated renderers")->capture_default_str();
   app.add_option("--photos", photos, "real photos of the same object, evaluated as one more row");
   app.add_option("--scale", scale, "render scale")
+      ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
   app.add_option("-o,--output", output, "output folder (default: out/<scene>/compare)");

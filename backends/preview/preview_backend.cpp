@@ -102,6 +102,13 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
 int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostream& log,
                 std::vector<ShotTiming>* timings) {
   const fs::path run_dir = options.output_dir;
+  // The check the run's cameras.txt makes at the end (a positive, finite scale), made before
+  // anything is written: a NaN scale used to render and record a shot first.
+  std::string camera_error;
+  if (!backends::output_camera(scene.camera, options.scale, &camera_error)) {
+    log << fmt::format("rigc: error: {}\n", camera_error);
+    return 1;
+  }
   if (!backends::prepare_run_folder(run_dir, {}, log)) return 1;
   std::vector<int> shots = options.shots;
   if (shots.empty()) {

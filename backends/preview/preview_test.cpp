@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
@@ -985,6 +986,23 @@ TEST(Preview, UnwritableOutputIsAUserError) {
   std::ostringstream log;
   EXPECT_EQ(run_preview(scene, options, log), 1);
   EXPECT_NE(log.str().find("cannot create the output folder"), std::string::npos) << log.str();
+}
+
+TEST(Preview, ANonFiniteScaleIsRejectedBeforeAnythingIsWritten) {
+  testing::TempDir dir;
+  ir::Scene scene = compile(ball_scene(
+      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  for (double scale : {std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::infinity(), 0.0, -0.5}) {
+    RenderOptions options;
+    options.output_dir = (dir.path() / "run").string();
+    options.scale = scale;
+    std::ostringstream log;
+    EXPECT_EQ(run_preview(scene, options, log), 1) << scale;
+    EXPECT_NE(log.str().find("render scale"), std::string::npos) << log.str();
+    // The run folder is not even made: a NaN scale used to render and record a shot first.
+    EXPECT_FALSE(fs::exists(dir.path() / "run")) << scale;
+  }
 }
 
 TEST(Preview, RenderCommandRejectsBadShotSelection) {

@@ -1,0 +1,65 @@
+// What the verbs in cli/ and eval/ share about their options (CLI11).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rigc::backends {
+
+// Parses a verb's options; returns the exit code when parsing ended the run (0 after --help, 1
+// after an error: the message is printed).
+inline std::optional<int> parse_options(CLI::App& app, const std::vector<std::string>& args) {
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;
+  }
+  return std::nullopt;
+}
+
+// A number that is not NaN or infinite. CLI11's Range and PositiveNumber let NaN through (every
+// comparison with it is false): `rigc render --scale nan` rendered a shot, recorded it in the
+// manifest without its files and failed only at the end. Check with this before a range.
+inline const CLI::Validator& finite_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
+        return {};
+      },
+      "FINITE");
+  return check;
+}
+
+// A finite number of 0 or more, and one above 0. (CLI11's own print their bound, 1.8e308, in
+// full; and CLI11 reads "-1" into an unsigned option as 2^64 - 1.)
+inline const CLI::Validator& non_negative_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        if (std::string problem = finite_number()(text); !problem.empty()) return problem;
+        double value = 0;
+        CLI::detail::lexical_cast(text, value);
+        return value >= 0 ? std::string() : "'" + text + "' is negative: give 0 or more";
+      },
+      "NONNEGATIVE");
+  return check;
+}
+inline const CLI::Validator& positive_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        if (std::string problem = finite_number()(text); !problem.empty()) return problem;
+        double value = 0;
+        CLI::detail::lexical_cast(text, value);
+        return value > 0 ? std::string() : "'" + text + "' is not above 0";
+      },
+      "POSITIVE");
+  return check;
+}
+
+}  // namespace rigc::backends
