@@ -1,5 +1,6 @@
 #include "eval/eval.h"
 
+#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -449,6 +450,29 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   if (image_names.size() < 2) {
     log << fmt::format("rigc eval: error: {} has {} image(s); SfM needs at least 2\n",
                        images_dir.string(), image_names.size());
+    return 1;
+  }
+  // Each image's header, read before COLMAP runs: its feature extractor only logs a file it
+  // cannot read, and a folder with such files ended in the matcher aborting (exit 134) without a
+  // word of which file it was.
+  std::vector<std::string> unreadable;
+  for (const auto& name : image_names) {
+    if (OIIO::ImageInput::open((images_dir / name).string())) continue;
+    std::string why = OIIO::geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    unreadable.push_back(fmt::format("{}: {}", (images_dir / name).string(), why));
+  }
+  if (!unreadable.empty()) {
+    log << fmt::format(
+        "rigc eval: error: {} of the {} images cannot be read; remove or replace "
+        "{}:\n",
+        unreadable.size(), image_names.size(), unreadable.size() == 1 ? "it" : "them");
+    constexpr std::size_t kListed = 10;
+    for (std::size_t i = 0; i < std::min(kListed, unreadable.size()); ++i) {
+      log << "  " << unreadable[i] << '\n';
+    }
+    if (unreadable.size() > kListed)
+      log << fmt::format("  and {} more\n", unreadable.size() - kListed);
     return 1;
   }
   const fs::path out = o.output_dir.empty() ? run_dir / "eval" : fs::path(o.output_dir);

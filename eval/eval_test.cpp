@@ -1,5 +1,6 @@
 #include "eval/eval.h"
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -317,13 +318,22 @@ TEST(EvalPictures, HeatColoursFollowCloudCompare) {
   EXPECT_EQ(signed_distance_color(5, 1), (C{255, 0, 0}));
 }
 
+// A small grey image in the format its name asks for, which eval's readability check accepts.
+void write_small_image(const std::string& path) {
+  const OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::UINT8);
+  const std::vector<unsigned char> pixels(16 * 16 * 3, 128);
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out && out->open(path, spec)) << path;
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+  ASSERT_TRUE(out->close());
+}
+
 TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   rigc::testing::TempDir dir;
   EXPECT_EQ(run_eval_command({"rigc eval", dir.file("nothing")}), 1);
   // A run folder with images but a COLMAP that does not exist.
   fs::create_directories(dir.path() / "run" / "images");
-  for (const char* name : {"a.jpg", "b.jpg"})
-    rigc::testing::write_text(dir.file("run/images/") + name, "x");
+  for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
   std::vector<Eigen::Vector3f> v;
   std::vector<std::array<std::uint32_t, 3>> t;
   cube(0.1, &v, &t);
@@ -350,7 +360,7 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   rigc::testing::TempDir dir;
   fs::create_directories(dir.path() / "photos");
   for (const char* name : {"a.jpg", "b.jpg", "c.jpg"})
-    rigc::testing::write_text(dir.file("photos/") + name, "x");
+    write_small_image(dir.file("photos/") + name);
   std::vector<Eigen::Vector3f> v;
   std::vector<std::array<std::uint32_t, 3>> t;
   cube(0.1, &v, &t);
@@ -367,6 +377,35 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_NE(log.str().find("planned pose"), std::string::npos) << log.str();
+}
+
+// COLMAP's extractor only logs a file it cannot read, and its matcher then aborted (exit 134)
+// without naming it: eval reads every image's header first and names the ones that fail.
+TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  for (const char* name : {"a.jpg", "b.jpg", "d.png"})
+    write_small_image(dir.file("photos/") + name);
+  rigc::testing::write_text(dir.file("photos/c.jpg"), "not an image");
+  std::vector<Eigen::Vector3f> v;
+  std::vector<std::array<std::uint32_t, 3>> t;
+  cube(0.1, &v, &t);
+  ir::Mesh mesh;
+  mesh.positions = v;
+  mesh.triangles = t;
+  std::string error;
+  ASSERT_TRUE(write_ply(dir.file("cube.ply"), mesh, &error)) << error;
+  EvalOptions o;
+  o.photos_dir = dir.file("photos");
+  o.ground_truth = dir.file("cube.ply");
+  o.output_dir = dir.file("eval");
+  o.colmap = dir.file("no-such-colmap");
+  std::ostringstream log;
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("1 of the 4 images cannot be read"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("c.jpg"), std::string::npos) << log.str();
+  EXPECT_EQ(log.str().find("d.png"), std::string::npos) << "a PNG is read too: " << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "nothing is written";
 }
 
 // ---------------------------------------------------------------------------------------------
