@@ -33,7 +33,7 @@ inline const CLI::Validator& finite_number() {
         if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
         return {};
       },
-      "FINITE");
+      "");
   return check;
 }
 
