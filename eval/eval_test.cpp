@@ -318,6 +318,18 @@ TEST(EvalPictures, HeatColoursFollowCloudCompare) {
   EXPECT_EQ(signed_distance_color(5, 1), (C{255, 0, 0}));
 }
 
+// A 10 cm cube as a PLY file: a ground truth for the command tests.
+void write_cube_ply(const std::string& path) {
+  std::vector<Eigen::Vector3f> v;
+  std::vector<std::array<std::uint32_t, 3>> t;
+  cube(0.1, &v, &t);
+  ir::Mesh mesh;
+  mesh.positions = v;
+  mesh.triangles = t;
+  std::string error;
+  ASSERT_TRUE(write_ply(path, mesh, &error)) << error;
+}
+
 // A small grey image in the format its name asks for, which eval's readability check accepts.
 void write_small_image(const std::string& path) {
   const OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::UINT8);
@@ -334,14 +346,7 @@ TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   // A run folder with images but a COLMAP that does not exist.
   fs::create_directories(dir.path() / "run" / "images");
   for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
-  std::vector<Eigen::Vector3f> v;
-  std::vector<std::array<std::uint32_t, 3>> t;
-  cube(0.1, &v, &t);
-  ir::Mesh mesh;
-  mesh.positions = v;
-  mesh.triangles = t;
-  std::string error;
-  ASSERT_TRUE(write_ply(dir.file("cube.ply"), mesh, &error)) << error;
+  write_cube_ply(dir.file("cube.ply"));
   EvalOptions o;
   o.run_dir = dir.file("run");
   o.ground_truth = dir.file("cube.ply");
@@ -361,14 +366,7 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   fs::create_directories(dir.path() / "photos");
   for (const char* name : {"a.jpg", "b.jpg", "c.jpg"})
     write_small_image(dir.file("photos/") + name);
-  std::vector<Eigen::Vector3f> v;
-  std::vector<std::array<std::uint32_t, 3>> t;
-  cube(0.1, &v, &t);
-  ir::Mesh mesh;
-  mesh.positions = v;
-  mesh.triangles = t;
-  std::string error;
-  ASSERT_TRUE(write_ply(dir.file("cube.ply"), mesh, &error)) << error;
+  write_cube_ply(dir.file("cube.ply"));
   EvalOptions o;
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");
@@ -387,14 +385,7 @@ TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
   for (const char* name : {"a.jpg", "b.jpg", "d.png"})
     write_small_image(dir.file("photos/") + name);
   rigc::testing::write_text(dir.file("photos/c.jpg"), "not an image");
-  std::vector<Eigen::Vector3f> v;
-  std::vector<std::array<std::uint32_t, 3>> t;
-  cube(0.1, &v, &t);
-  ir::Mesh mesh;
-  mesh.positions = v;
-  mesh.triangles = t;
-  std::string error;
-  ASSERT_TRUE(write_ply(dir.file("cube.ply"), mesh, &error)) << error;
+  write_cube_ply(dir.file("cube.ply"));
   EvalOptions o;
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rigc::backends {
@@ -22,43 +23,36 @@ inline std::optional<int> parse_options(CLI::App& app, const std::vector<std::st
   return std::nullopt;
 }
 
-// A number that is not NaN or infinite. CLI11's Range and PositiveNumber let NaN through (every
-// comparison with it is false): `rigc render --scale nan` rendered a shot, recorded it in the
-// manifest without its files and failed only at the end. Check with this before a range.
-inline const CLI::Validator& finite_number() {
-  static const CLI::Validator check(
-      [](std::string& text) -> std::string {
+// A number that is not NaN or infinite and that `accept` takes; otherwise the option's error is
+// the text and `complaint`. CLI11's Range and PositiveNumber let NaN through (every comparison
+// with it is false): `rigc render --scale nan` rendered a shot, recorded it in the manifest
+// without its files and failed only at the end. Their messages also print a bound of 1.8e308 in
+// full, and CLI11 reads "-1" into an unsigned option as 2^64 - 1.
+template <typename Accept>
+CLI::Validator finite_number_where(Accept accept, std::string complaint, std::string name) {
+  return CLI::Validator(
+      [accept, complaint](std::string& text) -> std::string {
         double value = 0;
         if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
         if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
-        return {};
+        return accept(value) ? std::string() : "'" + text + "' " + complaint;
       },
-      "");
-  return check;
+      std::move(name));
 }
 
-// A finite number of 0 or more, and one above 0. (CLI11's own print their bound, 1.8e308, in
-// full; and CLI11 reads "-1" into an unsigned option as 2^64 - 1.)
+// Check with this before a range (it adds nothing to the option's help line).
+inline const CLI::Validator& finite_number() {
+  static const CLI::Validator check = finite_number_where([](double) { return true; }, "", "");
+  return check;
+}
 inline const CLI::Validator& non_negative_number() {
-  static const CLI::Validator check(
-      [](std::string& text) -> std::string {
-        if (std::string problem = finite_number()(text); !problem.empty()) return problem;
-        double value = 0;
-        CLI::detail::lexical_cast(text, value);
-        return value >= 0 ? std::string() : "'" + text + "' is negative: give 0 or more";
-      },
-      "NONNEGATIVE");
+  static const CLI::Validator check = finite_number_where(
+      [](double value) { return value >= 0; }, "is negative: give 0 or more", "NONNEGATIVE");
   return check;
 }
 inline const CLI::Validator& positive_number() {
-  static const CLI::Validator check(
-      [](std::string& text) -> std::string {
-        if (std::string problem = finite_number()(text); !problem.empty()) return problem;
-        double value = 0;
-        CLI::detail::lexical_cast(text, value);
-        return value > 0 ? std::string() : "'" + text + "' is not above 0";
-      },
-      "POSITIVE");
+  static const CLI::Validator check =
+      finite_number_where([](double value) { return value > 0; }, "is not above 0", "POSITIVE");
   return check;
 }
 
