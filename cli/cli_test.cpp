@@ -66,6 +66,17 @@ TEST(Cli, CompileEmitsIrJsonAtomically) {
   EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
 }
 
+TEST(Cli, CompileRefusesToOverwriteTheSceneItself) {
+  testing::TempDir dir;
+  const std::string scene = dir.file("scene.yaml");
+  const std::string text = testing::read_text(source_path("scenes/paper-turntable.yaml"));
+  testing::write_text(scene, text);
+  auto result = run_rigc({"compile", scene, "--target", "ir", "-o", dir.file("./scene.yaml")});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("is the scene file itself"), std::string::npos) << result.err;
+  EXPECT_EQ(testing::read_text(scene), text);
+}
+
 TEST(Cli, UnknownVerbAndTargetAreUserErrors) {
   auto verb = run_rigc({"chekc"});
   EXPECT_EQ(verb.exit_code, 1);

@@ -136,6 +136,11 @@ int run_compile(std::vector<std::string> args) {
     std::cout << text;
     return kExitOk;
   }
+  std::error_code ec;
+  if (fs::equivalent(output, scene_path, ec)) {
+    std::cerr << fmt::format("rigc: error: -o {} is the scene file itself\n", output);
+    return kExitUserError;
+  }
   std::string error;
   if (!rigc::write_file_atomically(output, text, &error)) {
     std::cerr << "rigc: error: " << error << '\n';

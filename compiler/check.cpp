@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <set>
 
@@ -17,6 +18,22 @@ namespace {
 namespace fs = std::filesystem;
 using spec::Target;
 constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Real cameras' EXIF Make and Model are a few dozen characters.
+constexpr std::size_t kMaxExifText = 255;
+
+// Why `name` cannot be one folder of a path, or empty when it can: the scene's name is the
+// default run folder's parent (out/<name>/<backend>), and "/tmp/x" or "../../x" took runs there.
+std::string folder_name_problem(const std::string& name) {
+  if (name.empty()) return "it is empty";
+  if (name.size() > 100) return "it is longer than 100 bytes";
+  if (name == "." || name == "..") return "'.' and '..' are not folder names";
+  for (const unsigned char c : name) {
+    if (c == '/' || c == '\\') return "it holds a slash";
+    if (c < 0x20 || c == 0x7F) return "it holds a control character";
+  }
+  return {};
+}
 
 struct Range {
   double min;
@@ -51,6 +68,9 @@ class Checker {
   bool check_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
                   const std::string& context) {
     bool ok = true;
+    // yaml-cpp keeps a repeated key's first value and drops the rest without a word: `iso: 200,
+    // iso: 400` gave ISO 200.
+    std::map<std::string, int> first_line;
     for (auto it = map.begin(); it != map.end(); ++it) {
       if (!it->first.IsScalar()) {
         error(it->first, fmt::format("keys in {} must be plain names", context));
@@ -58,6 +78,12 @@ class Checker {
         continue;
       }
       const std::string key = it->first.Scalar();
+      if (auto [seen, fresh] = first_line.try_emplace(key, loc(it->first).line); !fresh) {
+        error(it->first, fmt::format("duplicate key '{}' in {} (first given on line {})", key,
+                                     context, seen->second));
+        ok = false;
+        continue;
+      }
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
       std::string suggestion = closest_match(key, allowed);
       std::string message = fmt::format("unknown key '{}' in {}", key, context);
@@ -221,7 +247,19 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
     diag_.error({file_, 1, 1}, "missing 'rigc: 1' (the language version) at the top of the scene");
   }
   if (root["name"]) {
-    if (auto name = scalar(root["name"], "name")) scene.name = *name;
+    if (auto name = scalar(root["name"], "name")) {
+      if (std::string problem = folder_name_problem(*name); !problem.empty()) {
+        error(root["name"], fmt::format("the scene's name cannot name a folder ({}): runs go to "
+                                        "out/<name>/ by default",
+                                        problem));
+      } else {
+        scene.name = *name;
+      }
+    }
+  } else if (std::string problem = folder_name_problem(scene.name); !problem.empty()) {
+    diag_.error({file_, 1, 1}, fmt::format("the file's name cannot name a folder ({}); give the "
+                                           "scene a 'name:'",
+                                           problem));
   }
   if (root["object"]) {
     read_object(root["object"], scene);
@@ -727,11 +765,18 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
       }
     }
   }
-  if (node["make"]) {
-    if (auto v = scalar(node["make"], "make")) camera.make = *v;
-  }
-  if (node["model"]) {
-    if (auto v = scalar(node["model"], "model")) camera.model = *v;
+  // EXIF strings: a JPEG marker holds under 64 KB, and libjpeg ended the process ("Bogus marker
+  // length") on a longer make or model.
+  for (const auto& [key, field] : {std::pair{"make", &camera.make}, {"model", &camera.model}}) {
+    if (!node[key]) continue;
+    if (auto v = scalar(node[key], key)) {
+      if (v->size() > kMaxExifText) {
+        error(node[key],
+              fmt::format("camera {} is {} bytes long; at most {}", key, v->size(), kMaxExifText));
+      } else {
+        *field = *v;
+      }
+    }
   }
   if (const YAML::Node lens = node["lens"]) {
     if (expect_map(lens, "lens")) {
@@ -1034,12 +1079,85 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   }
 }
 
+// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past
+// U+10FFFF).
+bool valid_utf8(const std::string& text) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const auto* end = p + text.size();
+  while (p < end) {
+    const unsigned char c = *p;
+    int extra = 0;
+    unsigned char low = 0x80, high = 0xBF;  // the first continuation byte's range
+    if (c < 0x80) {
+      ++p;
+      continue;
+    } else if (c >= 0xC2 && c <= 0xDF) {
+      extra = 1;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      extra = 2;
+      if (c == 0xE0) low = 0xA0;
+      if (c == 0xED) high = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      extra = 3;
+      if (c == 0xF0) low = 0x90;
+      if (c == 0xF4) high = 0x8F;
+    } else {
+      return false;
+    }
+    if (end - p <= extra || p[1] < low || p[1] > high) return false;
+    for (int k = 2; k <= extra; ++k) {
+      if (p[k] < 0x80 || p[k] > 0xBF) return false;
+    }
+    p += extra + 1;
+  }
+  return true;
+}
+
+// The mark of the first key or scalar value under `root` that is not UTF-8. yaml-cpp passes a
+// Latin-1 byte through: `check` accepted "café" in Latin-1, and writing the IR or the manifest
+// as JSON then failed (exit 2) after the images were written.
+std::optional<YAML::Mark> first_invalid_utf8_scalar(const YAML::Node& root) {
+  std::vector<YAML::Node> pending = {root};
+  // Aliases share nodes, so nested ones (a "billion laughs" file) repeat them exponentially: the
+  // walk stops after a bound far beyond any scene's node count.
+  constexpr int kMostNodes = 1 << 20;
+  for (int visited = 0; !pending.empty() && visited < kMostNodes; ++visited) {
+    const YAML::Node node = pending.back();
+    pending.pop_back();
+    if (node.IsScalar()) {
+      if (!valid_utf8(node.Scalar())) return node.Mark();
+    } else if (node.IsSequence()) {
+      for (const auto& item : node) pending.push_back(item);
+    } else if (node.IsMap()) {
+      for (auto it = node.begin(); it != node.end(); ++it) {
+        pending.push_back(it->first);
+        pending.push_back(it->second);
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string& file,
                                      DiagnosticEngine& diag) {
   try {
-    return YAML::Load(text);
+    // Every document, so that a second one is an error rather than silently left unread.
+    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    if (documents.size() > 1) {
+      const YAML::Mark mark = documents[1].Mark();
+      diag.error({file, std::max(mark.line, 0) + 1, std::max(mark.column, 0) + 1},
+                 "a scene file holds one YAML document; a second one starts here");
+      return std::nullopt;
+    }
+    const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+    if (const auto bad = first_invalid_utf8_scalar(root)) {
+      diag.error({file, bad->line + 1, bad->column + 1},
+                 "this text is not valid UTF-8 (save the scene file as UTF-8)");
+      return std::nullopt;
+    }
+    return root;
   } catch (const YAML::ParserException& e) {
     diag.error({file, e.mark.line + 1, e.mark.column + 1},
                fmt::format("YAML syntax error: {}", e.msg));

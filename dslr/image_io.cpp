@@ -22,8 +22,10 @@ void set_error(std::string* error, const std::string& message) {
 }
 
 // Writes pixels to a temporary file with the final name's format, then renames it into place.
-bool write_atomically(const fs::path& path, OIIO::ImageSpec spec, const void* pixels,
+bool write_atomically(const fs::path& requested, OIIO::ImageSpec spec, const void* pixels,
                       std::string* error) {
+  const fs::path path = file_to_replace(requested, error);
+  if (path.empty()) return false;
   auto out = OIIO::ImageOutput::create(path.string());
   if (!out) {
     set_error(error, "cannot write " + path.string() + ": " + OIIO::geterror());

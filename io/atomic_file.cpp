@@ -50,13 +50,37 @@ std::filesystem::path temporary_path_beside(const std::filesystem::path& path) {
   return path.parent_path() / ("." + path.filename().string() + unique_suffix());
 }
 
-bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+std::filesystem::path file_to_replace(const std::filesystem::path& path, std::string* error) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path target = path;
+  if (fs::is_symlink(fs::symlink_status(path, ec))) {
+    target = fs::weakly_canonical(path, ec);
+    if (ec) {
+      set_error(error, fmt::format("cannot write {}: the symbolic link leads nowhere: {}",
+                                   path.string(), ec.message()));
+      return {};
+    }
+  }
+  const fs::file_status status = fs::status(target, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    set_error(error, fmt::format("cannot write {}: it is not a regular file (a folder, a device "
+                                 "or a pipe); name a file",
+                                 path.string()));
+    return {};
+  }
+  return target;
+}
+
+bool write_file_atomically(const std::filesystem::path& requested, std::string_view bytes,
                            std::string* error) {
   try {
-    if (path.filename().empty()) {
-      set_error(error, fmt::format("cannot write '{}': not a file name", path.string()));
+    if (requested.filename().empty()) {
+      set_error(error, fmt::format("cannot write '{}': not a file name", requested.string()));
       return false;
     }
+    const std::filesystem::path path = file_to_replace(requested, error);
+    if (path.empty()) return false;
     std::string temp;
     int fd = -1;
     for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
@@ -77,7 +101,7 @@ bool write_file_atomically(const std::filesystem::path& path, std::string_view b
     set_error(error, fmt::format("cannot write {}: {}", path.string(), errno_text(code)));
     return false;
   } catch (const std::exception& e) {
-    set_error(error, fmt::format("cannot write {}: {}", path.string(), e.what()));
+    set_error(error, fmt::format("cannot write {}: {}", requested.string(), e.what()));
     return false;
   }
 }

@@ -12,9 +12,15 @@ namespace rigc {
 // opens the file itself, or a stream written in chunks); they rename it over `path` when done.
 std::filesystem::path temporary_path_beside(const std::filesystem::path& path);
 
-// Writes `bytes` to a temporary file beside `path` (unique suffix), then renames it over `path`.
-// The folder must exist. On failure removes the temporary file, sets `error` (if not null) to
-// one line naming the path and returns false. Never throws.
+// The file that writing `path` should replace: `path` itself, or the file a symbolic link at
+// `path` leads to (the link is kept). Empty, with `error` set (if not null), when something
+// other than a regular file is there: a rename over it replaced /dev/stdout with a regular file.
+std::filesystem::path file_to_replace(const std::filesystem::path& path, std::string* error);
+
+// Writes `bytes` to a temporary file beside `path` (unique suffix), then renames it over `path`
+// (over file_to_replace(path), which it refuses the same way). The folder must exist. On failure
+// removes the temporary file, sets `error` (if not null) to one line naming the path and returns
+// false. Never throws.
 bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            std::string* error);
 

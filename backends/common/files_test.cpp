@@ -1,6 +1,7 @@
 #include "backends/common/files.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <string>
 
@@ -63,6 +64,27 @@ TEST(BackendFiles, WriteAtomicallyWritesAndReplaces) {
   int entries = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir.path())) ++entries;
   EXPECT_EQ(entries, 1) << "a temporary file was left behind";
+}
+
+// A rename over the path replaced what was there: a symbolic link became a file of its own, and
+// as root /dev/stdout became a regular file.
+TEST(BackendFiles, WriteAtomicallyWritesThroughALinkAndRefusesAPipe) {
+  rigc::testing::TempDir dir;
+  const fs::path target = dir.path() / "target.json", link = dir.path() / "link.json";
+  rigc::testing::write_text(target.string(), "old");
+  fs::create_symlink("target.json", link);
+  std::string error;
+  ASSERT_TRUE(write_file_atomically(link, "new", &error)) << error;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(rigc::testing::read_text(target.string()), "new");
+
+  const fs::path pipe = dir.path() / "pipe.json";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  EXPECT_FALSE(write_file_atomically(pipe, "bytes", &error));
+  EXPECT_NE(error.find("not a regular file"), std::string::npos) << error;
+  EXPECT_TRUE(fs::is_fifo(pipe));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 3)
+      << "a temporary file was left behind";
 }
 
 TEST(BackendFiles, WriteAtomicallyIntoMissingFolderFails) {

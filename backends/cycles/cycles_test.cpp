@@ -30,7 +30,7 @@ ir::Scene hostile_scene(const TempDir& dir) {
   const std::string yaml_name =
       "a\\\"b\\\\c'd\\n\\\"); import os; os.system(\\\"touch PWNED\\\") #.obj";
   const std::string text = R"(rigc: 1
-name: "evil\"); import os; os.system(\"touch PWNED\")\n#"
+name: "evil\"); import os; os.system(\"touch PWNED\") #"
 object:
   mesh: ")" + yaml_name + R"("
   fit: {size: 10cm}
