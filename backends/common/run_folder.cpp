@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <map>
 #include <ostream>
+#include <set>
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/transforms_json.h"
@@ -34,6 +37,51 @@ bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& ex
   }
   if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
     log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
+    return false;
+  }
+  return true;
+}
+
+bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene, const fs::path& run_dir,
+                         const fs::path& manifest_path, std::ostream& log) {
+  std::map<std::string, std::set<std::string>> expected;  // per shot of the scene, its files
+  for (const auto& shot : scene.shots) {
+    expected[shot.name] = {image_relative_path(scene.camera, shot), mask_relative_path(shot)};
+  }
+  // A manifest is only data: a listed path outside images/ and masks/ is never touched.
+  auto ours = [](const fs::path& relative) {
+    const auto first = relative.begin();
+    if (relative.is_absolute() || first == relative.end()) return false;
+    if (*first != "images" && *first != "masks") return false;
+    return std::none_of(relative.begin(), relative.end(),
+                        [](const fs::path& part) { return part == ".." || part == "."; });
+  };
+  int removed = 0;
+  std::vector<std::string> gone;
+  for (const auto& [name, record] : manifest.shots()) {
+    const auto shot = expected.find(name);
+    for (const auto& file : record.files) {
+      if (shot != expected.end() && shot->second.count(file)) continue;
+      std::error_code ec;
+      const fs::path path = run_dir / file;
+      if (ours(file) && fs::is_regular_file(fs::symlink_status(path, ec)) && fs::remove(path, ec)) {
+        ++removed;
+      }
+    }
+    if (shot == expected.end()) gone.push_back(name);
+  }
+  for (const auto& name : gone) manifest.forget(name);
+  if (!gone.empty()) {
+    log << fmt::format(
+        "rigc: {} shot{} of an earlier run ({}{}) {} no longer in the scene: removed "
+        "from the run folder\n",
+        gone.size(), gone.size() == 1 ? "" : "s", gone.front(),
+        gone.size() > 1 ? fmt::format(" to {}", gone.back()) : "", gone.size() == 1 ? "is" : "are");
+  }
+  if (removed == 0 && gone.empty()) return true;
+  std::string error;
+  if (!manifest.save(manifest_path, &error)) {
+    log << fmt::format("rigc: error: {}\n", error);
     return false;
   }
   return true;

@@ -17,6 +17,15 @@ namespace rigc::backends {
 bool prepare_run_folder(const std::filesystem::path& run_dir,
                         const std::vector<std::filesystem::path>& extra, std::ostream& log);
 
+// A run folder holds one scene's shots, and `rigc eval` runs COLMAP on every image in images/:
+// drops the manifest's entries for shots the scene no longer has, and deletes the files they list
+// and, for the shots it has, listed files this camera no longer writes (a JPEG left beside a new
+// PNG). Only images/ and masks/ files named by the manifest are deleted. Saves the manifest when
+// it changed; false after writing a `rigc: error:` line to `log`.
+bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene,
+                         const std::filesystem::path& run_dir,
+                         const std::filesystem::path& manifest_path, std::ostream& log);
+
 // "\r[#####     ] 5/18 shot_004 0.42 s": the progress bar a run redraws on a terminal.
 std::string progress_line(int done, int total, const std::string& name, double seconds);
 

@@ -117,6 +117,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
 
   const fs::path manifest_path = run_dir / "manifest.json";
   backends::Manifest manifest = backends::Manifest::load(manifest_path);
+  if (!backends::prune_stale_outputs(manifest, scene, run_dir, manifest_path, log)) return 2;
   const std::string content_hash = backends::scene_content_hash(scene);
   manifest.set_backend("preview");
   manifest.set_inputs({{"scene", scene.name},

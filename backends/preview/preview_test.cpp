@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "backends/common/colmap_text.h"
+#include "backends/common/manifest.h"
 #include "backends/preview/preview_backend.h"
 #include "backends/preview/studio_scene.h"
 #include "compiler/frontend.h"
@@ -969,6 +970,39 @@ TEST(Preview, RunWritesTheLayoutAndResumes) {
   EXPECT_FALSE(timings[1].skipped);
   EXPECT_TRUE(timings[2].skipped);
   EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
+}
+
+// A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
+// rerun after the scene lost shots, or changed its image format, removes what it no longer makes.
+TEST(Preview, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
+  testing::TempDir dir;
+  auto scene_with = [](int steps, const char* format) {
+    return compile(ball_scene(std::string("}\n  output: {format: ") + format + "}",
+                              "  - turntable: {steps: " + std::to_string(steps) +
+                                  ", step: 90deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  };
+  RenderOptions options;
+  options.output_dir = dir.path().string();
+  options.scale = 0.05;
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene_with(4, "jpeg"), options, log), 0) << log.str();
+  ASSERT_TRUE(fs::exists(dir.path() / "images/shot_003.jpg"));
+  testing::write_text((dir.path() / "images/mine.jpg").string(), "not the run's");
+
+  ASSERT_EQ(run_preview(scene_with(2, "jpeg"), options, log), 0) << log.str();
+  EXPECT_NE(log.str().find("2 shots of an earlier run (shot_002 to shot_003) are no longer"),
+            std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_002.jpg"));
+  EXPECT_FALSE(fs::exists(dir.path() / "masks/shot_003.png"));
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
+  EXPECT_TRUE(fs::exists(dir.path() / "images/mine.jpg")) << "only the manifest's files go";
+  const auto manifest = backends::Manifest::load(dir.path() / "manifest.json");
+  EXPECT_EQ(manifest.shots().size(), 2u);
+
+  ASSERT_EQ(run_preview(scene_with(2, "png16"), options, log), 0) << log.str();
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_000.png"));
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg")) << "the JPEG beside the new PNG";
 }
 
 TEST(Preview, UnwritableOutputIsAUserError) {

@@ -129,6 +129,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
 
   const fs::path manifest_path = run_dir / "manifest.json";
   backends::Manifest manifest = backends::Manifest::load(manifest_path);
+  if (!backends::prune_stale_outputs(manifest, scene, run_dir, manifest_path, log)) return 2;
   const std::string content_hash = backends::scene_content_hash(scene);
   const std::string extra = fmt::format("samples={}", options.samples);
   manifest.set_backend(renderer.name());
