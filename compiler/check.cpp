@@ -19,6 +19,8 @@ namespace fs = std::filesystem;
 using spec::Target;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+constexpr std::size_t kMostLights = 32;
+
 // Real cameras' EXIF Make and Model are a few dozen characters.
 constexpr std::size_t kMaxExifText = 255;
 
@@ -549,6 +551,10 @@ void Checker::read_studio(const YAML::Node& node, spec::SceneSpec& scene) {
       error(lights,
             "lights must be a list, e.g. - {type: point, position: [1m, -1m, 1.5m], "
             "power: 200W}");
+    } else if (lights.size() > kMostLights) {
+      // Each light has a shadow map (tens of MB at full size): 2000 took 3.6 GB for one shot.
+      error(lights,
+            fmt::format("{} lights; a studio here has at most {}", lights.size(), kMostLights));
     } else {
       for (const auto& light : lights) read_light(light, scene);
     }

@@ -143,6 +143,24 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   };
   std::optional<PendingWrite> pending;
   bool manifest_failed = false;
+  // Saved after a shot once half a second has passed since the last save, and at the end, so an
+  // interrupted run resumes about where it stopped (the shots of that last half second render
+  // again). Rewriting the whole manifest after every shot made 3600 small shots take 97 s, 0.1 s
+  // of it rendering.
+  auto last_save = Clock::now() - std::chrono::hours(1);
+  bool unsaved = false;
+  auto save_manifest = [&](bool now) {
+    if (!unsaved || (!now && ms_since(last_save) < 500)) return true;
+    std::string save_error;
+    if (!manifest.save(manifest_path, &save_error)) {
+      log << fmt::format("rigc: error: {}\n", save_error);
+      manifest_failed = true;
+      return false;
+    }
+    last_save = Clock::now();
+    unsaved = false;
+    return true;
+  };
   auto finish_pending = [&]() {
     if (!pending) return;
     PendingWrite write = std::move(*pending);
@@ -175,13 +193,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
                        {"write", timing.write_ms}};
     record.files = {write.image, write.mask};
     manifest.record(record);
-    // Saved after every shot, so an interrupted run resumes where it stopped.
-    std::string save_error;
-    if (!manifest.save(manifest_path, &save_error)) {
-      log << fmt::format("rigc: error: {}\n", save_error);
-      manifest_failed = true;
-      return;
-    }
+    unsaved = true;
+    if (!save_manifest(false)) return;
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
@@ -240,7 +253,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     pending = std::move(write);
   }
   finish_pending();
-  if (manifest_failed) return 2;
+  if (manifest_failed || !save_manifest(true)) return 2;
   if (options.progress_bar) log << '\n';
 
   return backends::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);
