@@ -116,6 +116,7 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
     auto result = run_rigc(c.args);
     EXPECT_EQ(result.exit_code, 1) << c.args[0] << " " << c.message << "\n" << result.err;
     EXPECT_NE(result.err.find(c.message), std::string::npos) << result.err;
+    EXPECT_EQ(result.err.rfind("rigc: error: ", 0), 0u) << "like every error of rigc";
     EXPECT_FALSE(std::filesystem::exists(run)) << c.message;
   }
   // A seed of 0 and the largest one are seeds.

@@ -647,10 +647,11 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
   }
   if (node["direction"]) {
     if (auto d = vec3(node["direction"], QuantityKind::kNumber, "light direction")) {
-      if (d->norm() < 1e-9) {
+      // stableNorm: [1e200, 0, 0] overflowed norm() to inf and normalized() to a zero vector.
+      if (d->stableNorm() < 1e-9) {
         error(node["direction"], "light direction must not be zero");
       } else {
-        light.direction = d->normalized();
+        light.direction = d->stableNormalized();
       }
     }
   } else if (node["look_at"]) {
@@ -1071,10 +1072,10 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   }
   if (node["up"]) {
     if (auto u = vec3(node["up"], QuantityKind::kNumber, "up")) {
-      if (u->norm() < 1e-9)
+      if (u->stableNorm() < 1e-9)
         error(node["up"], "up must not be zero");
       else
-        pose.up = u->normalized();
+        pose.up = u->stableNormalized();
     }
   }
   if (node["turntable"]) {

@@ -193,6 +193,24 @@ TEST(Frontend, OrbitRingsExpandAroundTheObject) {
   EXPECT_GT(alignment, 1 - 1e-9);
 }
 
+// Directions of any length are directions: [1e200, 0, 0] overflowed norm() to inf, and the
+// pose's camera got zero right and down axes (and a non-unit quaternion in images.txt).
+TEST(Frontend, HugeDirectionVectorsStayDirections) {
+  std::string text = kMinimalScene;
+  text.replace(text.find("  - turntable:"), std::string::npos,
+               "  - pose: {position: [0.5m, -0.6m, 1.1m], look_at: object, up: [1e200, 0, 0]}\n");
+  text.replace(text.find("camera:"), 7,
+               "studio:\n  lights:\n    - {type: directional, direction: [1e300, 1e300, -1e300], "
+               "illuminance: 1000lx}\ncamera:");
+  Compiled compiled = compile_text(text);
+  ASSERT_TRUE(compiled.scene) << compiled.diagnostics;
+  const ir::Mat4& world_from_camera = compiled.scene->shots.at(0).world_from_camera;
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR((world_from_camera.block<3, 1>(0, axis).norm()), 1, 1e-9) << axis;
+  }
+  EXPECT_NEAR(compiled.scene->studio.lights.at(0).direction.norm(), 1, 1e-9);
+}
+
 TEST(Frontend, BareNumbersTakeDocumentedUnits) {
   std::string text = kMinimalScene;
   text.replace(text.find("80cm"), 4, "0.8");

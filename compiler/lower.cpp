@@ -295,6 +295,12 @@ void Lowering::lower_shots() {
         // object stays centred while it turns.
         Vec3 aim = aim_point(tt.camera.aim);
         if (tt.camera.aim.object) aim.head<2>().setZero();
+        if ((aim - eye).norm() < 1e-6) {
+          // As for a pose: the camera would get an arbitrary orientation.
+          error(tt.camera.aim.loc.line > 0 ? tt.camera.aim.loc : group.loc,
+                "the turntable camera's aim is the camera's own position");
+          break;
+        }
         const Mat4 world_from_camera = look_at(eye, aim, Vec3::UnitZ());
         for (int i = 0; i < tt.steps; ++i) {
           add_shot(ir::ShotKind::kTurntable, world_from_camera, tt.start_rad + i * tt.step_rad,

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <iostream>
 #include <optional>
 #include <string>
 #include <utility>
@@ -11,14 +12,16 @@
 namespace rigc::backends {
 
 // Parses a verb's options; returns the exit code when parsing ended the run (0 after --help, 1
-// after an error: the message is printed).
+// after an error, printed as `rigc: error: ...` like every other error of rigc).
 inline std::optional<int> parse_options(CLI::App& app, const std::vector<std::string>& args) {
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());
   try {
     app.parse(static_cast<int>(argv.size()), argv.data());
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 1;
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::cerr << "rigc: error: " << e.what() << "\nRun with --help for more information.\n";
+    return 1;
   }
   return std::nullopt;
 }

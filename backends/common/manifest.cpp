@@ -76,8 +76,11 @@ bool Manifest::is_done(const std::string& name, const std::string& key,
   const ShotRecord* record = find(name);
   if (record == nullptr || record->key != key || key.empty()) return false;
   for (const auto& file : record->files) {
+    // An empty file is no image (a disk that filled up, a file truncated by hand).
     std::error_code ec;
     if (!fs::is_regular_file(run_dir / file, ec)) return false;
+    const auto bytes = fs::file_size(run_dir / file, ec);
+    if (ec || bytes == 0) return false;
   }
   return true;
 }

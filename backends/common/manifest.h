@@ -32,7 +32,7 @@ class Manifest {
   static Manifest load(const std::filesystem::path& path);
 
   // True when the entry for `name` has this (non-empty) key and every file it lists exists in
-  // run_dir.
+  // run_dir and is not empty.
   bool is_done(const std::string& name, const std::string& key,
                const std::filesystem::path& run_dir) const;
   // Adds or replaces the entry for record.name.

@@ -52,6 +52,12 @@ TEST(BackendManifest, SaveLoadAndIsDone) {
   EXPECT_FALSE(loaded.is_done("shot_000", "abd", run.path()));  // changed key
   EXPECT_FALSE(loaded.is_done("shot_001", "abc", run.path()));  // no entry
 
+  // An emptied output (a full disk, a file truncated by hand) is no output.
+  write_text((run.path() / "images/shot_000.jpg").string(), "");
+  EXPECT_FALSE(loaded.is_done("shot_000", "abc", run.path()));
+  write_outputs(run.path());
+  EXPECT_TRUE(loaded.is_done("shot_000", "abc", run.path()));
+
   fs::remove(run.path() / "masks/shot_000.png");  // a deleted output
   EXPECT_FALSE(loaded.is_done("shot_000", "abc", run.path()));
 }
