@@ -96,11 +96,18 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
         camera, 1.0, std::abs(shot.turntable_velocity_rad_s), radius, depth);
     if (blur_px > 1) {
       last_line = shot.loc.line;
-      diag.warning(shot.loc,
-                   fmt::format("the turning table smears the object by up to {:.1f} px "
-                               "during the {:g} s exposure; stop the table for each "
-                               "shot or use 1/{:.0f} s or shorter",
-                               blur_px, camera.shutter_s, std::ceil(blur_px / camera.shutter_s)));
+      // A shutter that keeps the smear under a pixel, if a camera has one (1/8000 s is the
+      // fastest the language takes).
+      const double fastest_denominator = 8000;
+      const double needed_denominator = std::ceil(blur_px / camera.shutter_s);
+      const std::string remedy =
+          needed_denominator <= fastest_denominator
+              ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
+                            needed_denominator)
+              : std::string("stop the table for each shot (no shutter is fast enough)");
+      diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} "
+                                         "px during the {:g} s exposure; {}",
+                                         blur_px, camera.shutter_s, remedy));
     }
   }
   // Faces never seen (the base resting on the table cannot be, so it does not count).

@@ -147,6 +147,11 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
        "  - turntable: {steps: 18, step: 20deg, speed: 20deg/s, camera: {distance: 90cm, "
        "height: 15cm}}\n",
        "", "the turning table smears the object"},
+      // Beyond any shutter the language takes (1/8000 s): no 1/147408 s advice.
+      {"motion blur, no shutter helps", kGoodExposure,
+       "  - turntable: {steps: 18, step: 20deg, speed: 120rpm, camera: {distance: 90cm, "
+       "height: 15cm}}\n",
+       "", "stop the table for each shot (no shutter is fast enough)"},
       {"unseen top", kGoodExposure,
        "  - turntable: {steps: 18, step: 20deg, camera: {distance: 90cm, height: -5cm}}\n", "",
        "add a ring at a higher elevation"},
