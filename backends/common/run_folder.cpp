@@ -1,12 +1,15 @@
 #include "backends/common/run_folder.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <map>
 #include <ostream>
 #include <set>
+#include <system_error>
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/transforms_json.h"
@@ -37,6 +40,30 @@ bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& ex
   }
   if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
     log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
+    return false;
+  }
+  return true;
+}
+
+RunFolderLock::~RunFolderLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases its flock
+}
+
+bool RunFolderLock::acquire(const fs::path& run_dir, std::ostream& log) {
+  const fs::path path = run_dir / ".rigc.lock";
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    log << fmt::format("rigc: error: cannot create {}: {}\n", path.string(),
+                       std::system_category().message(errno));
+    return false;
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    log << fmt::format(
+        "rigc: error: another rigc is writing to the run folder '{}'; wait for it "
+        "or choose another folder with -o\n",
+        run_dir.string());
+    ::close(fd_);
+    fd_ = -1;
     return false;
   }
   return true;

@@ -110,6 +110,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     return 1;
   }
   if (!backends::prepare_run_folder(run_dir, {}, log)) return 1;
+  backends::RunFolderLock lock;
+  if (!lock.acquire(run_dir, log)) return 1;
   std::vector<int> shots = options.shots;
   if (shots.empty()) {
     for (const auto& shot : scene.shots) shots.push_back(shot.index);

@@ -10,6 +10,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/manifest.h"
+#include "backends/common/run_folder.h"
 #include "backends/preview/preview_backend.h"
 #include "backends/preview/studio_scene.h"
 #include "compiler/frontend.h"
@@ -1003,6 +1004,26 @@ TEST(Preview, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
   ASSERT_EQ(run_preview(scene_with(2, "png16"), options, log), 0) << log.str();
   EXPECT_TRUE(fs::exists(dir.path() / "images/shot_000.png"));
   EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg")) << "the JPEG beside the new PNG";
+}
+
+// Two renders into one folder at once each saved their own manifest over the other's.
+TEST(Preview, ASecondRenderIntoABusyRunFolderIsRefused) {
+  testing::TempDir dir;
+  ir::Scene scene = compile(ball_scene(
+      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  RenderOptions options;
+  options.output_dir = dir.path().string();
+  options.scale = 0.05;
+  std::ostringstream log;
+  {
+    backends::RunFolderLock other;  // as another rigc process would hold it
+    ASSERT_TRUE(other.acquire(dir.path(), log)) << log.str();
+    EXPECT_EQ(run_preview(scene, options, log), 1);
+    EXPECT_NE(log.str().find("another rigc is writing to the run folder"), std::string::npos)
+        << log.str();
+    EXPECT_FALSE(fs::exists(dir.path() / "manifest.json"));
+  }
+  EXPECT_EQ(run_preview(scene, options, log), 0) << log.str();
 }
 
 TEST(Preview, UnwritableOutputIsAUserError) {

@@ -104,6 +104,8 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
   const fs::path run_dir = options.output_dir;
   const fs::path work_dir = render_folder(run_dir);
   if (!backends::prepare_run_folder(run_dir, {work_dir}, log)) return 1;
+  backends::RunFolderLock lock;
+  if (!lock.acquire(run_dir, log)) return 1;
   if (!(options.scale > 0) || options.samples < 0) {
     log << "rigc: error: the scale must be positive and the samples not negative\n";
     return 1;
