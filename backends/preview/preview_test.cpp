@@ -60,6 +60,22 @@ shots:
 )" + shots;
 }
 
+// The ball scene with one turntable group of `steps` shots `step` apart, 40 cm away.
+ir::Scene turntable_ball(int steps, const std::string& step,
+                         const std::string& camera_extra = "}") {
+  return compile(ball_scene(camera_extra, "  - turntable: {steps: " + std::to_string(steps) +
+                                              ", step: " + step +
+                                              ", camera: {distance: 40cm, height: 1cm}}\n"));
+}
+
+// A run into `dir` at 5 % of the sensor: a few kilobytes a shot.
+RenderOptions small_run(const fs::path& dir) {
+  RenderOptions options;
+  options.output_dir = dir.string();
+  options.scale = 0.05;
+  return options;
+}
+
 struct Blob {
   double x = 0, y = 0, mass = 0;
   int min_x = 1 << 30, max_x = -1;
@@ -947,11 +963,8 @@ TEST(Preview, SameSeedGivesIdenticalImagesOtherSeedDiffers) {
 
 TEST(Preview, RunWritesTheLayoutAndResumes) {
   testing::TempDir dir;
-  ir::Scene scene = compile(ball_scene(
-      "}", "  - turntable: {steps: 3, step: 120deg, camera: {distance: 40cm, height: 1cm}}\n"));
-  RenderOptions options;
-  options.output_dir = dir.path().string();
-  options.scale = 0.05;
+  ir::Scene scene = turntable_ball(3, "120deg");
+  RenderOptions options = small_run(dir.path());
   std::ostringstream log;
   ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
   for (const char* file :
@@ -978,13 +991,9 @@ TEST(Preview, RunWritesTheLayoutAndResumes) {
 TEST(Preview, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
   testing::TempDir dir;
   auto scene_with = [](int steps, const char* format) {
-    return compile(ball_scene(std::string("}\n  output: {format: ") + format + "}",
-                              "  - turntable: {steps: " + std::to_string(steps) +
-                                  ", step: 90deg, camera: {distance: 40cm, height: 1cm}}\n"));
+    return turntable_ball(steps, "90deg", std::string("}\n  output: {format: ") + format + "}");
   };
-  RenderOptions options;
-  options.output_dir = dir.path().string();
-  options.scale = 0.05;
+  RenderOptions options = small_run(dir.path());
   std::ostringstream log;
   ASSERT_EQ(run_preview(scene_with(4, "jpeg"), options, log), 0) << log.str();
   ASSERT_TRUE(fs::exists(dir.path() / "images/shot_003.jpg"));
@@ -1009,11 +1018,8 @@ TEST(Preview, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
 // Two renders into one folder at once each saved their own manifest over the other's.
 TEST(Preview, ASecondRenderIntoABusyRunFolderIsRefused) {
   testing::TempDir dir;
-  ir::Scene scene = compile(ball_scene(
-      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
-  RenderOptions options;
-  options.output_dir = dir.path().string();
-  options.scale = 0.05;
+  ir::Scene scene = turntable_ball(1, "0deg");
+  RenderOptions options = small_run(dir.path());
   std::ostringstream log;
   {
     backends::RunFolderLock other;  // as another rigc process would hold it
@@ -1033,11 +1039,8 @@ TEST(Preview, UnwritableOutputIsAUserError) {
     // Running as root: permissions do not stop us, so use a path under a regular file instead.
     testing::write_text(dir.file("file"), "x");
   }
-  ir::Scene scene = compile(ball_scene(
-      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
-  RenderOptions options;
-  options.output_dir = (dir.path() / "file" / "run").string();
-  options.scale = 0.05;
+  ir::Scene scene = turntable_ball(1, "0deg");
+  RenderOptions options = small_run(dir.path() / "file" / "run");
   std::ostringstream log;
   EXPECT_EQ(run_preview(scene, options, log), 1);
   EXPECT_NE(log.str().find("cannot create the output folder"), std::string::npos) << log.str();
@@ -1045,12 +1048,10 @@ TEST(Preview, UnwritableOutputIsAUserError) {
 
 TEST(Preview, ANonFiniteScaleIsRejectedBeforeAnythingIsWritten) {
   testing::TempDir dir;
-  ir::Scene scene = compile(ball_scene(
-      "}", "  - turntable: {steps: 1, step: 0deg, camera: {distance: 40cm, height: 1cm}}\n"));
+  ir::Scene scene = turntable_ball(1, "0deg");
   for (double scale : {std::numeric_limits<double>::quiet_NaN(),
                        std::numeric_limits<double>::infinity(), 0.0, -0.5}) {
-    RenderOptions options;
-    options.output_dir = (dir.path() / "run").string();
+    RenderOptions options = small_run(dir.path() / "run");
     options.scale = scale;
     std::ostringstream log;
     EXPECT_EQ(run_preview(scene, options, log), 1) << scale;
