@@ -197,6 +197,18 @@ bool Lowering::lower_object() {
   out.object_from_mesh = translation(rest_on_table + object.translate) * shaped;
   transformed_bounds(out.mesh, out.object_from_mesh, &out.bounds_min_object,
                      &out.bounds_max_object);
+  // An object a camera can photograph: `scale: 1e-300` made one of zero size (coverage printed
+  // -nan), and `translate: [1e300m, 0, 0]` put it beyond any float.
+  const double size_m = (out.bounds_max_object - out.bounds_min_object).maxCoeff();
+  const double offset_m =
+      out.bounds_min_object.cwiseAbs().cwiseMax(out.bounds_max_object.cwiseAbs()).maxCoeff();
+  if (!(size_m >= 1e-3 && size_m <= 100 && offset_m <= 1000)) {
+    error(object.loc, fmt::format("the object is {:.3g} m across and reaches {:.3g} m from the "
+                                  "table's centre after fit, scale and translate; it must be "
+                                  "1 mm to 100 m across and within 1 km",
+                                  size_m, offset_m));
+    return false;
+  }
   object_center_ = (out.bounds_min_object + out.bounds_max_object) / 2;
   const double radius = (out.bounds_max_object - out.bounds_min_object).head<2>().norm() / 2;
   if (radius > scene_.studio.turntable.diameter_m / 2 * 1.5) {

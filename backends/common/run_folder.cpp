@@ -13,6 +13,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/transforms_json.h"
+#include "io/atomic_file.h"
 
 namespace rigc::backends {
 
@@ -40,6 +41,12 @@ bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& ex
   }
   if (access(run_dir.c_str(), W_OK) != 0 || access((run_dir / "images").c_str(), W_OK) != 0) {
     log << fmt::format("rigc: error: the output folder '{}' is not writable\n", run_dir.string());
+    return false;
+  }
+  // Before any shot renders: a folder named manifest.json let the whole run render, then fail.
+  std::string error;
+  if (file_to_replace(run_dir / "manifest.json", &error).empty()) {
+    log << fmt::format("rigc: error: {}\n", error);
     return false;
   }
   return true;

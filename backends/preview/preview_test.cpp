@@ -1032,6 +1032,18 @@ TEST(Preview, ASecondRenderIntoABusyRunFolderIsRefused) {
   EXPECT_EQ(run_preview(scene, options, log), 0) << log.str();
 }
 
+// A folder named manifest.json let every shot render, and then the run failed (exit 2).
+TEST(Preview, AManifestThatIsNoFileStopsTheRunBeforeItRenders) {
+  testing::TempDir dir;
+  fs::create_directories(dir.path() / "manifest.json");
+  RenderOptions options = small_run(dir.path());
+  std::ostringstream log;
+  EXPECT_EQ(run_preview(turntable_ball(1, "0deg"), options, log), 1);
+  EXPECT_NE(log.str().find("manifest.json: it is not a regular file"), std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg"));
+}
+
 TEST(Preview, UnwritableOutputIsAUserError) {
   testing::TempDir dir;
   fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
