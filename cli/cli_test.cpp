@@ -111,6 +111,11 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
       {{"eval", run, "--tau", "nan"}, "--tau: 'nan' is not a finite number"},
       {{"eval", run, "--color-range", "-1"}, "--color-range: '-1' is not above 0"},
       {{"compare", scene, "-o", run, "--scale", "-nan"}, "is not a finite number"},
+      // strtod reads hexadecimal: "0x1" was a scale of 1.
+      {{"render", scene, "-o", run, "--scale", "0x1"}, "--scale: '0x1' is not a number"},
+      {{"render", scene, "-o", run, "--scale", "0.5cm"}, "--scale: '0.5cm' is not a number"},
+      // An empty selection (a shell variable that came out empty) is not "every shot".
+      {{"render", scene, "-o", run, "--shots", ""}, "--shots: the shot selection is empty"},
   };
   for (const Case& c : cases) {
     auto result = run_rigc(c.args);

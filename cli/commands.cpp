@@ -151,7 +151,7 @@ int run_compile(std::vector<std::string> args) {
 
 int run_render(std::vector<std::string> args) {
   CLI::App app{"Render every shot of a scene with a backend, in RigC's output layout."};
-  std::string scene_path, backend = "preview", output, shot_text;
+  std::string scene_path, backend = "preview", output, shot_text = "all";
   double scale = 1.0;
   std::uint64_t seed = 1;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
@@ -163,7 +163,8 @@ int run_render(std::vector<std::string> args) {
                  "samples per pixel for povray and cycles (0: the backend's default)")
       ->check(non_negative_number());
   app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
-  app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 (default: all)");
+  app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 or all")
+      ->capture_default_str();
   app.add_option("--scale", scale, "multiplies the sensor resolution, for quick looks")
       ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))

@@ -394,7 +394,7 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
     const YAML::Node fit = node["fit"];
     if (expect_map(fit, "fit")) {
       check_keys(fit, {"height", "width", "size"}, "fit");
-      if (fit.size() > 1) error(fit, "fit takes one of height, width or size");
+      if (fit.size() != 1) error(fit, "fit takes one of height, width or size");
       auto read = [&](const char* key, std::optional<spec::Located<double>>& out) {
         if (!fit[key]) return;
         if (auto v = quantity(fit[key], QuantityKind::kLength, fmt::format("fit {}", key),
@@ -777,9 +777,17 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
   for (const auto& [key, field] : {std::pair{"make", &camera.make}, {"model", &camera.model}}) {
     if (!node[key]) continue;
     if (auto v = scalar(node[key], key)) {
+      // EXIF text is NUL-terminated: a "\0" cut the tag short without a word.
+      const bool control = std::any_of(v->begin(), v->end(), [](unsigned char c) {
+        return c < 0x20 || c == 0x7F;
+      });
       if (v->size() > kMaxExifText) {
         error(node[key],
               fmt::format("camera {} is {} bytes long; at most {}", key, v->size(), kMaxExifText));
+      } else if (control) {
+        error(node[key], fmt::format("camera {} holds a control character (EXIF text is one line "
+                                     "of printable characters)",
+                                     key));
       } else {
         *field = *v;
       }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <cmath>
 #include <iostream>
 #include <optional>
@@ -30,13 +31,19 @@ inline std::optional<int> parse_options(CLI::App& app, const std::vector<std::st
 // the text and `complaint`. CLI11's Range and PositiveNumber let NaN through (every comparison
 // with it is false): `rigc render --scale nan` rendered a shot, recorded it in the manifest
 // without its files and failed only at the end. Their messages also print a bound of 1.8e308 in
-// full, and CLI11 reads "-1" into an unsigned option as 2^64 - 1.
+// full, and CLI11 reads "-1" into an unsigned option as 2^64 - 1. Only decimal numbers are
+// taken: strtod, under CLI11, also reads hexadecimal ("0x1" was a scale of 1).
 template <typename Accept>
 CLI::Validator finite_number_where(Accept accept, std::string complaint, std::string name) {
   return CLI::Validator(
       [accept, complaint](std::string& text) -> std::string {
         double value = 0;
-        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        const char* first = text.data() + (text.starts_with('+') ? 1 : 0);
+        const char* last = text.data() + text.size();
+        const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
+        if (first == last || error != std::errc() || end != last) {
+          return "'" + text + "' is not a number";
+        }
         if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
         return accept(value) ? std::string() : "'" + text + "' " + complaint;
       },

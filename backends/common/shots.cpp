@@ -41,7 +41,14 @@ std::optional<std::vector<int>> parse_shot_selection(const std::string& text, in
                                            : "the scene has no shots";
   const std::string_view all = trim(text);
   std::vector<int> selected;
-  if (all.empty() || all == "all") {
+  // An empty `--shots ''` is refused rather than read as "all": it is usually a shell variable
+  // that came out empty, and rendering every shot of a big scene is not what was meant.
+  if (all.empty()) {
+    return fail(fmt::format("the shot selection is empty: give indices and ranges like 0,3,5-7 "
+                            "or 'all' ({})",
+                            range));
+  }
+  if (all == "all") {
     for (int i = 0; i < shot_count; ++i) selected.push_back(i);
     return selected;
   }

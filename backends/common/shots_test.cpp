@@ -28,10 +28,15 @@ TEST(BackendShots, ParsesIndicesAndRanges) {
   EXPECT_EQ(parse_ok("3-3", 10), (std::vector<int>{3}));
 }
 
-TEST(BackendShots, EmptyOrAllSelectsEverything) {
-  EXPECT_EQ(parse_ok("", 3), (std::vector<int>{0, 1, 2}));
+TEST(BackendShots, AllSelectsEverythingAndEmptyIsAnError) {
   EXPECT_EQ(parse_ok("all", 3), (std::vector<int>{0, 1, 2}));
-  EXPECT_EQ(parse_ok("", 0), (std::vector<int>{}));
+  EXPECT_EQ(parse_ok(" all ", 3), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(parse_ok("all", 0), (std::vector<int>{}));
+  for (const char* text : {"", "  "}) {
+    const std::string error = parse_error(text, 3);
+    EXPECT_NE(error.find("empty"), std::string::npos) << error;
+    EXPECT_NE(error.find("0..2"), std::string::npos) << error;
+  }
 }
 
 TEST(BackendShots, ReportsErrorsWithTheValidRange) {
