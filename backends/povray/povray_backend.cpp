@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <ostream>
 #include <regex>
+#include <set>
 
 #include "backends/common/files.h"
 #include "backends/preview/preview_backend.h"
@@ -299,6 +301,27 @@ bool write_text_file(const fs::path& path, const std::string& text, std::string*
   return backends::write_file_atomically(path, text, error);
 }
 
+// The shots whose .pov and .ini files the last emit into a folder wrote, one name a line. An
+// emit into a folder that held more shots (`compile --target povray` after shots were removed)
+// deletes those shots' files, and only those: a `povray` over every .ini there rendered shots
+// the scene no longer has.
+constexpr const char* kShotListFile = "shots.txt";
+
+void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
+  std::ifstream listed(dir / kShotListFile);
+  std::set<std::string> current;
+  for (const auto& shot : scene.shots) current.insert(shot.name);
+  std::string name;
+  while (std::getline(listed, name)) {
+    // Only names an emit could have written: a plain file stem, not a path.
+    if (current.count(name) || !reference::is_plain_file_stem(name)) continue;
+    for (const char* suffix : {".pov", ".ini", "_mask.ini"}) {
+      std::error_code ec;
+      if (fs::is_regular_file(dir / (name + suffix), ec)) fs::remove(dir / (name + suffix), ec);
+    }
+  }
+}
+
 class PovrayRenderer : public reference::Renderer {
  public:
   std::string name() const override { return "povray"; }
@@ -377,6 +400,7 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   const dslr::Intrinsics canvas = dslr::render_geometry_for(scene.camera, scale);
   subframes->assign(scene.shots.size(), 1);
   const bool focal_blur = scene.camera.effects.depth_of_field;
+  remove_stale_shot_files(scene, dir);
   for (const auto& shot : scene.shots) {
     const int count = subframes_for(scene, studio, shot, scale);
     (*subframes)[shot.index] = count;
@@ -389,7 +413,9 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
       return false;
     }
   }
-  return true;
+  std::string shot_list;
+  for (const auto& shot : scene.shots) shot_list += shot.name + '\n';
+  return write_text_file(dir / kShotListFile, shot_list, error);
 }
 
 bool run_povray(const fs::path& dir, const std::string& ini, const fs::path& log_path,

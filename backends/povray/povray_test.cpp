@@ -1,7 +1,9 @@
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "backends/povray/povray_backend.h"
@@ -61,6 +63,31 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   const std::string pov = read_text((dir.path() / "pov" / "shot_000.pov").string());
   EXPECT_NE(pov.find("aperture"), std::string::npos);  // f-number mapped to focal blur
   EXPECT_NE(pov.find("focal_point"), std::string::npos);
+}
+
+TEST(PovrayEmit, AnEmitWithFewerShotsRemovesOnlyTheFilesOfTheShotsItNoLongerHas) {
+  ir::Scene scene = paper_scene();
+  ASSERT_EQ(scene.shots.size(), 18u);
+  TempDir dir;
+  const fs::path out = dir.path() / "pov";
+  std::string error;
+  ASSERT_TRUE(emit(scene, out, 0.05, &error)) << error;
+  EXPECT_TRUE(fs::exists(out / "shot_017.ini"));
+  // The user's own files in the folder stay, whatever their names.
+  fs::create_directories(out);
+  std::ofstream(out / "notes.ini") << "mine\n";
+  std::ofstream(out / "shot_099.pov") << "mine\n";
+  scene.shots.resize(4);
+  ASSERT_TRUE(emit(scene, out, 0.05, &error)) << error;
+  for (int i = 0; i < 18; ++i) {
+    const std::string stem = fmt::format("shot_{:03d}", i);
+    for (const char* suffix : {".pov", ".ini", "_mask.ini"}) {
+      EXPECT_EQ(fs::exists(out / (stem + suffix)), i < 4) << stem << suffix;
+    }
+  }
+  EXPECT_TRUE(fs::exists(out / "notes.ini"));
+  EXPECT_TRUE(fs::exists(out / "shot_099.pov"));
+  EXPECT_EQ(read_text((out / "shots.txt").string()), "shot_000\nshot_001\nshot_002\nshot_003\n");
 }
 
 TEST(PovrayEmit, TurningTableGetsMotionBlurSubframes) {
