@@ -1,5 +1,6 @@
 #include "eval/eval.h"
 
+#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
@@ -200,8 +201,34 @@ bool every_image_planned(const std::vector<std::string>& image_names,
 }
 
 // Features, matches, mapper, text export of the largest model.
-ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs::path& run_dir,
-                     const fs::path& out, const std::vector<std::string>& image_names,
+// What the image headers said, read before COLMAP runs.
+struct ImageSet {
+  bool one_size = true;       // every image the same width and height
+  bool all_eight_bit = true;  // COLMAP 3.8 reads 8-bit images only
+};
+
+// Writes every image of `from` into `to` as 8 bits a channel, under the same name: COLMAP 3.8
+// cannot read the 16-bit PNG and TIFF that a camera's `output: {format: png16}` writes (its
+// matcher then aborted), and its SIFT works on 8-bit grey anyway.
+bool write_eight_bit_copies(const fs::path& from, const fs::path& to,
+                            const std::vector<std::string>& names, std::string* error) {
+  std::error_code ec;
+  fs::create_directories(to, ec);
+  for (const auto& name : names) {
+    OIIO::ImageBuf image((from / name).string());
+    if (!image.read(0, 0, true, OIIO::TypeDesc::UINT8) ||
+        !image.write((to / name).string(), OIIO::TypeDesc::UINT8)) {
+      *error = fmt::format("cannot write an 8-bit copy of {} for COLMAP: {}",
+                           (from / name).string(), image.geterror());
+      return false;
+    }
+  }
+  return true;
+}
+
+ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, const ImageSet& set,
+                     const fs::path& run_dir, const fs::path& out,
+                     const std::vector<std::string>& image_names,
                      const std::map<std::string, ir::Mat4>& planned_poses, std::ostream& log) {
   ColmapRun r;
   const int image_count = static_cast<int>(image_names.size());
@@ -228,6 +255,17 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
   fs::create_directories(work / "sparse", ec);
   fs::create_directories(logs, ec);
   std::string error;
+  fs::path images_dir = given_images_dir;
+  if (!set.all_eight_bit) {
+    images_dir = work / "images_8bit";
+    if (!o.quiet)
+      log << "rigc eval: 8-bit copies of the images for COLMAP in " << images_dir.string() << "\n";
+    if (!write_eight_bit_copies(given_images_dir, images_dir, image_names, &error)) {
+      r.exit_code = 2;
+      r.failure = error;
+      return r;
+    }
+  }
   auto flags = probe_colmap(o.colmap, logs, &error);
   if (!flags) {
     r.exit_code = 2;
@@ -235,14 +273,11 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& images_dir, const fs:
     return r;
   }
   const fs::path db = work / "database.db";
-  std::vector<std::string> fe = {o.colmap,
-                                 "feature_extractor",
-                                 "--database_path",
-                                 db.string(),
-                                 "--image_path",
-                                 images_dir.string(),
-                                 "--ImageReader.single_camera",
-                                 "1"};
+  std::vector<std::string> fe = {o.colmap, "feature_extractor", "--database_path", db.string(),
+                                 "--image_path", images_dir.string(), "--ImageReader.single_camera",
+                                 // One camera for photos of one size; COLMAP refuses a single
+                                 // camera over images of different sizes.
+                                 set.one_size ? "1" : "0"};
   if (!flags->extraction_gpu.empty()) {
     fe.push_back(flags->extraction_gpu);
     fe.push_back("0");
@@ -441,6 +476,11 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const fs::path run_dir = photos ? fs::path(o.photos_dir) : fs::path(o.run_dir);
   fs::path images_dir = run_dir / "images";
   if (photos && !fs::is_directory(images_dir)) images_dir = run_dir;
+  std::error_code exists_ec;
+  if (!fs::exists(run_dir, exists_ec)) {
+    log << fmt::format("rigc eval: error: {} does not exist\n", run_dir.string());
+    return 1;
+  }
   if (!fs::is_directory(images_dir)) {
     log << fmt::format("rigc eval: error: {} has no images/ folder (is it a run folder?)\n",
                        run_dir.string());
@@ -456,8 +496,16 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   // cannot read, and a folder with such files ended in the matcher aborting (exit 134) without a
   // word of which file it was.
   std::vector<std::string> unreadable;
+  std::map<std::string, std::pair<int, int>> image_size;
+  ImageSet image_set;
   for (const auto& name : image_names) {
-    if (OIIO::ImageInput::open((images_dir / name).string())) continue;
+    if (auto input = OIIO::ImageInput::open((images_dir / name).string())) {
+      const OIIO::ImageSpec& spec = input->spec();
+      image_size[name] = {spec.width, spec.height};
+      image_set.one_size = image_set.one_size && image_size[name] == image_size.begin()->second;
+      image_set.all_eight_bit = image_set.all_eight_bit && spec.format == OIIO::TypeDesc::UINT8;
+      continue;
+    }
     std::string why = OIIO::geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
     unreadable.push_back(fmt::format("{}: {}", (images_dir / name).string(), why));
@@ -507,6 +555,20 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     }
     for (const auto& im : *images) gt_poses[im.name] = im.camera_from_world;
     gt_camera = cams->front();
+    // COLMAP takes this camera as every image's intrinsics: a size that is not the images' own
+    // tripped an assertion in OpenImageIO (a height of 3) or took 24 GB (a height of 547000).
+    for (const auto& [name, size] : image_size) {
+      if (size != std::pair{gt_camera->width, gt_camera->height}) {
+        log << fmt::format(
+            "rigc eval: error: {} is {}x{} pixels, but {} gives the camera as {}x{}\n",
+            (images_dir / name).string(), size.first, size.second,
+            (run_dir / "sparse" / "cameras.txt").string(), gt_camera->width, gt_camera->height);
+        return 1;
+      }
+    }
+  }
+  if (!image_set.one_size && !o.quiet) {
+    log << "rigc eval: the photos differ in size: COLMAP gets one camera per photo\n";
   }
   if (o.matcher == "neighbours" && !every_image_planned(image_names, gt_poses)) {
     log << fmt::format(
@@ -527,7 +589,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
 
   // 1. COLMAP.
   const double setup_s = seconds_since(t_start);  // ground truth and poses
-  ColmapRun colmap = run_colmap(o, images_dir, run_dir, out, image_names, gt_poses, log);
+  ColmapRun colmap = run_colmap(o, images_dir, image_set, run_dir, out, image_names, gt_poses, log);
   report["colmap"] = {{"steps", colmap.steps},
                       {"seconds", colmap.seconds},
                       {"matching", colmap.matching},

@@ -399,6 +399,40 @@ TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
   EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "nothing is written";
 }
 
+TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "run" / "images");
+  fs::create_directories(dir.path() / "run" / "sparse");
+  for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
+  write_cube_ply(dir.file("cube.ply"));
+  rigc::testing::write_text(dir.file("run/sparse/images.txt"),
+                            "1 1 0 0 0 0 0 1 1 a.jpg\n\n2 1 0 0 0 0.1 0 1 1 b.jpg\n\n");
+  EvalOptions o;
+  o.run_dir = dir.file("run");
+  o.ground_truth = dir.file("cube.ply");
+  o.output_dir = dir.file("eval");
+  o.colmap = dir.file("no-such-colmap");
+  // The images are 16 x 16: a camera of 16 x 3 tripped an assertion in OpenImageIO.
+  rigc::testing::write_text(dir.file("run/sparse/cameras.txt"),
+                            "1 OPENCV 16 3 20 20 8 8 0 0 0 0\n");
+  std::ostringstream log;
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("a.jpg is 16x16 pixels, but"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("gives the camera as 16x3"), std::string::npos) << log.str();
+  // An empty camera file printed "rigc eval: error: " and nothing more.
+  rigc::testing::write_text(dir.file("run/sparse/cameras.txt"), "");
+  log.str("");
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("cameras.txt lists no camera"), std::string::npos) << log.str();
+  // A photos folder that is not there is named as such.
+  o = EvalOptions{};
+  o.photos_dir = dir.file("nothere");
+  o.ground_truth = dir.file("cube.ply");
+  log.str("");
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("nothere does not exist"), std::string::npos) << log.str();
+}
+
 // ---------------------------------------------------------------------------------------------
 // End to end with COLMAP: SLOW (the textured one takes about 1-2 minutes on 2 busy cores, the
 // untextured one seconds). Skipped without colmap. Filter them out with -EvalEndToEnd.*
@@ -479,6 +513,44 @@ shots:
   for (const auto& entry : fs::directory_iterator(run.run_dir / "eval")) {
     EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
   }
+}
+
+// COLMAP 3.8 reads 8-bit images only: a run in the language's own 16-bit PNG made its matcher
+// abort (exit 134). Eval hands it 8-bit copies.
+TEST(EvalEndToEnd, SlowSixteenBitRunIsEvaluated) {
+  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
+  rigc::testing::TempDir dir;
+  const RenderedRun run = render(dir, R"(rigc: 1
+name: eval-e2e-png16
+object:
+  primitive: {shape: statue, detail: 4, seed: 3}
+  fit: {height: 25cm}
+  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
+studio:
+  backdrop: {green_screen: true}
+  lights:
+    - {type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
+  ambient: 50lx
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm}
+  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
+  effects: {motion_blur: false}
+  output: {format: png16}
+shots:
+  - turntable: {steps: 8, step: 20deg, camera: {distance: 70cm, height: 15cm}}
+)",
+                                 0.12);
+  ASSERT_TRUE(fs::exists(run.run_dir / "images" / "shot_000.png"));
+  EvalOptions o;
+  o.run_dir = run.run_dir.string();
+  o.quiet = true;
+  o.ground_truth_samples = 20000;
+  std::ostringstream log;
+  EvalSummary s;
+  ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
+  EXPECT_EQ(s.registered, 8);
+  EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "colmap" / "images_8bit" / "shot_000.png"));
 }
 
 TEST(EvalEndToEnd, SlowUntexturedObjectReportsTheFailure) {

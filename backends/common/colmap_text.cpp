@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string_view>
@@ -211,6 +212,7 @@ bool read_lines(const fs::path& path, std::string* error, OnLine on_line) {
 std::optional<std::vector<ColmapImage>> read_colmap_images(const fs::path& path,
                                                            std::string* error) {
   std::vector<ColmapImage> images;
+  std::set<std::string> names;
   const bool ok = read_lines(
       path, error,
       [&](std::istream& in, const std::string& line, int& number, std::string* message) {
@@ -231,6 +233,14 @@ std::optional<std::vector<ColmapImage>> read_colmap_images(const fs::path& path,
           name.remove_suffix(1);
         }
         image.name = std::string(name);
+        if (!std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) {
+          *message = "the pose holds a number that is not finite";
+          return false;
+        }
+        if (!names.insert(image.name).second) {
+          *message = fmt::format("image '{}' is listed twice", image.name);
+          return false;
+        }
         Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
         if (!(q.norm() > 0)) {
           *message = "the quaternion is zero";
@@ -248,6 +258,54 @@ std::optional<std::vector<ColmapImage>> read_colmap_images(const fs::path& path,
   if (!ok) return std::nullopt;
   return images;
 }
+
+namespace {
+
+// What COLMAP could not use in a camera line (empty if nothing): its model with the parameter
+// count COLMAP expects, a size of real images, finite parameters and positive focal lengths. A
+// wrong height reached OpenImageIO as an assertion, and a huge one took 24 GB before the kernel
+// stopped it; a NaN focal length made COLMAP's matcher abort.
+std::string camera_problem(const ColmapCamera& camera) {
+  // COLMAP's camera models and their parameter counts (colmap/sensor/models.h); the focal
+  // lengths come first in every one of them (one for the SIMPLE_ models, fx and fy otherwise).
+  static const std::map<std::string, std::pair<std::size_t, int>> kModels = {
+      {"SIMPLE_PINHOLE", {3, 1}},
+      {"PINHOLE", {4, 2}},
+      {"SIMPLE_RADIAL", {4, 1}},
+      {"RADIAL", {5, 1}},
+      {"OPENCV", {8, 2}},
+      {"OPENCV_FISHEYE", {8, 2}},
+      {"FULL_OPENCV", {12, 2}},
+      {"FOV", {5, 2}},
+      {"SIMPLE_RADIAL_FISHEYE", {4, 1}},
+      {"RADIAL_FISHEYE", {5, 1}},
+      {"THIN_PRISM_FISHEYE", {12, 2}}};
+  const auto model = kModels.find(camera.model);
+  if (model == kModels.end()) {
+    return fmt::format("unknown camera model '{}' (COLMAP's are PINHOLE, OPENCV, ...)",
+                       camera.model);
+  }
+  const auto [count, focals] = model->second;
+  if (camera.params.size() != count) {
+    return fmt::format("camera model {} takes {} parameters, not {}", camera.model, count,
+                       camera.params.size());
+  }
+  constexpr int kLargestSide = 100000;
+  if (camera.width < 1 || camera.height < 1 || camera.width > kLargestSide ||
+      camera.height > kLargestSide) {
+    return fmt::format("camera size {}x{} is not an image size (1 to {} pixels a side)",
+                       camera.width, camera.height, kLargestSide);
+  }
+  for (double p : camera.params) {
+    if (!std::isfinite(p)) return "a camera parameter is not a finite number";
+  }
+  for (int i = 0; i < focals; ++i) {
+    if (!(camera.params[i] > 0)) return "the focal length must be above 0";
+  }
+  return {};
+}
+
+}  // namespace
 
 std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const fs::path& path,
                                                              std::string* error) {
@@ -268,10 +326,16 @@ std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const fs::path& pat
           *message = "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]";
           return false;
         }
+        *message = camera_problem(camera);
+        if (!message->empty()) return false;
         cameras.push_back(std::move(camera));
         return true;
       });
   if (!ok) return std::nullopt;
+  if (cameras.empty()) {
+    if (error != nullptr) *error = fmt::format("{} lists no camera", path.string());
+    return std::nullopt;
+  }
   return cameras;
 }
 

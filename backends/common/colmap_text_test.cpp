@@ -156,6 +156,52 @@ TEST(BackendColmap, ReadersReportMalformedLines) {
   EXPECT_FALSE(read_colmap_cameras(dir.path() / "missing.txt", &error).has_value());
 }
 
+TEST(BackendColmap, CameraLinesCOLMAPCannotUseAreErrorsAtTheirLine) {
+  TempDir dir;
+  const std::string good = "1 OPENCV 821 547 1146 1144 410.5 273.5 -0.02 0 0 0";
+  struct Case {
+    std::string line, message;
+  };
+  const std::vector<Case> cases = {
+      {"1 OPENCV 821 547000 1146 1144 410.5 273.5 -0.02 0 0 0", "821x547000 is not an image size"},
+      {"1 OPENCV 0 0 1146 1144 410.5 273.5 -0.02 0 0 0", "0x0 is not an image size"},
+      {"1 OPENCV -5 547 1146 1144 410.5 273.5 -0.02 0 0 0", "-5x547 is not an image size"},
+      {"1 OPENCV 821 547 nan 1144 410.5 273.5 -0.02 0 0 0", "not a finite number"},
+      {"1 OPENCV 821 547 -1146 1144 410.5 273.5 -0.02 0 0 0", "focal length must be above 0"},
+      {"1 SIMPLE_RADIAL 821 547 0 410.5 273.5 0", "focal length must be above 0"},
+      {"1 OPENCV 821 547 1146", "OPENCV takes 8 parameters, not 1"},
+      {"1 FOOCAM 821 547 1146 1144 410.5 273.5", "unknown camera model 'FOOCAM'"},
+  };
+  std::string error;
+  for (const Case& c : cases) {
+    rigc::testing::write_text(dir.file("cameras.txt"), "# header\n" + c.line + "\n");
+    EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value()) << c.line;
+    EXPECT_NE(error.find("cameras.txt:2: "), std::string::npos) << error;
+    EXPECT_NE(error.find(c.message), std::string::npos) << error;
+  }
+  rigc::testing::write_text(dir.file("cameras.txt"), "# only comments\n");
+  EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value());
+  EXPECT_NE(error.find("lists no camera"), std::string::npos) << error;
+  rigc::testing::write_text(dir.file("cameras.txt"), good + "\n2 PINHOLE 100 80 90 90 50 40\n");
+  const auto cameras = read_colmap_cameras(dir.path() / "cameras.txt", &error);
+  ASSERT_TRUE(cameras.has_value()) << error;
+  EXPECT_EQ(cameras->size(), 2u);
+}
+
+TEST(BackendColmap, ImagesWithNonFinitePosesOrRepeatedNamesAreErrors) {
+  TempDir dir;
+  std::string error;
+  rigc::testing::write_text(dir.file("images.txt"), "1 nan 0 0 0 0 0 0 1 a.jpg\n\n");
+  EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
+  EXPECT_NE(error.find("images.txt:1: the pose holds a number that is not finite"),
+            std::string::npos)
+      << error;
+  rigc::testing::write_text(dir.file("images.txt"),
+                            "1 1 0 0 0 0 0 0 1 a.jpg\n\n2 1 0 0 0 0 0 1 1 a.jpg\n\n");
+  EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
+  EXPECT_NE(error.find("images.txt:3: image 'a.jpg' is listed twice"), std::string::npos) << error;
+}
+
 TEST(BackendColmap, ProjectOpencvCentreAndHandComputedPoint) {
   const ir::Scene scene = testing::small_scene();
   std::string error;
