@@ -1,7 +1,15 @@
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "tests/test_support.h"
 
@@ -128,6 +136,62 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
   auto largest = run_rigc({"render", scene, "-o", run, "--scale", "0.02", "--shots", "0", "--seed",
                            "18446744073709551615"});
   EXPECT_EQ(largest.exit_code, 0) << largest.err;
+}
+
+// Whether process `pid` has ended (gone, or a zombie waiting for init to reap it).
+bool process_ended(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const std::size_t close = text.rfind(')');
+  return text.empty() || close == std::string::npos || text.substr(close + 2, 1) == "Z";
+}
+
+// A SIGTERM to rigc alone (`kill`, `timeout`) left POV-Ray rendering on, into the folder that a
+// rerun then rendered into too. Here a stand-in "povray" that records its pid and sleeps.
+TEST(Cli, StoppingRigcStopsTheRendererItStarted) {
+  testing::TempDir dir;
+  std::filesystem::create_directories(dir.path() / "bin");
+  const std::string pid_file = dir.file("povray.pid");
+  const std::string fake = dir.file("bin/povray");
+  testing::write_text(fake, "#!/bin/sh\necho $$ > '" + pid_file + "'\nexec sleep 60\n");
+  std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+  std::vector<std::string> args = {
+      RIGC_BINARY, "render",       source_path("scenes/paper-turntable.yaml"),
+      "--backend", "povray",       "--scale",
+      "0.02",      "--shots",      "0",
+      "-o",        dir.file("run")};
+  std::vector<std::string> env = {"PATH=" + dir.file("bin") + ":/usr/bin:/bin",
+                                  "HOME=" + dir.path().string()};
+  std::vector<char*> argv, envp;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t rigc = 0;
+  ASSERT_EQ(posix_spawn(&rigc, argv[0], &actions, nullptr, argv.data(), envp.data()), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  // Wait for the stand-in to start (scene preparation and emitting come first).
+  pid_t renderer = 0;
+  for (int i = 0; i < 600 && renderer <= 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::ifstream(pid_file) >> renderer;
+  }
+  ASSERT_GT(renderer, 0) << "the stand-in povray never started";
+  ASSERT_FALSE(process_ended(renderer));
+  kill(rigc, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(waitpid(rigc, &status, 0), rigc);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "rigc dies of the signal";
+  bool ended = false;
+  for (int i = 0; i < 50 && !ended; ++i) {
+    ended = process_ended(renderer);
+    if (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_TRUE(ended) << "the renderer rigc started still runs";
+  if (!ended) kill(renderer, SIGKILL);
 }
 
 TEST(Cli, VersionAndHelp) {

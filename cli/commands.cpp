@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <regex>
 
 #include "analysis/advice.h"
 #include "analysis/coverage.h"
@@ -289,7 +290,10 @@ int run_main(std::vector<std::string> args) {
     try {
       return command.run(verb_args);
     } catch (const std::exception& e) {
-      std::cerr << "rigc: internal error: " << e.what() << '\n';
+      // Libraries colour their messages (Open3D's errors come as "\e[1;31m[Open3D Error] ...");
+      // the terminal codes are dropped.
+      const std::string what = std::regex_replace(e.what(), std::regex("\x1b\\[[0-9;]*m"), "");
+      std::cerr << "rigc: internal error: " << what << '\n';
       return kExitInternalError;
     }
   }

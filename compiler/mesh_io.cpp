@@ -137,6 +137,16 @@ class Builder {
     for (std::size_t i = 0; i < m.positions.size(); ++i) {
       if (!m.positions[i].allFinite()) fail("vertex {} has a position that is not finite", i);
     }
+    // A mesh of lines and points only has no surface to see or measure: it rendered nothing,
+    // coverage printed -nan, and eval's surface sampler threw.
+    const bool any_area = std::any_of(m.triangles.begin(), m.triangles.end(), [&](const auto& t) {
+      const Eigen::Vector3d p0 = m.positions[t[0]].template cast<double>();
+      const Eigen::Vector3d e1 = m.positions[t[1]].template cast<double>() - p0;
+      const Eigen::Vector3d e2 = m.positions[t[2]].template cast<double>() - p0;
+      return e1.cross(e2).squaredNorm() > 0;
+    });
+    if (!any_area)
+      fail("has no triangle with an area (all {} are lines or points)", m.triangles.size());
     const bool any_missing =
         std::find(needs_normal_.begin(), needs_normal_.end(), 1) != needs_normal_.end();
     if (any_missing) {

@@ -399,6 +399,10 @@ TEST(MeshIoPly, RejectsMalformedFiles) {
   expect_load_error(dir.file("range.ply"), "index 7 is out of range (3 vertices)");
   write_file(dir.file("nan.ply"), header + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
   expect_load_error(dir.file("nan.ply"), "not finite");
+  // Collinear corners: a triangle with no area (coverage printed -nan, eval's sampler threw).
+  write_file(dir.file("flat.ply"), header + "0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n");
+  expect_load_error(dir.file("flat.ply"),
+                    "has no triangle with an area (all 1 are lines or points)");
   write_file(dir.file("short.ply"), header + "0 0 0\n1 0 0\n");
   expect_load_error(dir.file("short.ply"), "truncated");
   write_file(dir.file("huge.ply"),

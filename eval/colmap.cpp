@@ -15,6 +15,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "backends/common/child_processes.h"
 #include "backends/common/files.h"
 
 extern char** environ;
@@ -66,6 +67,7 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
     *error = fmt::format("cannot run {}: {}", argv[0], std::strerror(rc));
     return -1;
   }
+  const backends::WatchedChild watched(pid);
   int status = 0;
   rusage usage{};
   while (wait4(pid, &status, 0, &usage) < 0) {

@@ -12,6 +12,8 @@
 #include <deque>
 #include <fstream>
 
+#include "backends/common/child_processes.h"
+
 extern char** environ;
 
 namespace rigc::reference {
@@ -76,6 +78,7 @@ ProgramResult run_program(const std::vector<std::string>& argv, const fs::path& 
     return result;
   }
   result.started = true;
+  const backends::WatchedChild watched(pid);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {

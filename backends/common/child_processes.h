@@ -1,0 +1,27 @@
+// Programs that rigc starts (POV-Ray, Blender, COLMAP) stop when rigc is stopped.
+#pragma once
+
+#include <sys/types.h>
+
+namespace rigc::backends {
+
+// While a child is watched, a SIGINT, SIGTERM or SIGHUP that stops rigc sends the child a
+// SIGTERM first. A signal sent to rigc alone (`kill`, `timeout`, a closed ssh session) left
+// POV-Ray rendering on its own, into the folder a rerun then rendered into as well. (A SIGKILL
+// cannot be caught: its children still run on.)
+void watch_child(pid_t pid);
+void unwatch_child(pid_t pid);
+
+// Unwatches on scope exit.
+class WatchedChild {
+ public:
+  explicit WatchedChild(pid_t pid) : pid_(pid) { watch_child(pid_); }
+  ~WatchedChild() { unwatch_child(pid_); }
+  WatchedChild(const WatchedChild&) = delete;
+  WatchedChild& operator=(const WatchedChild&) = delete;
+
+ private:
+  pid_t pid_;
+};
+
+}  // namespace rigc::backends
