@@ -778,9 +778,8 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     if (!node[key]) continue;
     if (auto v = scalar(node[key], key)) {
       // EXIF text is NUL-terminated: a "\0" cut the tag short without a word.
-      const bool control = std::any_of(v->begin(), v->end(), [](unsigned char c) {
-        return c < 0x20 || c == 0x7F;
-      });
+      const bool control =
+          std::any_of(v->begin(), v->end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; });
       if (v->size() > kMaxExifText) {
         error(node[key],
               fmt::format("camera {} is {} bytes long; at most {}", key, v->size(), kMaxExifText));
@@ -806,6 +805,7 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
       }
       if (const YAML::Node distortion = lens["distortion"]) {
         if (expect_map(distortion, "distortion")) {
+          scene.distortion_loc = loc(distortion);
           check_keys(distortion, {"k1", "k2", "k3", "p1", "p2"}, "distortion");
           auto read = [&](const char* key, double& out) {
             if (!distortion[key]) return;

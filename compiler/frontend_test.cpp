@@ -211,6 +211,35 @@ TEST(Frontend, HugeDirectionVectorsStayDirections) {
   EXPECT_NEAR(compiled.scene->studio.lights.at(0).direction.norm(), 1, 1e-9);
 }
 
+// Real lenses (a few percent of barrel or pincushion, a 24 mm's stronger barrel) pass; a
+// mapping that folds the frame over, or never reaches its edge, is no lens.
+TEST(Frontend, DistortionThatFoldsTheFrameOverIsAnError) {
+  struct Case {
+    std::string lens;
+    bool valid;
+  };
+  const std::vector<Case> cases = {
+      {"{focal_length: 50mm, distortion: {k1: -0.02}}", true},
+      {"{focal_length: 24mm, distortion: {k1: -0.12, k2: 0.05, p1: 0.001}}", true},
+      {"{focal_length: 50mm, distortion: {k1: 1, k2: 0.5}}", true},
+      {"{focal_length: 50mm, distortion: {k1: -0.5}}", true},
+      {"{focal_length: 50mm, distortion: {k1: -1}}", false},  // folds at 89 % of the corner
+      {"{focal_length: 50mm, distortion: {p1: 1}}", false},
+      {"{focal_length: 24mm, distortion: {k1: -0.3}}", false},
+      {"{focal_length: 50mm, distortion: {k1: -1, k2: -1, k3: -1, p1: -1, p2: -1}}", false},
+  };
+  for (const Case& c : cases) {
+    std::string text = kMinimalScene;
+    text.replace(text.find("{focal_length: 50mm}"), 20, c.lens);
+    Compiled compiled = compile_text(text);
+    EXPECT_EQ(compiled.scene.has_value(), c.valid) << c.lens << "\n" << compiled.diagnostics;
+    if (!c.valid) {
+      EXPECT_NE(compiled.diagnostics.find("the distortion folds the image over"), std::string::npos)
+          << compiled.diagnostics;
+    }
+  }
+}
+
 TEST(Frontend, BareNumbersTakeDocumentedUnits) {
   std::string text = kMinimalScene;
   text.replace(text.find("80cm"), 4, "0.8");

@@ -228,12 +228,55 @@ bool Lowering::lower_object() {
   return true;
 }
 
+// Why the Brown-Conrady mapping `d` is no lens over a sensor of half-extents (x, y) in
+// normalised coordinates (empty if it is one): walking out from the centre along every
+// direction, the mapping must stay one-to-one (a positive Jacobian) until it leaves the sensor,
+// and it must leave it. Each coefficient alone may lie in -1..1, but k1 = -1 folds a 50 mm
+// lens's frame over before its corners, and all five at +1 smeared the image beyond
+// recognition, while the exported cameras.txt claimed the mapping as the truth.
+std::string distortion_problem(const ir::Distortion& d, double half_x, double half_y) {
+  if (d.is_zero()) return {};
+  constexpr int kDirections = 256;
+  const double corner = std::hypot(half_x, half_y);
+  const double step = corner / 512, farthest = 8 * corner;
+  for (int k = 0; k < kDirections; ++k) {
+    const double angle = 2 * std::numbers::pi * (k + 0.5) / kDirections;
+    const double cx = std::cos(angle), cy = std::sin(angle);
+    bool left = false;
+    for (double r = step; r <= farthest && !left; r += step) {
+      const double x = r * cx, y = r * cy, r2 = x * x + y * y;
+      const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+      const double dradial = d.k1 + r2 * (2 * d.k2 + 3 * d.k3 * r2);
+      const double jxx = radial + 2 * x * x * dradial + 2 * d.p1 * y + 6 * d.p2 * x;
+      const double jxy = 2 * x * y * dradial + 2 * d.p1 * x + 2 * d.p2 * y;
+      const double jyy = radial + 2 * y * y * dradial + 6 * d.p1 * y + 2 * d.p2 * x;
+      const double xd = x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x);
+      const double yd = y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y;
+      if (!(jxx * jyy - jxy * jxy > 0)) {
+        return fmt::format(
+            "the distortion folds the image over {:.0f} % of the way to the frame's corner: "
+            "no lens maps it; make the coefficients smaller",
+            100 * std::hypot(xd, yd) / corner);
+      }
+      left = std::abs(xd) > half_x || std::abs(yd) > half_y;
+    }
+    if (!left) {
+      return "the distortion pulls the frame's edge in so far that no scene point reaches it; "
+             "make the coefficients smaller";
+    }
+  }
+  return {};
+}
+
 void Lowering::lower_camera() {
   ir::Camera& camera = scene_.camera;
   camera.fx = camera.focal_length_m * camera.width_px / camera.sensor_width_m;
   camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
   camera.cx = camera.width_px / 2.0;
   camera.cy = camera.height_px / 2.0;
+  const std::string lens_problem =
+      distortion_problem(camera.distortion, camera.cx / camera.fx, camera.cy / camera.fy);
+  if (!lens_problem.empty()) error(spec_.distortion_loc, lens_problem);
   // The photographer's acceptable circle of confusion unless the scene sets its own.
   if (scene_.coverage.max_blur_px <= 0) {
     scene_.coverage.max_blur_px =
