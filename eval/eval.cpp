@@ -16,6 +16,7 @@
 
 #include "backends/common/colmap_text.h"
 #include "backends/common/files.h"
+#include "backends/common/manifest.h"
 #include "compiler/frontend.h"
 #include "compiler/mesh_io.h"
 #include "eval/colmap.h"
@@ -64,8 +65,10 @@ struct GroundTruth {
   std::string description;
 };
 
+// `warning` is set when the run's images were rendered from another version of the scene.
 std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::path& run_dir,
-                                             std::string* error) {
+                                             bool photos, std::string* error,
+                                             std::string* warning) {
   GroundTruth gt;
   if (!o.ground_truth.empty()) {
     auto model = load_model(o.ground_truth, error);
@@ -75,10 +78,25 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
     gt.description = fmt::format("{} (its own frame)", o.ground_truth);
   } else {
     std::string scene_path = o.scene;
+    const fs::path manifest = run_dir / "manifest.json";
+    const json run_manifest = photos ? json() : json::parse(read_text(manifest), nullptr, false);
+    const json& m = run_manifest;
     if (scene_path.empty()) {
-      const fs::path manifest = run_dir / "manifest.json";
-      json m = json::parse(read_text(manifest), nullptr, false);
-      if (m.is_discarded() || !m.contains("inputs") || !m["inputs"].contains("source_file")) {
+      if (!fs::exists(manifest)) {
+        *error = fmt::format(
+            "no ground truth: {} has no manifest.json naming its scene; pass --ground-truth MESH "
+            "or --scene FILE",
+            run_dir.string());
+        return std::nullopt;
+      }
+      if (m.is_discarded()) {
+        *error = fmt::format(
+            "no ground truth: {} is not valid JSON; pass --ground-truth MESH or --scene FILE",
+            manifest.string());
+        return std::nullopt;
+      }
+      if (!m.is_object() || !m.contains("inputs") || !m["inputs"].is_object() ||
+          !m["inputs"].contains("source_file") || !m["inputs"]["source_file"].is_string()) {
         *error = fmt::format(
             "no ground truth: {} has no inputs.source_file; pass --ground-truth MESH or --scene "
             "FILE",
@@ -105,13 +123,25 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
                            messages);
       return std::nullopt;
     }
-    const ir::Mat4& m = scene->object.object_from_mesh;
+    const ir::Mat4& object_from_mesh = scene->object.object_from_mesh;
     for (const auto& p : scene->object.mesh.positions) {
-      const ir::Vec3 q = m.topLeftCorner<3, 3>() * p.cast<double>() + m.topRightCorner<3, 1>();
+      const ir::Vec3 q = object_from_mesh.topLeftCorner<3, 3>() * p.cast<double>() +
+                         object_from_mesh.topRightCorner<3, 1>();
       gt.positions.push_back(q.cast<float>());
     }
     gt.triangles = scene->object.mesh.triangles;
     gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
+    // A run measured against a scene it was not rendered from gives numbers without meaning
+    // (another object: F-score 0, and no word of why).
+    if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
+        m["inputs"].contains("content_sha256") && m["inputs"]["content_sha256"].is_string() &&
+        m["inputs"]["content_sha256"].get<std::string>() != backends::scene_content_hash(*scene)) {
+      *warning = fmt::format(
+          "the object of {} is not the one the run in {} was rendered with (its mesh or "
+          "textures differ from manifest.json's content hash): the numbers measure against "
+          "another object",
+          scene_path, run_dir.string());
+    }
   }
   if (gt.triangles.empty()) {
     *error = "the ground-truth mesh has no triangles";
@@ -539,11 +569,13 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     log << "rigc eval: error: photos need a ground truth: --ground-truth MESH or --scene FILE\n";
     return 1;
   }
-  auto gt = load_ground_truth(o, run_dir, &error);
+  std::string gt_warning;
+  auto gt = load_ground_truth(o, run_dir, photos, &error, &gt_warning);
   if (!gt) {
     log << "rigc eval: error: " << error << "\n";
     return 1;
   }
+  if (!gt_warning.empty()) log << "rigc eval: warning: " << gt_warning << "\n";
   std::map<std::string, ir::Mat4> gt_poses;
   std::optional<backends::ColmapCamera> gt_camera;
   if (!photos && fs::exists(run_dir / "sparse" / "images.txt")) {

@@ -433,6 +433,28 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   EXPECT_NE(log.str().find("nothere does not exist"), std::string::npos) << log.str();
 }
 
+TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "run" / "images");
+  for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
+  EvalOptions o;
+  o.run_dir = dir.file("run");
+  o.output_dir = dir.file("eval");
+  o.colmap = dir.file("no-such-colmap");
+  std::ostringstream log;
+  rigc::testing::write_text(dir.file("run/manifest.json"), "{");
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("manifest.json is not valid JSON"), std::string::npos) << log.str();
+  // Rendered from one object, measured against the paper scene's statue: said, then measured.
+  rigc::testing::write_text(dir.file("run/manifest.json"),
+                            R"({"inputs": {"content_sha256": "0123", "source_file": "x.yaml"}})");
+  o.scene = rigc::testing::source_path("scenes/paper-turntable.yaml");
+  log.str("");
+  EXPECT_EQ(evaluate(o, log, nullptr), 2) << log.str();  // then the missing COLMAP
+  EXPECT_NE(log.str().find("warning: the object of"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("is not the one the run in"), std::string::npos) << log.str();
+}
+
 // ---------------------------------------------------------------------------------------------
 // End to end with COLMAP: SLOW (the textured one takes about 1-2 minutes on 2 busy cores, the
 // untextured one seconds). Skipped without colmap. Filter them out with -EvalEndToEnd.*
