@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "dslr/exposure.h"
 
@@ -16,6 +18,41 @@ constexpr double kWarnShare = 0.05;
 
 const SourceLoc& first_known(const SourceLoc& a, const SourceLoc& b) {
   return a.line > 0 ? a : b;
+}
+
+// Stops of less light that leave at most kWarnShare of the seen area clipped, from the shots'
+// signal histograms summed (`histogram`, over `visible` m²), rounded up to a third of a stop.
+double stops_to_unclip(const std::vector<double>& histogram, double visible) {
+  double above = 0;
+  for (int b = ShotCoverage::kSignalBins - 1; b >= 0; --b) {
+    if (above + histogram[b] > kWarnShare * visible) {
+      const double upper =
+          ShotCoverage::kSignalLowestStops + (b + 1) * ShotCoverage::kSignalBinStops;
+      return std::ceil(std::max(0.0, upper) * 3 - 1e-9) / 3;
+    }
+    above += histogram[b];
+  }
+  return 0;
+}
+
+// Stops of more light that leave at most kWarnShare of the seen area below `dark_stops` (the
+// dark limit, in stops from the clipping level), rounded up to a third of a stop.
+double stops_to_undarken(const std::vector<double>& histogram, double visible, double dark_stops) {
+  double below = 0;
+  for (int b = 0; b < ShotCoverage::kSignalBins; ++b) {
+    if (below + histogram[b] > kWarnShare * visible) {
+      const double lower = ShotCoverage::kSignalLowestStops + b * ShotCoverage::kSignalBinStops;
+      return std::ceil(std::max(0.0, dark_stops - lower) * 3 - 1e-9) / 3;
+    }
+    below += histogram[b];
+  }
+  return 0;
+}
+
+// "1/250 s" or "2.5 s": a shutter time as a camera shows it.
+std::string shutter_text(double seconds) {
+  if (seconds >= 0.3) return fmt::format("{:.2g} s", seconds);
+  return fmt::format("1/{:.0f} s", 1 / seconds);
 }
 
 }  // namespace
@@ -41,7 +78,11 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
 
   // Area-weighted means over all views.
   double visible = 0, out_of_focus = 0, clipped = 0, dark = 0;
+  std::vector<double> signal_histogram(ShotCoverage::kSignalBins, 0.0);
   for (const auto& shot : coverage.shots) {
+    for (std::size_t b = 0; b < shot.signal_histogram.size() && b < signal_histogram.size(); ++b) {
+      signal_histogram[b] += shot.signal_histogram[b];
+    }
     visible += shot.visible_area_m2;
     out_of_focus += shot.out_of_focus * shot.visible_area_m2;
     clipped += shot.clipped * shot.visible_area_m2;
@@ -72,19 +113,38 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
                              settings.max_blur_px));
   }
   // Exposure.
+  // The advice names how many stops: "one stop" was the advice at 30 s too, where twelve were
+  // needed.
+  auto stops_text = [](double stops) {  // in thirds, as cameras step: "1/3 stop", "5 2/3 stops"
+    const int thirds = static_cast<int>(std::lround(stops * 3));
+    const int whole = thirds / 3, rest = thirds % 3;
+    const std::string count = whole == 0  ? fmt::format("{}/3", rest)
+                              : rest == 0 ? fmt::format("{}", whole)
+                                          : fmt::format("{} {}/3", whole, rest);
+    return count + (thirds > 3 ? " stops" : " stop");
+  };
   if (clipped / visible > kWarnShare) {
-    diag.warning(
-        shutter_loc,
-        fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
-                    "(EV100 {:.1f}); shorten the shutter or stop down by one stop",
-                    100 * clipped / visible, dslr::ev100(n, camera.shutter_s, camera.iso)));
+    const double stops = std::max(1.0 / 3, stops_to_unclip(signal_histogram, visible));
+    const double shutter = camera.shutter_s * std::exp2(-stops);
+    diag.warning(shutter_loc,
+                 fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
+                             "(EV100 {:.1f}); {} less light: {}",
+                             100 * clipped / visible, dslr::ev100(n, camera.shutter_s, camera.iso),
+                             stops_text(stops),
+                             shutter >= 1.0 / 8000
+                                 ? fmt::format("a shutter of {} (or stop down, or a lower ISO)",
+                                               shutter_text(shutter))
+                                 : "stop down, lower the ISO or dim the lights"));
   }
   if (dark / visible > kWarnShare) {
+    const double dark_stops = std::log2(settings.min_signal / settings.max_signal);
+    const double stops =
+        std::max(1.0 / 3, stops_to_undarken(signal_histogram, visible, dark_stops));
     diag.warning(shutter_loc,
                  fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
-                             "full scale, where sensor noise hides texture; lengthen the shutter, "
-                             "raise the ISO or add light",
-                             100 * dark / visible, 100 * settings.min_signal));
+                             "full scale, where sensor noise hides texture; {} more light: "
+                             "lengthen the shutter, raise the ISO or add light",
+                             100 * dark / visible, 100 * settings.min_signal, stops_text(stops)));
   }
   // Motion blur from a turning table, per shot group (reported once per source line).
   int last_line = -1;

@@ -30,6 +30,7 @@ struct ShotSums {
   double reconstructable_gain = 0;
   double nearest = 1e30;
   std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
+  std::vector<double> signal_histogram = std::vector<double>(ShotCoverage::kSignalBins, 0.0);
 };
 
 // Mean albedo luminance of each face: material colour, texture average, pattern average.
@@ -179,6 +180,13 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
             }
             const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
 
+            const double stops_over = std::log2(std::max(signal, 1e-300) / settings.max_signal);
+            const int signal_bin = static_cast<int>(
+                std::clamp(std::floor((stops_over - ShotCoverage::kSignalLowestStops) /
+                                      ShotCoverage::kSignalBinStops),
+                           0.0, ShotCoverage::kSignalBins - 1.0));
+            sum.signal_histogram[signal_bin] += area;
+
             const bool in_focus = blur_px <= settings.max_blur_px;
             const bool clipped = signal > settings.max_signal;
             const bool dark = signal < settings.min_signal;
@@ -221,8 +229,12 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
       for (int k = 1; k <= 3; ++k) seen_area[k] += part.seen_gain[k];
       reconstructable_area += part.reconstructable_gain;
       for (int b = 0; b <= kBlurBins; ++b) blur_histogram[b] += part.blur_histogram[b];
+      for (int b = 0; b < ShotCoverage::kSignalBins; ++b) {
+        total.signal_histogram[b] += part.signal_histogram[b];
+      }
     }
     ShotCoverage coverage;
+    coverage.signal_histogram = total.signal_histogram;
     coverage.shot = s;
     coverage.visible_area_m2 = total.visible;
     coverage.new_area_m2 = total.fresh;

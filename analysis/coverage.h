@@ -22,6 +22,12 @@ struct ShotCoverage {
   double out_of_focus = 0, clipped = 0, too_dark = 0, too_oblique = 0, too_coarse = 0;
   double frame_fill = 0;  // object's share of the image area
   double nearest_depth_m = 0;
+  // Visible area by signal, in steps of kSignalBinStops from kSignalLowestStops below the
+  // clipping level (max_signal) up; the ends hold everything beyond. How many stops less (or
+  // more) light would bring the clipped (or dark) share under a limit follows from it.
+  static constexpr int kSignalBins = 320;
+  static constexpr double kSignalBinStops = 0.125, kSignalLowestStops = -20;
+  std::vector<double> signal_histogram;
 };
 
 struct CoverageResult {

@@ -1,8 +1,10 @@
 #include "analysis/coverage.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <regex>
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
@@ -166,6 +168,25 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
   for (const auto& c : cases) {
     Analysed a = analyse(scene_text(kStatue, c.exposure, c.shots, c.extra_camera));
     EXPECT_NE(a.warnings.find(c.expected), std::string::npos) << c.name << ":\n" << a.warnings;
+  }
+}
+
+// The over-exposure advice names a shutter; taking it, the warning goes (it said "one stop" at
+// any setting, at 30 s too, where nine were needed).
+TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {
+  for (const char* shutter : {"30", "1/2", "1/15"}) {
+    Analysed a = analyse(scene_text(
+        kStatue, fmt::format("{{aperture: f/13, shutter: {}, iso: 200}}", shutter), kGoodShots));
+    const std::regex advice("over-exposure: .* stops? less light: a shutter of (1/)?([0-9.]+) s");
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(a.warnings, match, advice)) << shutter << ":\n" << a.warnings;
+    const std::string suggested = match[1].str() + match[2].str();
+    Analysed after = analyse(scene_text(
+        kStatue, fmt::format("{{aperture: f/13, shutter: {}, iso: 200}}", suggested), kGoodShots));
+    EXPECT_EQ(after.warnings.find("over-exposure"), std::string::npos)
+        << shutter << " -> " << suggested << ":\n"
+        << after.warnings;
+    EXPECT_EQ(after.warnings.find("under-exposure"), std::string::npos) << after.warnings;
   }
 }
 
