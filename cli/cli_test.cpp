@@ -116,6 +116,8 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
        "--scale: 'inf' is not a finite number"},
       {{"coverage", scene, "-o", run, "--visibility-scale", "nan"},
        "--visibility-scale: 'nan' is not a finite number"},
+      {{"coverage", scene, "-o", run, "--visibility-scale", "1e-9"},
+       "--visibility-scale: '1e-9' is neither 0 (automatic) nor within 0.01..1"},
       {{"eval", run, "--tau", "nan"}, "--tau: 'nan' is not a finite number"},
       {{"eval", run, "--color-range", "-1"}, "--color-range: '-1' is not above 0"},
       {{"compare", scene, "-o", run, "--scale", "-nan"}, "is not a finite number"},
@@ -132,6 +134,11 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
     EXPECT_EQ(result.err.rfind("rigc: error: ", 0), 0u) << "like every error of rigc";
     EXPECT_FALSE(std::filesystem::exists(run)) << c.message;
   }
+  // A backend named twice rendered and evaluated twice into one folder.
+  auto twice = run_rigc({"compare", scene, "-o", run, "--backends", "preview,preview"});
+  EXPECT_EQ(twice.exit_code, 1) << twice.err;
+  EXPECT_NE(twice.err.find("--backends names 'preview' twice"), std::string::npos) << twice.err;
+  EXPECT_FALSE(std::filesystem::exists(run));
   // A seed of 0 and the largest one are seeds.
   auto largest = run_rigc({"render", scene, "-o", run, "--scale", "0.02", "--shots", "0", "--seed",
                            "18446744073709551615"});

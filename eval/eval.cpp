@@ -599,6 +599,18 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
       }
     }
   }
+  // SIFT finds nothing in a thumbnail: two 1 x 1 photos ended in "COLMAP reconstructed
+  // nothing", exit 2, as if a tool had failed.
+  constexpr int kSmallestSide = 32;
+  for (const auto& [name, size] : image_size) {
+    if (std::min(size.first, size.second) < kSmallestSide) {
+      log << fmt::format(
+          "rigc eval: error: {} is {}x{} pixels: too small to find features in (at least {} a "
+          "side)\n",
+          (images_dir / name).string(), size.first, size.second, kSmallestSide);
+      return 1;
+    }
+  }
   if (!image_set.one_size && !o.quiet) {
     log << "rigc eval: the photos differ in size: COLMAP gets one camera per photo\n";
   }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -172,6 +173,11 @@ int run_compare_command(std::vector<std::string> args) {
         for (const auto& b : render_backends()) known += (known.empty() ? "" : ", ") + b.name;
         std::cerr << fmt::format("rigc compare: error: unknown backend '{}' (available: {})\n",
                                  name, known);
+        return 1;
+      }
+      // Twice the same backend rendered and evaluated it twice into one folder.
+      if (std::find(chosen.begin(), chosen.end(), found) != chosen.end()) {
+        std::cerr << fmt::format("rigc compare: error: --backends names '{}' twice\n", name);
         return 1;
       }
       chosen.push_back(found);

@@ -331,9 +331,9 @@ void write_cube_ply(const std::string& path) {
 }
 
 // A small grey image in the format its name asks for, which eval's readability check accepts.
-void write_small_image(const std::string& path) {
-  const OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::UINT8);
-  const std::vector<unsigned char> pixels(16 * 16 * 3, 128);
+void write_small_image(const std::string& path, int side = 64) {
+  const OIIO::ImageSpec spec(side, side, 3, OIIO::TypeDesc::UINT8);
+  const std::vector<unsigned char> pixels(static_cast<std::size_t>(side) * side * 3, 128);
   auto out = OIIO::ImageOutput::create(path);
   ASSERT_TRUE(out && out->open(path, spec)) << path;
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
@@ -412,18 +412,28 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
   o.colmap = dir.file("no-such-colmap");
-  // The images are 16 x 16: a camera of 16 x 3 tripped an assertion in OpenImageIO.
+  // The images are 64 x 64: a camera of 64 x 3 tripped an assertion in OpenImageIO.
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"),
-                            "1 OPENCV 16 3 20 20 8 8 0 0 0 0\n");
+                            "1 OPENCV 64 3 80 80 32 32 0 0 0 0\n");
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("a.jpg is 16x16 pixels, but"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("gives the camera as 16x3"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("a.jpg is 64x64 pixels, but"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("gives the camera as 64x3"), std::string::npos) << log.str();
   // An empty camera file printed "rigc eval: error: " and nothing more.
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"), "");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_NE(log.str().find("cameras.txt lists no camera"), std::string::npos) << log.str();
+  // Thumbnails are too small for SIFT: a user error, not COLMAP's failure.
+  fs::create_directories(dir.path() / "tiny");
+  for (const char* name : {"a.png", "b.png"}) write_small_image(dir.file("tiny/") + name, 1);
+  o = EvalOptions{};
+  o.photos_dir = dir.file("tiny");
+  o.ground_truth = dir.file("cube.ply");
+  o.colmap = dir.file("no-such-colmap");
+  log.str("");
+  EXPECT_EQ(evaluate(o, log, nullptr), 1);
+  EXPECT_NE(log.str().find("a.png is 1x1 pixels: too small"), std::string::npos) << log.str();
   // A photos folder that is not there is named as such.
   o = EvalOptions{};
   o.photos_dir = dir.file("nothere");
