@@ -407,10 +407,13 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
     match.push_back(flags->matching_gpu);
     match.push_back("0");
   }
-  std::vector<std::string> map = {o.colmap,          "mapper",
-                                  "--database_path", db.string(),
-                                  "--image_path",    images_dir.string(),
-                                  "--output_path",   (work / "sparse").string()};
+  std::vector<std::string> map = {o.colmap, "mapper", "--database_path", db.string(),
+                                  "--image_path", images_dir.string(), "--output_path",
+                                  (work / "sparse").string(),
+                                  // COLMAP drops models of fewer than 10 images by default: a
+                                  // 9-shot capture (or 10 with one lost) then "reconstructed
+                                  // nothing" although the mapper had built it whole.
+                                  "--Mapper.min_model_size", "3"};
   if (exact_prior && !o.refine_intrinsics) {
     // A known camera: refining focal length and distortion from two narrow-angle views of a
     // small object is ill-conditioned and can stop the reconstruction at its first pair.
