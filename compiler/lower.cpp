@@ -334,6 +334,15 @@ void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double
   if ((eye_in_object.cwiseAbs() - half).maxCoeff() < 0) {
     error(loc, fmt::format("{}: the camera is inside the object's bounding box", shot.name));
   }
+  // Inside the studio's own solids the camera sees nothing (the checks warned only that the
+  // object filled 0 % of the frame).
+  const ir::Turntable& table = scene_.studio.turntable;
+  if (eye.z() < 0) {
+    error(loc, fmt::format("{}: the camera is {:.2f} m below the floor", shot.name, -eye.z()));
+  } else if (eye.head<2>().norm() < table.diameter_m / 2 && eye.z() <= table.height_m &&
+             eye.z() >= table.height_m - table.thickness_m) {
+    error(loc, fmt::format("{}: the camera is inside the turntable's disc", shot.name));
+  }
   scene_.shots.push_back(shot);
 }
 
