@@ -131,6 +131,9 @@ bool Lowering::lower_object() {
       error(object.mesh_path->loc, fmt::format("cannot load mesh: {}", why));
       return false;
     }
+    for (const std::string& warning : model->warnings) {
+      diag_.warning(object.mesh_path->loc, warning);
+    }
     out.source = object.mesh_path_resolved;
     out.mesh = std::move(model->mesh);
     scene_.materials = std::move(model->materials);

@@ -21,6 +21,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iterator>
 #include <limits>
 #include <map>
@@ -1640,6 +1641,29 @@ class AssimpLoader {
   std::map<std::string, int> textures_;
 };
 
+// The material libraries an OBJ names (`mtllib a.mtl b.mtl`) that are not beside it: Assimp
+// loads the mesh without them and says nothing, so its colours and textures silently went grey.
+std::vector<std::string> missing_material_libraries(const std::string& path) {
+  std::vector<std::string> warnings;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line.compare(start, 7, "mtllib ") != 0) continue;
+    std::istringstream names(line.substr(start + 7));
+    std::string name;
+    while (names >> name) {
+      std::error_code ec;
+      if (!fs::exists(fs::path(path).parent_path() / name, ec)) {
+        warnings.push_back(fmt::format(
+            "material library '{}' is not beside the mesh: its colours and textures are not used",
+            one_line(name)));
+      }
+    }
+  }
+  return warnings;
+}
+
 LoadedModel load_with_assimp(const std::string& path, const std::string& ext) {
   Assimp::Importer importer;
   // No JoinIdenticalVertices (slow): AssimpLoader welds vertices itself.
@@ -1653,6 +1677,7 @@ LoadedModel load_with_assimp(const std::string& path, const std::string& ext) {
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) fail("is incomplete (no meshes were read)");
   LoadedModel out;
   AssimpLoader(path, *scene, /*use_file_normals=*/ext != ".stl", &out).run();
+  if (ext == ".obj") out.warnings = missing_material_libraries(path);
   return out;
 }
 

@@ -13,6 +13,7 @@ struct LoadedModel {
   ir::Mesh mesh;  // triangle_material indexes `materials`
   std::vector<ir::Material> materials;
   std::vector<ir::Texture> textures;  // Material::base_color_texture indexes this
+  std::vector<std::string> warnings;  // what loaded but not as the file meant (one line each)
 };
 
 // Loads glTF 2.0 (.gltf/.glb, through tinygltf, with base-colour textures) or OBJ/PLY/STL (through

@@ -328,6 +328,19 @@ TEST(MeshIoObj, MissingTextureIsAnErrorNamingIt) {
   expect_load_error(dir.file("spider.obj"), "wal67ar_small.jpg");
 }
 
+TEST(MeshIoObj, AMissingMaterialLibraryLoadsWithAWarning) {
+  EXPECT_TRUE(load_ok(kModels + "OBJ/spider.obj").warnings.empty()) << "its spider.mtl is there";
+  TempDir dir;
+  write_file(dir.file("grey.obj"),
+             "# a triangle\n  mtllib gone.mtl here.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_file(dir.file("here.mtl"), "newmtl m\nKd 1 0 0\n");
+  const LoadedModel m = load_ok(dir.file("grey.obj"));
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_EQ(m.warnings[0],
+            "material library 'gone.mtl' is not beside the mesh: its colours and textures are "
+            "not used");
+}
+
 TEST(MeshIoObj, RejectsFilesWithoutTriangles) {
   expect_load_error(kModels + "OBJ/testpoints.obj", "contains no triangles");
   expect_load_error(kModels + "OBJ/testline.obj", "contains no triangles");
