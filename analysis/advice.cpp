@@ -113,7 +113,7 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
                              settings.max_blur_px));
   }
   // Exposure.
-  // The advice names how many stops: "one stop" was the advice at 30 s too, where twelve were
+  // The advice names how many stops: "one stop" was the advice at 30 s too, where nine were
   // needed.
   auto stops_text = [](double stops) {  // in thirds, as cameras step: "1/3 stop", "5 2/3 stops"
     const int thirds = static_cast<int>(std::lround(stops * 3));

@@ -180,7 +180,10 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
             }
             const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
 
-            const double stops_over = std::log2(std::max(signal, 1e-300) / settings.max_signal);
+            // A signal that is not a number (no light data) counts as the darkest.
+            const double stops_over =
+                std::isfinite(signal) ? std::log2(std::max(signal, 1e-300) / settings.max_signal)
+                                      : ShotCoverage::kSignalLowestStops;
             const int signal_bin = static_cast<int>(
                 std::clamp(std::floor((stops_over - ShotCoverage::kSignalLowestStops) /
                                       ShotCoverage::kSignalBinStops),

@@ -277,8 +277,11 @@ void Lowering::lower_camera() {
   camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
   camera.cx = camera.width_px / 2.0;
   camera.cy = camera.height_px / 2.0;
+  // With the effect off the mapping is neither rendered nor exported.
   const std::string lens_problem =
-      distortion_problem(camera.distortion, camera.cx / camera.fx, camera.cy / camera.fy);
+      camera.effects.distortion
+          ? distortion_problem(camera.distortion, camera.cx / camera.fx, camera.cy / camera.fy)
+          : std::string();
   if (!lens_problem.empty()) error(spec_.distortion_loc, lens_problem);
   // The photographer's acceptable circle of confusion unless the scene sets its own.
   if (scene_.coverage.max_blur_px <= 0) {
@@ -337,8 +340,8 @@ void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double
   if ((eye_in_object.cwiseAbs() - half).maxCoeff() < 0) {
     error(loc, fmt::format("{}: the camera is inside the object's bounding box", shot.name));
   }
-  // Inside the studio's own solids the camera sees nothing (the checks warned only that the
-  // object filled 0 % of the frame).
+  // Below the floor or inside the turntable's disc the camera sees nothing (the checks warned
+  // only that the object filled 0 % of the frame). The thin stand under the disc is left out.
   const ir::Turntable& table = scene_.studio.turntable;
   if (eye.z() < 0) {
     error(loc, fmt::format("{}: the camera is {:.2f} m below the floor", shot.name, -eye.z()));

@@ -67,7 +67,7 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
     *error = fmt::format("cannot run {}: {}", argv[0], std::strerror(rc));
     return -1;
   }
-  const backends::WatchedChild watched(pid);
+  backends::WatchedChild watched(pid);
   int status = 0;
   rusage usage{};
   while (wait4(pid, &status, 0, &usage) < 0) {
@@ -76,6 +76,7 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
       return -1;
     }
   }
+  watched.release();
   if (cpu_seconds) {
     auto seconds = [](const timeval& t) {
       return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6;

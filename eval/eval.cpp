@@ -131,15 +131,14 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
     }
     gt.triangles = scene->object.mesh.triangles;
     gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
-    // A run measured against a scene it was not rendered from gives numbers without meaning
-    // (another object: F-score 0, and no word of why).
+    // A run measured against an object it was not rendered from gives numbers without meaning
+    // (another object: F-score 0, and no word of why). Runs record the object's surface.
     if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
-        m["inputs"].contains("content_sha256") && m["inputs"]["content_sha256"].is_string() &&
-        m["inputs"]["content_sha256"].get<std::string>() != backends::scene_content_hash(*scene)) {
+        m["inputs"].contains("object_sha256") && m["inputs"]["object_sha256"].is_string() &&
+        m["inputs"]["object_sha256"].get<std::string>() != backends::object_geometry_hash(*scene)) {
       *warning = fmt::format(
-          "the object of {} is not the one the run in {} was rendered with (its mesh or "
-          "textures differ from manifest.json's content hash): the numbers measure against "
-          "another object",
+          "the object of {} is not the one the run in {} was rendered with (its surface differs "
+          "from manifest.json's object_sha256): the numbers measure against another object",
           scene_path, run_dir.string());
     }
   }
@@ -237,17 +236,38 @@ struct ImageSet {
   bool all_eight_bit = true;  // COLMAP 3.8 reads 8-bit images only
 };
 
-// Writes every image of `from` into `to` as 8 bits a channel, under the same name: COLMAP 3.8
-// cannot read the 16-bit PNG and TIFF that a camera's `output: {format: png16}` writes (its
-// matcher then aborted), and its SIFT works on 8-bit grey anyway.
+// Puts every image of `from` into `to` under the same name, 8 bits a channel: COLMAP 3.8 cannot
+// read the 16-bit PNG and TIFF that a camera's `output: {format: png16}` writes (its matcher then
+// aborted), and its SIFT works on 8-bit grey anyway. 8-bit files are copied as they are (a JPEG
+// is not encoded twice). False with `error` when an image's pixels cannot be read (its header
+// could: the input is at fault) or a copy cannot be written.
 bool write_eight_bit_copies(const fs::path& from, const fs::path& to,
-                            const std::vector<std::string>& names, std::string* error) {
+                            const std::vector<std::string>& names, bool* input_fault,
+                            std::string* error) {
   std::error_code ec;
   fs::create_directories(to, ec);
   for (const auto& name : names) {
     OIIO::ImageBuf image((from / name).string());
-    if (!image.read(0, 0, true, OIIO::TypeDesc::UINT8) ||
-        !image.write((to / name).string(), OIIO::TypeDesc::UINT8)) {
+    if (!image.init_spec((from / name).string(), 0, 0)) {
+      *input_fault = true;
+      *error = fmt::format("cannot read {}: {}", (from / name).string(), image.geterror());
+      return false;
+    }
+    if (image.spec().format == OIIO::TypeDesc::UINT8) {
+      fs::copy_file(from / name, to / name, fs::copy_options::overwrite_existing, ec);
+      if (ec) {
+        *error = fmt::format("cannot copy {} for COLMAP: {}", (from / name).string(), ec.message());
+        return false;
+      }
+      continue;
+    }
+    if (!image.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
+      *input_fault = true;
+      *error =
+          fmt::format("cannot read the pixels of {}: {}", (from / name).string(), image.geterror());
+      return false;
+    }
+    if (!image.write((to / name).string(), OIIO::TypeDesc::UINT8)) {
       *error = fmt::format("cannot write an 8-bit copy of {} for COLMAP: {}",
                            (from / name).string(), image.geterror());
       return false;
@@ -290,8 +310,9 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
     images_dir = work / "images_8bit";
     if (!o.quiet)
       log << "rigc eval: 8-bit copies of the images for COLMAP in " << images_dir.string() << "\n";
-    if (!write_eight_bit_copies(given_images_dir, images_dir, image_names, &error)) {
-      r.exit_code = 2;
+    bool input_fault = false;
+    if (!write_eight_bit_copies(given_images_dir, images_dir, image_names, &input_fault, &error)) {
+      r.exit_code = input_fault ? 1 : 2;
       r.failure = error;
       return r;
     }
@@ -410,9 +431,9 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
   std::vector<std::string> map = {o.colmap, "mapper", "--database_path", db.string(),
                                   "--image_path", images_dir.string(), "--output_path",
                                   (work / "sparse").string(),
-                                  // COLMAP drops models of fewer than 10 images by default: a
-                                  // 9-shot capture (or 10 with one lost) then "reconstructed
-                                  // nothing" although the mapper had built it whole.
+                                  // COLMAP 3.8 drops a model of fewer than min(images, 10)
+                                  // registered images: a ring with one photo lost registers in
+                                  // parts, and "reconstructed nothing" though it had built 5 of 9.
                                   "--Mapper.min_model_size", "3"};
   if (exact_prior && !o.refine_intrinsics) {
     // A known camera: refining focal length and distortion from two narrow-angle views of a
@@ -557,13 +578,6 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     return 1;
   }
   const fs::path out = o.output_dir.empty() ? run_dir / "eval" : fs::path(o.output_dir);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (!fs::is_directory(out)) {
-    log << fmt::format("rigc eval: error: cannot create the output folder {}\n", out.string());
-    return 1;
-  }
-  sum.output_dir = out.string();
   sum.images = static_cast<int>(image_names.size());
   std::string error;
 
@@ -624,6 +638,16 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
         images_dir.string());
     return 1;
   }
+
+  // Made only now that the inputs have passed their checks: a refused input leaves nothing
+  // behind (in photos mode the folder would sit among the user's photos).
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (!fs::is_directory(out)) {
+    log << fmt::format("rigc eval: error: cannot create the output folder {}\n", out.string());
+    return 1;
+  }
+  sum.output_dir = out.string();
 
   json report;
   report["rigc_eval_version"] = 1;

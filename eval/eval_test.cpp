@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 
+#include "backends/common/manifest.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
 #include "compiler/mesh_io.h"
@@ -419,6 +420,7 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_NE(log.str().find("a.jpg is 64x64 pixels, but"), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("gives the camera as 64x3"), std::string::npos) << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "a refused input leaves nothing behind";
   // An empty camera file printed "rigc eval: error: " and nothing more.
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"), "");
   log.str("");
@@ -456,13 +458,54 @@ TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_NE(log.str().find("manifest.json is not valid JSON"), std::string::npos) << log.str();
   // Rendered from one object, measured against the paper scene's statue: said, then measured.
-  rigc::testing::write_text(dir.file("run/manifest.json"),
-                            R"({"inputs": {"content_sha256": "0123", "source_file": "x.yaml"}})");
   o.scene = rigc::testing::source_path("scenes/paper-turntable.yaml");
-  log.str("");
-  EXPECT_EQ(evaluate(o, log, nullptr), 2) << log.str();  // then the missing COLMAP
-  EXPECT_NE(log.str().find("warning: the object of"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("is not the one the run in"), std::string::npos) << log.str();
+  DiagnosticEngine diag;
+  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  auto paper = compile_scene_file(o.scene, diag);
+  ASSERT_TRUE(paper);
+  const std::string paper_hash = backends::object_geometry_hash(*paper);
+  auto scaled = *paper;  // the same mesh fitted 1 % taller: another ground truth
+  scaled.object.object_from_mesh.topLeftCorner<3, 3>() *= 1.01;
+  ASSERT_NE(backends::object_geometry_hash(scaled), paper_hash);
+  for (const std::string& hash : {paper_hash, std::string("0123")}) {
+    rigc::testing::write_text(
+        dir.file("run/manifest.json"),
+        R"({"inputs": {"object_sha256": ")" + hash + R"(", "source_file": "x.yaml"}})");
+    log.str("");
+    EXPECT_EQ(evaluate(o, log, nullptr), 2) << log.str();  // then the missing COLMAP
+    const bool warned = log.str().find("warning: the object of") != std::string::npos;
+    EXPECT_EQ(warned, hash != paper_hash) << log.str();
+  }
+}
+
+// 16-bit photos go to COLMAP as 8-bit copies; one whose header reads but whose pixels do not is
+// the input's fault (exit 1), named, not a tool failure.
+TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  for (const char* name : {"a.png", "b.png"}) {
+    const std::string path = dir.file("photos/") + name;
+    const OIIO::ImageSpec spec(64, 64, 3, OIIO::TypeDesc::UINT16);
+    std::vector<std::uint16_t> pixels(64 * 64 * 3);
+    for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<std::uint16_t>(i * 977);
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out && out->open(path, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT16, pixels.data()));
+    ASSERT_TRUE(out->close());
+  }
+  fs::resize_file(dir.path() / "photos" / "b.png",
+                  fs::file_size(dir.path() / "photos" / "b.png") / 2);
+  write_cube_ply(dir.file("cube.ply"));
+  EvalOptions o;
+  o.photos_dir = dir.file("photos");
+  o.ground_truth = dir.file("cube.ply");
+  o.output_dir = dir.file("eval");
+  o.colmap = dir.file("no-such-colmap");
+  std::ostringstream log;
+  EXPECT_EQ(evaluate(o, log, nullptr), 1) << log.str();
+  EXPECT_NE(log.str().find("cannot read the pixels of"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("b.png"), std::string::npos) << log.str();
+  EXPECT_TRUE(fs::exists(dir.path() / "eval" / "colmap" / "images_8bit" / "a.png"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -585,8 +628,8 @@ shots:
   EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "colmap" / "images_8bit" / "shot_000.png"));
 }
 
-// A ring with a gap (one of ten photos lost) registers in part. COLMAP drops models smaller than
-// 80 % of the images unless told otherwise: this said "reconstructed nothing".
+// A ring with a gap (one of ten photos lost) registers in part. COLMAP 3.8 drops models smaller
+// than min(images, 10) unless told otherwise: this said "reconstructed nothing".
 TEST(EvalEndToEnd, SlowCaptureWithAGapReportsThePartItReconstructs) {
   if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
   rigc::testing::TempDir dir;

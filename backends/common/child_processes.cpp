@@ -11,6 +11,7 @@ namespace {
 
 // Lock-free slots, read by the signal handler (0: free). A few children run at once at most.
 std::array<std::atomic<pid_t>, 16> g_children{};
+static_assert(std::atomic<pid_t>::is_always_lock_free, "the signal handler reads the slots");
 
 constexpr std::array kStopSignals = {SIGINT, SIGTERM, SIGHUP};
 

@@ -41,9 +41,13 @@ CLI::Validator finite_number_where(Accept accept, std::string complaint, std::st
         const char* first = text.data() + (text.starts_with('+') ? 1 : 0);
         const char* last = text.data() + text.size();
         const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
-        if (first == last || error != std::errc() || end != last) {
+        // "+-2" is no number; 1e400 parses but is out of a double's range.
+        const bool signed_twice = first != text.data() && first != last && *first == '-';
+        if (first == last || signed_twice || end != last ||
+            (error != std::errc() && error != std::errc::result_out_of_range)) {
           return "'" + text + "' is not a number";
         }
+        if (error == std::errc::result_out_of_range) return "'" + text + "' is out of range";
         if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
         return accept(value) ? std::string() : "'" + text + "' " + complaint;
       },

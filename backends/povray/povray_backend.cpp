@@ -305,7 +305,7 @@ bool write_text_file(const fs::path& path, const std::string& text, std::string*
 // emit into a folder that held more shots (`compile --target povray` after shots were removed)
 // deletes those shots' files, and only those: a `povray` over every .ini there rendered shots
 // the scene no longer has.
-constexpr const char* kShotListFile = "shots.txt";
+constexpr const char* kShotListFile = "rigc-shots.txt";
 
 void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
   std::ifstream listed(dir / kShotListFile);

@@ -125,6 +125,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   manifest.set_inputs({{"scene", scene.name},
                        {"source_file", scene.source_file},
                        {"content_sha256", content_hash},
+                       {"object_sha256", backends::object_geometry_hash(scene)},
                        {"scale", options.scale},
                        {"seed", options.seed}});
   const StudioScene studio = prepare_studio_scene(scene);

@@ -78,7 +78,7 @@ ProgramResult run_program(const std::vector<std::string>& argv, const fs::path& 
     return result;
   }
   result.started = true;
-  const backends::WatchedChild watched(pid);
+  backends::WatchedChild watched(pid);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {
@@ -86,6 +86,7 @@ ProgramResult run_program(const std::vector<std::string>& argv, const fs::path& 
       return result;
     }
   }
+  watched.release();
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
 }

@@ -138,6 +138,7 @@ int run_reference(const ir::Scene& scene, const ReferenceOptions& options, Rende
   manifest.set_inputs({{"scene", scene.name},
                        {"source_file", scene.source_file},
                        {"content_sha256", content_hash},
+                       {"object_sha256", backends::object_geometry_hash(scene)},
                        {"scale", options.scale},
                        {"seed", options.seed},
                        {"samples", options.samples}});
