@@ -1,6 +1,7 @@
 #include "eval/eval.h"
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -380,18 +381,25 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
 
 // COLMAP's extractor only logs a file it cannot read, and its matcher then aborted (exit 134)
 // without naming it: eval reads every image's header first and names the ones that fail.
-TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
-  rigc::testing::TempDir dir;
-  fs::create_directories(dir.path() / "photos");
-  for (const char* name : {"a.jpg", "b.jpg", "d.png"})
-    write_small_image(dir.file("photos/") + name);
-  rigc::testing::write_text(dir.file("photos/c.jpg"), "not an image");
+// Options for evaluating dir/photos against a cube (written here) into dir/eval, with a COLMAP
+// that does not exist: for the checks that come before COLMAP runs.
+EvalOptions photos_without_colmap(const rigc::testing::TempDir& dir) {
   write_cube_ply(dir.file("cube.ply"));
   EvalOptions o;
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
   o.colmap = dir.file("no-such-colmap");
+  return o;
+}
+
+TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  for (const char* name : {"a.jpg", "b.jpg", "d.png"})
+    write_small_image(dir.file("photos/") + name);
+  rigc::testing::write_text(dir.file("photos/c.jpg"), "not an image");
+  const EvalOptions o = photos_without_colmap(dir);
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_NE(log.str().find("1 of the 4 images cannot be read"), std::string::npos) << log.str();
@@ -495,12 +503,7 @@ TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
   }
   fs::resize_file(dir.path() / "photos" / "b.png",
                   fs::file_size(dir.path() / "photos" / "b.png") / 2);
-  write_cube_ply(dir.file("cube.ply"));
-  EvalOptions o;
-  o.photos_dir = dir.file("photos");
-  o.ground_truth = dir.file("cube.ply");
-  o.output_dir = dir.file("eval");
-  o.colmap = dir.file("no-such-colmap");
+  const EvalOptions o = photos_without_colmap(dir);
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1) << log.str();
   EXPECT_NE(log.str().find("cannot read the pixels of"), std::string::npos) << log.str();
@@ -590,40 +593,54 @@ shots:
   }
 }
 
-// COLMAP 3.8 reads 8-bit images only: a run in the language's own 16-bit PNG made its matcher
-// abort (exit 134). Eval hands it 8-bit copies.
-TEST(EvalEndToEnd, SlowSixteenBitRunIsEvaluated) {
-  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
-  rigc::testing::TempDir dir;
-  const RenderedRun run = render(dir, R"(rigc: 1
-name: eval-e2e-png16
+// A small speckled statue on a turntable, `steps` shots 20 degrees apart, 656 px wide at the
+// tests' 0.12 scale; `camera_extra` lines go into the camera section.
+std::string small_statue_ring(const std::string& name, int steps, const std::string& camera_extra) {
+  return fmt::format(R"(rigc: 1
+name: {}
 object:
-  primitive: {shape: statue, detail: 4, seed: 3}
-  fit: {height: 25cm}
-  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
+  primitive: {{shape: statue, detail: 4, seed: 3}}
+  fit: {{height: 25cm}}
+  surface: {{pattern: speckle, scale: 2mm, contrast: 0.8}}
 studio:
-  backdrop: {green_screen: true}
+  backdrop: {{green_screen: true}}
   lights:
-    - {type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
+    - {{type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}}
   ambient: 50lx
 camera:
   body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
-  effects: {motion_blur: false}
-  output: {format: png16}
-shots:
-  - turntable: {steps: 8, step: 20deg, camera: {distance: 70cm, height: 15cm}}
+  lens: {{focal_length: 50mm}}
+  exposure: {{aperture: f/11, shutter: 1/125, iso: 200}}
+  effects: {{motion_blur: false}}
+{}shots:
+  - turntable: {{steps: {}, step: 20deg, camera: {{distance: 70cm, height: 15cm}}}}
 )",
-                                 0.12);
-  ASSERT_TRUE(fs::exists(run.run_dir / "images" / "shot_000.png"));
+                     name, camera_extra, steps);
+}
+
+// Evaluates a small rendered run quietly (20000 ground-truth samples); false, with the log
+// printed, if eval does not exit 0.
+bool evaluate_small_run(const RenderedRun& run, EvalSummary* s) {
   EvalOptions o;
   o.run_dir = run.run_dir.string();
   o.quiet = true;
   o.ground_truth_samples = 20000;
   std::ostringstream log;
+  const int code = evaluate(o, log, s);
+  if (code != 0) ADD_FAILURE() << "eval exited " << code << ":\n" << log.str();
+  return code == 0;
+}
+
+// COLMAP 3.8 reads 8-bit images only: a run in the language's own 16-bit PNG made its matcher
+// abort (exit 134). Eval hands it 8-bit copies.
+TEST(EvalEndToEnd, SlowSixteenBitRunIsEvaluated) {
+  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
+  rigc::testing::TempDir dir;
+  const RenderedRun run =
+      render(dir, small_statue_ring("eval-e2e-png16", 8, "  output: {format: png16}\n"), 0.12);
+  ASSERT_TRUE(fs::exists(run.run_dir / "images" / "shot_000.png"));
   EvalSummary s;
-  ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
+  ASSERT_TRUE(evaluate_small_run(run, &s));
   EXPECT_EQ(s.registered, 8);
   EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "colmap" / "images_8bit" / "shot_000.png"));
 }
@@ -633,34 +650,10 @@ shots:
 TEST(EvalEndToEnd, SlowCaptureWithAGapReportsThePartItReconstructs) {
   if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
   rigc::testing::TempDir dir;
-  const RenderedRun run = render(dir, R"(rigc: 1
-name: eval-e2e-gap
-object:
-  primitive: {shape: statue, detail: 4, seed: 3}
-  fit: {height: 25cm}
-  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
-studio:
-  backdrop: {green_screen: true}
-  lights:
-    - {type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
-  ambient: 50lx
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
-  effects: {motion_blur: false}
-shots:
-  - turntable: {steps: 10, step: 20deg, camera: {distance: 70cm, height: 15cm}}
-)",
-                                 0.12);
+  const RenderedRun run = render(dir, small_statue_ring("eval-e2e-gap", 10, ""), 0.12);
   ASSERT_TRUE(fs::remove(run.run_dir / "images" / "shot_005.jpg"));
-  EvalOptions o;
-  o.run_dir = run.run_dir.string();
-  o.quiet = true;
-  o.ground_truth_samples = 20000;
-  std::ostringstream log;
   EvalSummary s;
-  ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
+  ASSERT_TRUE(evaluate_small_run(run, &s));
   EXPECT_EQ(s.images, 9);
   EXPECT_GE(s.registered, 3);
   EXPECT_LT(s.registered, 9) << "the gap splits the ring";
