@@ -21,13 +21,13 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iterator>
 #include <limits>
 #include <map>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <utility>

@@ -44,9 +44,10 @@ std::optional<std::vector<int>> parse_shot_selection(const std::string& text, in
   // An empty `--shots ''` is refused rather than read as "all": it is usually a shell variable
   // that came out empty, and rendering every shot of a big scene is not what was meant.
   if (all.empty()) {
-    return fail(fmt::format("the shot selection is empty: give indices and ranges like 0,3,5-7 "
-                            "or 'all' ({})",
-                            range));
+    return fail(
+        fmt::format("the shot selection is empty: give indices and ranges like 0,3,5-7 "
+                    "or 'all' ({})",
+                    range));
   }
   if (all == "all") {
     for (int i = 0; i < shot_count; ++i) selected.push_back(i);

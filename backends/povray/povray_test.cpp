@@ -87,7 +87,8 @@ TEST(PovrayEmit, AnEmitWithFewerShotsRemovesOnlyTheFilesOfTheShotsItNoLongerHas)
   }
   EXPECT_TRUE(fs::exists(out / "notes.ini"));
   EXPECT_TRUE(fs::exists(out / "shot_099.pov"));
-  EXPECT_EQ(read_text((out / "rigc-shots.txt").string()), "shot_000\nshot_001\nshot_002\nshot_003\n");
+  EXPECT_EQ(read_text((out / "rigc-shots.txt").string()),
+            "shot_000\nshot_001\nshot_002\nshot_003\n");
 }
 
 TEST(PovrayEmit, TurningTableGetsMotionBlurSubframes) {
