@@ -116,6 +116,26 @@ struct Studio {
 struct Distortion {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
   bool is_zero() const { return k1 == 0 && k2 == 0 && p1 == 0 && p2 == 0 && k3 == 0; }
+  // The distorted normalised point of the undistorted (x, y) (COLMAP's OPENCV model). The one
+  // place the mapping is written: the lens's inversion and the compiler's fold-over check use it.
+  Vec2 apply(double x, double y) const {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
+            y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
+  }
+  // d apply / d(x, y) at (x, y); symmetric.
+  Eigen::Matrix2d jacobian(double x, double y) const {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial = k1 + r2 * (2 * k2 + 3 * k3 * r2);  // d radial / d r²
+    const double jxx = radial + 2 * x * x * dradial + 2 * p1 * y + 6 * p2 * x;
+    const double jxy = 2 * x * y * dradial + 2 * p1 * x + 2 * p2 * y;
+    const double jyy = radial + 2 * y * y * dradial + 6 * p1 * y + 2 * p2 * x;
+    Eigen::Matrix2d j;
+    j << jxx, jxy, jxy, jyy;
+    return j;
+  }
 };
 
 // Sensor noise model (ISETCam order). Electrons at clipping scale as FWC * base_iso / iso.
@@ -216,5 +236,9 @@ struct Scene {
 
 // world_from_object for a turntable angle.
 Mat4 world_from_object(const Scene& scene, double turntable_angle_rad);
+
+// The object's mesh positions in the object frame (through object_from_mesh, in double, stored
+// as float): the ground truth eval measures against.
+std::vector<Eigen::Vector3f> object_frame_positions(const Object& object);
 
 }  // namespace rigc::ir

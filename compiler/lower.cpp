@@ -247,21 +247,14 @@ std::string distortion_problem(const ir::Distortion& d, double half_x, double ha
     const double cx = std::cos(angle), cy = std::sin(angle);
     bool left = false;
     for (double r = step; r <= farthest && !left; r += step) {
-      const double x = r * cx, y = r * cy, r2 = x * x + y * y;
-      const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-      const double dradial = d.k1 + r2 * (2 * d.k2 + 3 * d.k3 * r2);
-      const double jxx = radial + 2 * x * x * dradial + 2 * d.p1 * y + 6 * d.p2 * x;
-      const double jxy = 2 * x * y * dradial + 2 * d.p1 * x + 2 * d.p2 * y;
-      const double jyy = radial + 2 * y * y * dradial + 6 * d.p1 * y + 2 * d.p2 * x;
-      const double xd = x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x);
-      const double yd = y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y;
-      if (!(jxx * jyy - jxy * jxy > 0)) {
+      const ir::Vec2 distorted = d.apply(r * cx, r * cy);
+      if (!(d.jacobian(r * cx, r * cy).determinant() > 0)) {
         return fmt::format(
             "the distortion folds the image over {:.0f} % of the way to the frame's corner: "
             "no lens maps it; make the coefficients smaller",
-            100 * std::hypot(xd, yd) / corner);
+            100 * distorted.norm() / corner);
       }
-      left = std::abs(xd) > half_x || std::abs(yd) > half_y;
+      left = std::abs(distorted.x()) > half_x || std::abs(distorted.y()) > half_y;
     }
     if (!left) {
       return "the distortion pulls the frame's edge in so far that no scene point reaches it; "
@@ -479,6 +472,17 @@ std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticE
 Mat4 ir::world_from_object(const ir::Scene& scene, double turntable_angle_rad) {
   return translation(Vec3(0, 0, scene.studio.turntable.height_m)) *
          rotation(Eigen::AngleAxisd(turntable_angle_rad, Vec3::UnitZ()).toRotationMatrix());
+}
+
+std::vector<Eigen::Vector3f> ir::object_frame_positions(const ir::Object& object) {
+  std::vector<Eigen::Vector3f> positions;
+  positions.reserve(object.mesh.positions.size());
+  for (const auto& p : object.mesh.positions) {
+    const Vec3 q = object.object_from_mesh.topLeftCorner<3, 3>() * p.cast<double>() +
+                   object.object_from_mesh.topRightCorner<3, 1>();
+    positions.push_back(q.cast<float>());
+  }
+  return positions;
 }
 
 }  // namespace rigc

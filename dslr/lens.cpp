@@ -38,24 +38,17 @@ Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale) {
 }
 
 ir::Vec2 distort_normalized(const ir::Distortion& d, double x, double y) {
-  const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-  return {x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x),
-          y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y};
+  return d.apply(x, y);
 }
 
 bool try_undistort_normalized(const ir::Distortion& d, double x, double y, ir::Vec2* undistorted,
                               const ir::Vec2* guess) {
   auto newton = [&](double ux, double uy) -> bool {
     for (int iteration = 0; iteration < 30; ++iteration) {
-      const double r2 = ux * ux + uy * uy;
-      const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-      const double dradial = d.k1 + r2 * (2 * d.k2 + 3 * d.k3 * r2);  // d radial / d r²
-      const double fx = ux * radial + 2 * d.p1 * ux * uy + d.p2 * (r2 + 2 * ux * ux) - x;
-      const double fy = uy * radial + d.p1 * (r2 + 2 * uy * uy) + 2 * d.p2 * ux * uy - y;
-      const double jxx = radial + 2 * ux * ux * dradial + 2 * d.p1 * uy + 6 * d.p2 * ux;
-      const double jxy = 2 * ux * uy * dradial + 2 * d.p1 * ux + 2 * d.p2 * uy;
-      const double jyy = radial + 2 * uy * uy * dradial + 6 * d.p1 * uy + 2 * d.p2 * ux;
+      const ir::Vec2 distorted = d.apply(ux, uy);
+      const double fx = distorted.x() - x, fy = distorted.y() - y;
+      const Eigen::Matrix2d j = d.jacobian(ux, uy);
+      const double jxx = j(0, 0), jxy = j(0, 1), jyy = j(1, 1);
       const double det = jxx * jyy - jxy * jxy;
       // A non-positive Jacobian means we are past the fold: the lens maps no point here.
       if (!(det > 1e-12)) return false;

@@ -123,12 +123,7 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
                            messages);
       return std::nullopt;
     }
-    const ir::Mat4& object_from_mesh = scene->object.object_from_mesh;
-    for (const auto& p : scene->object.mesh.positions) {
-      const ir::Vec3 q = object_from_mesh.topLeftCorner<3, 3>() * p.cast<double>() +
-                         object_from_mesh.topRightCorner<3, 1>();
-      gt.positions.push_back(q.cast<float>());
-    }
+    gt.positions = ir::object_frame_positions(scene->object);
     gt.triangles = scene->object.mesh.triangles;
     gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
     // A run measured against an object it was not rendered from gives numbers without meaning

@@ -140,14 +140,7 @@ std::string scene_content_hash(const ir::Scene& scene) {
 
 std::string object_geometry_hash(const ir::Scene& scene) {
   Sha256 hash;
-  const ir::Mat4& object_from_mesh = scene.object.object_from_mesh;
-  std::vector<Eigen::Vector3f> positions;
-  positions.reserve(scene.object.mesh.positions.size());
-  for (const auto& p : scene.object.mesh.positions) {
-    const ir::Vec3 q = object_from_mesh.topLeftCorner<3, 3>() * p.cast<double>() +
-                       object_from_mesh.topRightCorner<3, 1>();
-    positions.push_back(q.cast<float>());
-  }
+  const std::vector<Eigen::Vector3f> positions = ir::object_frame_positions(scene.object);
   const std::uint64_t counts[2] = {positions.size(), scene.object.mesh.triangles.size()};
   hash.update(counts, sizeof counts);
   if (!positions.empty()) hash.update(positions.data(), positions.size() * sizeof(positions[0]));

@@ -66,9 +66,9 @@ class Manifest {
 // per scene and pass it to shot_key.
 std::string scene_content_hash(const ir::Scene& scene);
 
-// SHA-256 of the object's surface in its own frame (mesh positions through object_from_mesh, as
-// float, and the triangles): what eval measures a reconstruction against. Unlike the content
-// hash it follows fit/scale/rotate and ignores textures.
+// SHA-256 of the object's surface in its own frame (ir::object_frame_positions and the
+// triangles): what eval measures a reconstruction against. Unlike the content hash it follows
+// fit/scale/rotate and ignores textures.
 std::string object_geometry_hash(const ir::Scene& scene);
 
 // The key of one shot's output: SHA-256 over the IR of everything that can change its image
