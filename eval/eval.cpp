@@ -12,6 +12,7 @@
 #include <map>
 #include <ostream>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "backends/common/colmap_text.h"
@@ -225,10 +226,14 @@ bool every_image_planned(const std::vector<std::string>& image_names,
 }
 
 // Features, matches, mapper, text export of the largest model.
-// What the image headers said, read before COLMAP runs.
+// What the image headers said, read once before COLMAP runs.
 struct ImageSet {
-  bool one_size = true;       // every image the same width and height
-  bool all_eight_bit = true;  // COLMAP 3.8 reads 8-bit images only
+  std::map<std::string, std::pair<int, int>> size;  // width, height by image name
+  std::set<std::string> wider_than_eight_bit;       // COLMAP 3.8 reads 8-bit images only
+  bool one_size() const {
+    return std::all_of(size.begin(), size.end(),
+                       [&](const auto& entry) { return entry.second == size.begin()->second; });
+  }
 };
 
 // Puts every image of `from` into `to` under the same name, 8 bits a channel: COLMAP 3.8 cannot
@@ -236,19 +241,12 @@ struct ImageSet {
 // aborted), and its SIFT works on 8-bit grey anyway. 8-bit files are copied as they are (a JPEG
 // is not encoded twice). False with `error` when an image's pixels cannot be read (its header
 // could: the input is at fault) or a copy cannot be written.
-bool write_eight_bit_copies(const fs::path& from, const fs::path& to,
-                            const std::vector<std::string>& names, bool* input_fault,
-                            std::string* error) {
+bool write_eight_bit_copies(const fs::path& from, const fs::path& to, const ImageSet& set,
+                            bool* input_fault, std::string* error) {
   std::error_code ec;
   fs::create_directories(to, ec);
-  for (const auto& name : names) {
-    OIIO::ImageBuf image((from / name).string());
-    if (!image.init_spec((from / name).string(), 0, 0)) {
-      *input_fault = true;
-      *error = fmt::format("cannot read {}: {}", (from / name).string(), image.geterror());
-      return false;
-    }
-    if (image.spec().format == OIIO::TypeDesc::UINT8) {
+  for (const auto& [name, size] : set.size) {
+    if (!set.wider_than_eight_bit.count(name)) {
       fs::copy_file(from / name, to / name, fs::copy_options::overwrite_existing, ec);
       if (ec) {
         *error = fmt::format("cannot copy {} for COLMAP: {}", (from / name).string(), ec.message());
@@ -256,6 +254,7 @@ bool write_eight_bit_copies(const fs::path& from, const fs::path& to,
       }
       continue;
     }
+    OIIO::ImageBuf image((from / name).string());
     if (!image.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
       *input_fault = true;
       *error =
@@ -301,12 +300,12 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
   fs::create_directories(logs, ec);
   std::string error;
   fs::path images_dir = given_images_dir;
-  if (!set.all_eight_bit) {
+  if (!set.wider_than_eight_bit.empty()) {
     images_dir = work / "images_8bit";
     if (!o.quiet)
       log << "rigc eval: 8-bit copies of the images for COLMAP in " << images_dir.string() << "\n";
     bool input_fault = false;
-    if (!write_eight_bit_copies(given_images_dir, images_dir, image_names, &input_fault, &error)) {
+    if (!write_eight_bit_copies(given_images_dir, images_dir, set, &input_fault, &error)) {
       r.exit_code = input_fault ? 1 : 2;
       r.failure = error;
       return r;
@@ -323,7 +322,7 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
                                  "--image_path", images_dir.string(), "--ImageReader.single_camera",
                                  // One camera for photos of one size; COLMAP refuses a single
                                  // camera over images of different sizes.
-                                 set.one_size ? "1" : "0"};
+                                 set.one_size() ? "1" : "0"};
   if (!flags->extraction_gpu.empty()) {
     fe.push_back(flags->extraction_gpu);
     fe.push_back("0");
@@ -545,14 +544,12 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   // cannot read, and a folder with such files ended in the matcher aborting (exit 134) without a
   // word of which file it was.
   std::vector<std::string> unreadable;
-  std::map<std::string, std::pair<int, int>> image_size;
   ImageSet image_set;
   for (const auto& name : image_names) {
     if (auto input = OIIO::ImageInput::open((images_dir / name).string())) {
       const OIIO::ImageSpec& spec = input->spec();
-      image_size[name] = {spec.width, spec.height};
-      image_set.one_size = image_set.one_size && image_size[name] == image_size.begin()->second;
-      image_set.all_eight_bit = image_set.all_eight_bit && spec.format == OIIO::TypeDesc::UINT8;
+      image_set.size[name] = {spec.width, spec.height};
+      if (spec.format != OIIO::TypeDesc::UINT8) image_set.wider_than_eight_bit.insert(name);
       continue;
     }
     std::string why = OIIO::geterror();
@@ -601,7 +598,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     gt_camera = cams->front();
     // COLMAP takes this camera as every image's intrinsics: a size that is not the images' own
     // tripped an assertion in OpenImageIO (a height of 3) or took 24 GB (a height of 547000).
-    for (const auto& [name, size] : image_size) {
+    for (const auto& [name, size] : image_set.size) {
       if (size != std::pair{gt_camera->width, gt_camera->height}) {
         log << fmt::format(
             "rigc eval: error: {} is {}x{} pixels, but {} gives the camera as {}x{}\n",
@@ -614,7 +611,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   // SIFT finds nothing in a thumbnail: two 1 x 1 photos ended in "COLMAP reconstructed
   // nothing", exit 2, as if a tool had failed.
   constexpr int kSmallestSide = 32;
-  for (const auto& [name, size] : image_size) {
+  for (const auto& [name, size] : image_set.size) {
     if (std::min(size.first, size.second) < kSmallestSide) {
       log << fmt::format(
           "rigc eval: error: {} is {}x{} pixels: too small to find features in (at least {} a "
@@ -623,7 +620,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
       return 1;
     }
   }
-  if (!image_set.one_size && !o.quiet) {
+  if (!image_set.one_size() && !o.quiet) {
     log << "rigc eval: the photos differ in size: COLMAP gets one camera per photo\n";
   }
   if (o.matcher == "neighbours" && !every_image_planned(image_names, gt_poses)) {
