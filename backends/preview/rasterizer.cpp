@@ -1126,14 +1126,19 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
             // Each triangle against the box of the tile's samples: inside all three edges at
             // the four corners (covers), outside one edge at all four (misses), or neither.
             // The planes are affine, so the corners decide; a margin keeps rounding out.
-            constexpr float kMargin = 1e-4f;
+            constexpr float kMargin = 1e-4f, kBehindMargin = 1e-3f;
             const float bx0 = x0 + (Samples == 1 ? 0.5f : 0.125f);
             const float bx1 = x1 - 1 + (Samples == 1 ? 0.5f : 0.875f);
             const float by0 = y0 + (Samples == 1 ? 0.5f : 0.125f);
             const float by1 = y1 - 1 + (Samples == 1 ? 0.5f : 0.875f);
             const Float4 cx = {bx0, bx1, bx0, bx1}, cy = {by0, by0, by1, by1};
+            // The nearest triangle that covers the box (1/z at the corners: 1/z is affine, so
+            // a triangle whose plane lies behind it at all four corners lies behind it at every
+            // sample and can never show). The studio's big planes overlap: the floor runs on
+            // behind the green screen, the turntable's stand behind its disc.
             std::int32_t covering = -1;
-            bool uniform = true;
+            Float4 covering_inv_z = {};
+            Float4 others_inv_z = Float4{} - std::numeric_limits<float>::infinity();
             for (std::int32_t i = setup.tile_start[tile]; i < setup.tile_start[tile + 1]; ++i) {
               const ScreenTriangle& s = setup.tris[setup.tile_tris[i]];
               const Float4 w0 = s.w0_plane[0] * cx + s.w0_plane[1] * cy + s.w0_plane[2];
@@ -1143,13 +1148,22 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
               const Int4 out0 = w0 < -kMargin, out1 = w1 < -kMargin, out2 = w2 < -kMargin;
               auto all = [](Int4 m) { return m[0] && m[1] && m[2] && m[3]; };
               if (all(out0) || all(out1) || all(out2)) continue;  // misses
-              if (!all(in) || covering >= 0) {
-                uniform = false;
-                break;
+              const Float4 inv_z = s.inv_z_plane[0] * cx + s.inv_z_plane[1] * cy + s.inv_z_plane[2];
+              if (all(in) && (covering < 0 || all(inv_z > covering_inv_z))) {
+                if (covering >= 0)
+                  others_inv_z = others_inv_z > covering_inv_z ? others_inv_z : covering_inv_z;
+                covering = setup.tile_tris[i];
+                covering_inv_z = inv_z;
+              } else {
+                others_inv_z = others_inv_z > inv_z ? others_inv_z : inv_z;
               }
-              covering = setup.tile_tris[i];
             }
-            if (uniform && covering >= 0 && uniform_tile(x0, y0, x1, y1, covering)) continue;
+            // Behind by more than float rounding can move a sample's 1/z.
+            const Float4 behind = covering_inv_z - kBehindMargin * covering_inv_z;
+            const Int4 hidden = others_inv_z < behind;
+            const bool uniform = covering >= 0 && covering_inv_z[0] > 0 && hidden[0] && hidden[1] &&
+                                 hidden[2] && hidden[3];
+            if (uniform && uniform_tile(x0, y0, x1, y1, covering)) continue;
           }
           std::fill(std::begin(sample_inv_z), std::end(sample_inv_z), 0.0f);
           std::fill(std::begin(sample_tri), std::end(sample_tri), -1);
