@@ -931,6 +931,64 @@ TEST(Preview, FaceColourPicturesShadePlanesEvenly) {
 }
 
 // Back faces are skipped only for meshes that bound a solid wound outwards.
+// The rasterizer lets the triangles of one convex face cover a tile together (a tile with a
+// corner in none of them, or an edge crossing it, is rasterized per sample): each face must be
+// flat, and its triangles must tile a convex polygon, their areas summing to its hull's.
+TEST(Preview, StudioConvexFacesAreFlatAndConvex) {
+  const StudioScene studio = prepare_studio_scene(paper_scene());
+  const Geometry& room = studio.studio;
+  ASSERT_EQ(room.convex_face.size(), room.triangles.size());
+  // Two cylinders (96 side rectangles and two caps each), the floor and the green screen.
+  ASSERT_EQ(room.convex_faces, 2 * (96 + 2) + 2);
+  for (std::int32_t face = 0; face < room.convex_faces; ++face) {
+    SCOPED_TRACE(::testing::Message() << "face " << face);
+    std::vector<std::size_t> members;
+    for (std::size_t t = 0; t < room.triangles.size(); ++t) {
+      if (room.convex_face[t] == face) members.push_back(t);
+    }
+    ASSERT_FALSE(members.empty());
+    const Eigen::Vector3f normal = room.face_normals[members[0]];
+    const Eigen::Vector3f origin = room.positions[room.triangles[members[0]][0]];
+    const Eigen::Vector3f u = normal.unitOrthogonal(), v = normal.cross(u);
+    std::vector<Eigen::Vector2d> points;
+    double area = 0;
+    for (const std::size_t t : members) {
+      EXPECT_GT(room.face_normals[t].dot(normal), 0.99999f);
+      std::array<Eigen::Vector2d, 3> corner;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3f p = room.positions[room.triangles[t][k]] - origin;
+        EXPECT_NEAR(p.dot(normal), 0, 1e-5);
+        corner[k] = Eigen::Vector2d(p.dot(u), p.dot(v));
+        points.push_back(corner[k]);
+      }
+      const Eigen::Vector2d a = corner[1] - corner[0], b = corner[2] - corner[0];
+      area += std::abs(a.x() * b.y() - a.y() * b.x()) / 2;
+    }
+    // The hull by Andrew's monotone chain, then its area.
+    std::sort(points.begin(), points.end(), [](const auto& p, const auto& q) {
+      return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+    });
+    auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+    };
+    std::vector<Eigen::Vector2d> hull(2 * points.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+      hull[k++] = points[i];
+    }
+    for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+      while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+      hull[k++] = points[i];
+    }
+    double hull_area = 0;
+    for (std::size_t i = 0; i + 1 < k; ++i) {
+      hull_area += (hull[i].x() * hull[i + 1].y() - hull[i + 1].x() * hull[i].y()) / 2;
+    }
+    EXPECT_NEAR(area, hull_area, 1e-6 * hull_area);
+  }
+}
+
 TEST(Preview, ClosedOutwardMeshesAreRecognised) {
   const ir::Mesh box = make_primitive(PrimitiveKind::kBox, 1, 0);
   const ir::Mesh statue = make_primitive(PrimitiveKind::kStatue, 4, 7);

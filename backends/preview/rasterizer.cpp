@@ -1092,12 +1092,14 @@ inline void store4(std::int32_t* p, Int4 v) {
 // Four samples are tested at once: a pixel's four, or four neighbouring pixel centres. Each lane
 // evaluates the planes with the same expression as a scalar pass would, so coverage and depth
 // ties come out the same.
-// uniform_tile(x0, y0, x1, y1, id) is offered each tile that one triangle covers whole while
-// the rest of its bin misses it (the studio's big planes); returning true, it has written the
-// tile itself and the samples are skipped.
-template <int Samples, typename UniformTile, typename ResolveTile>
+// uniform_tile(x0, y0, x1, y1, id) is offered each tile where only the plane of screen triangle
+// `id` shows (the studio's big planes; see below): returning true, it has written the tile itself
+// and the samples are skipped. face_of(triangle) names the convex planar face a triangle belongs
+// to (-1: none), so that the triangles of one face may cover a tile together.
+template <int Samples, typename FaceOf, typename UniformTile, typename ResolveTile>
 void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
-                     const UniformTile& uniform_tile, const ResolveTile& resolve_tile) {
+                     const FaceOf& face_of, const UniformTile& uniform_tile,
+                     const ResolveTile& resolve_tile) {
   static_assert(Samples == 1 || Samples == kSamples);
   static_assert(kTileSize % 4 == 0);
   // Lane offsets from the pixel (Samples 4) or from the first of four pixels (Samples 1).
@@ -1132,38 +1134,60 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
             const float by0 = y0 + (Samples == 1 ? 0.5f : 0.125f);
             const float by1 = y1 - 1 + (Samples == 1 ? 0.5f : 0.875f);
             const Float4 cx = {bx0, bx1, bx0, bx1}, cy = {by0, by0, by1, by1};
-            // The nearest triangle that covers the box (1/z at the corners: 1/z is affine, so
-            // a triangle whose plane lies behind it at all four corners lies behind it at every
-            // sample and can never show). The studio's big planes overlap: the floor runs on
-            // behind the green screen, the turntable's stand behind its disc.
-            std::int32_t covering = -1;
-            Float4 covering_inv_z = {};
-            Float4 others_inv_z = Float4{} - std::numeric_limits<float>::infinity();
+            // One convex plane alone may show in the box: the nearest triangle with a corner of
+            // the box inside it, together with the triangles of its convex face (the two of a
+            // quad, the strips of a disc), when each corner lies inside one of them (a convex
+            // polygon holding the four corners holds the box) and every other triangle's plane
+            // lies behind it at all four corners (1/z is affine: then at every sample too). The
+            // studio's planes overlap: the floor runs on behind the green screen, the
+            // turntable's stand behind its disc.
+            struct Seen {
+              std::int32_t id, face;
+              Float4 inv_z;
+              Int4 in;
+            };
+            constexpr int kMaxSeen = 32;  // a busier bin is the object's, never one plane
+            std::array<Seen, kMaxSeen> seen;
+            int seen_count = 0, front = -1;
+            float front_inv_z = 0;
+            auto all = [](Int4 m) { return m[0] && m[1] && m[2] && m[3]; };
             for (std::int32_t i = setup.tile_start[tile]; i < setup.tile_start[tile + 1]; ++i) {
               const ScreenTriangle& s = setup.tris[setup.tile_tris[i]];
               const Float4 w0 = s.w0_plane[0] * cx + s.w0_plane[1] * cy + s.w0_plane[2];
               const Float4 w1 = s.w1_plane[0] * cx + s.w1_plane[1] * cy + s.w1_plane[2];
               const Float4 w2 = 1 - (w0 + w1);
-              const Int4 in = (w0 >= kMargin) & (w1 >= kMargin) & (w2 >= kMargin);
               const Int4 out0 = w0 < -kMargin, out1 = w1 < -kMargin, out2 = w2 < -kMargin;
-              auto all = [](Int4 m) { return m[0] && m[1] && m[2] && m[3]; };
               if (all(out0) || all(out1) || all(out2)) continue;  // misses
-              const Float4 inv_z = s.inv_z_plane[0] * cx + s.inv_z_plane[1] * cy + s.inv_z_plane[2];
-              if (all(in) && (covering < 0 || all(inv_z > covering_inv_z))) {
-                if (covering >= 0)
-                  others_inv_z = others_inv_z > covering_inv_z ? others_inv_z : covering_inv_z;
-                covering = setup.tile_tris[i];
-                covering_inv_z = inv_z;
-              } else {
-                others_inv_z = others_inv_z > inv_z ? others_inv_z : inv_z;
+              if (seen_count == kMaxSeen) {
+                front = -1;
+                break;
               }
+              const Int4 in = (w0 >= kMargin) & (w1 >= kMargin) & (w2 >= kMargin);
+              const Float4 inv_z = s.inv_z_plane[0] * cx + s.inv_z_plane[1] * cy + s.inv_z_plane[2];
+              seen[seen_count] = {setup.tile_tris[i], face_of(s), inv_z, in};
+              const float centre_inv_z = 0.5f * (inv_z[0] + inv_z[3]);
+              if ((in[0] || in[1] || in[2] || in[3]) && (front < 0 || centre_inv_z > front_inv_z)) {
+                front = seen_count;
+                front_inv_z = centre_inv_z;
+              }
+              ++seen_count;
             }
-            // Behind by more than float rounding can move a sample's 1/z.
-            const Float4 behind = covering_inv_z - kBehindMargin * covering_inv_z;
-            const Int4 hidden = others_inv_z < behind;
-            const bool uniform = covering >= 0 && covering_inv_z[0] > 0 && hidden[0] && hidden[1] &&
-                                 hidden[2] && hidden[3];
-            if (uniform && uniform_tile(x0, y0, x1, y1, covering)) continue;
+            if (front >= 0) {
+              const Seen& plane = seen[front];
+              // Behind by more than float rounding can move a sample's 1/z.
+              const Float4 behind = plane.inv_z - kBehindMargin * plane.inv_z;
+              Int4 covered = plane.in;
+              bool alone = plane.inv_z[0] > 0 && plane.inv_z[3] > 0;
+              for (int k = 0; k < seen_count && alone; ++k) {
+                if (k == front) continue;
+                if (plane.face >= 0 && seen[k].face == plane.face) {
+                  covered |= seen[k].in;
+                } else {
+                  alone = all(seen[k].inv_z < behind);
+                }
+              }
+              if (alone && all(covered) && uniform_tile(x0, y0, x1, y1, plane.id)) continue;
+            }
           }
           std::fill(std::begin(sample_inv_z), std::end(sample_inv_z), 0.0f);
           std::fill(std::begin(sample_tri), std::end(sample_tri), -1);
@@ -1278,7 +1302,8 @@ template <int Samples, typename Resolve>
 void rasterize_pixels(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                       const Resolve& resolve) {
   rasterize_tiles<Samples>(
-      setup, canvas, [](int, int, int, int, std::int32_t) { return false; },
+      setup, canvas, [](const ScreenTriangle&) { return -1; },
+      [](int, int, int, int, std::int32_t) { return false; },
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         for (int py = y0; py < y1; ++py) {
           for (int px = x0; px < x1; ++px) {
@@ -1874,8 +1899,14 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     record_ranges(x0, y0, x1, y1);
     return true;
   };
+  // The studio's convex planar faces (quads, the discs' caps), for the tiles they cover together.
+  auto face_of = [&](const ScreenTriangle& t) -> std::int32_t {
+    if (t.source < object_tris) return -1;
+    const auto local = static_cast<std::size_t>(t.source - object_tris);
+    return local < room.convex_face.size() ? room.convex_face[local] : -1;
+  };
   rasterize_tiles<kSamples>(
-      setup, canvas, plain_studio_tile_recorded,
+      setup, canvas, face_of, plain_studio_tile_recorded,
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         auto at = [&](int px, int py) { return ((py - y0) * kTileSize + (px - x0)) * kSamples; };
         // 2 x 2 quads inside one surface sum the lights once, at the quad's centre, and take the

@@ -118,6 +118,12 @@ simd::F32x8 value_noise8(simd::F32x8 px, simd::F32x8 py, simd::F32x8 pz, std::ui
               lerp(lerp(v001, v101, tx), lerp(v011, v111, tx), ty), tz);
 }
 
+// The triangles from `first` on are one convex planar face.
+void mark_convex_face(Geometry& g, std::size_t first) {
+  g.convex_face.resize(first, -1);
+  g.convex_face.resize(g.triangles.size(), g.convex_faces++);
+}
+
 void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const Vector3f& edge_v,
               int material) {
   const Vector3f normal = edge_u.cross(edge_v).normalized();
@@ -132,6 +138,7 @@ void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const
   g.triangles.push_back({base, base + 1, base + 2});
   g.triangles.push_back({base, base + 2, base + 3});
   g.triangle_material.insert(g.triangle_material.end(), 2, material);
+  mark_convex_face(g, g.triangles.size() - 2);
 }
 
 // A closed cylinder about the Z axis from z0 to z1, smooth sides and flat caps.
@@ -154,6 +161,7 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
     g.triangles.push_back({base, base + 1, base + 2});
     g.triangles.push_back({base, base + 2, base + 3});
     g.triangle_material.insert(g.triangle_material.end(), 2, material);
+    mark_convex_face(g, g.triangles.size() - 2);  // a flat rectangle
   }
   // Caps as zig-zag strips across the disc rather than fans: compact triangles, so their
   // screen boxes do not overlap one another (a fan's thin wedges each box half the disc).
@@ -175,6 +183,7 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
       }
       g.triangle_material.push_back(material);
     };
+    const std::size_t first_triangle = g.triangles.size();
     int i = 0, j = kSegments - 1;
     bool forward = true;
     while (j - i >= 2) {
@@ -187,6 +196,7 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
       }
       forward = !forward;
     }
+    mark_convex_face(g, first_triangle);
   }
 }
 

@@ -41,6 +41,11 @@ struct Geometry {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::int32_t> triangle_material;  // index into StudioScene::materials
   std::vector<Eigen::Vector3f> face_normals;    // unit, from the winding; filled by prepare
+  // Per triangle, the convex planar polygon it is a piece of (a quad, a disc's cap; -1: none, or
+  // empty for none at all): together they cover that polygon without gaps, so a tile inside it
+  // shows its plane alone.
+  std::vector<std::int32_t> convex_face;
+  std::int32_t convex_faces = 0;
 
   void compute_face_normals();
 };
