@@ -1390,6 +1390,9 @@ struct FrameContext {
 dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio,
                                const FrameRequest& request, RasterTimings* timings) {
   const dslr::Intrinsics& canvas = request.canvas;
+  // Tells this frame's per-thread caches from those any earlier frame left behind.
+  static std::atomic<std::uint64_t> frames_started{0};
+  const std::uint64_t frame_serial = ++frames_started;
   dslr::LinearFrame frame;
   frame.width = canvas.width;
   frame.height = canvas.height;
@@ -1828,9 +1831,30 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     if (!use_blocks || !plain_studio(plane)) return false;
     PlaneCorners cache;
     const int columns = (x1 - x0 + kBlock - 1) / kBlock, rows = (y1 - y0 + kBlock - 1) / kBlock;
+    // The tile this thread did just before, when it is the left neighbour on the same screen
+    // triangle: its right column of corners is this tile's left one, the same values (a corner
+    // on a tile's border depends on that border's corners only, see plane_corner_of).
+    struct RightColumn {
+      std::uint64_t frame = 0;
+      int x1 = -1, y0 = -1;
+      std::int32_t triangle = -1;
+      std::array<Vector3f, kCorners> color;
+    };
+    thread_local RightColumn left;
+    if (left.frame == frame_serial && left.x1 == x0 && left.y0 == y0 && left.triangle == id) {
+      for (int cy = 0; cy <= rows; ++cy) {
+        cache.plane[cy * kCorners] = plane.source;
+        cache.color[cy * kCorners] = left.color[cy];
+      }
+    }
     for (int cy = 0; cy <= rows; ++cy) {
       for (int cx = 0; cx <= columns; ++cx) plane_corner(cache, plane, x0, y0, cx, cy);
     }
+    left.frame = frame_serial;
+    left.x1 = columns == kTileSize / kBlock ? x1 : -1;
+    left.y0 = y0;
+    left.triangle = id;
+    for (int cy = 0; cy <= rows; ++cy) left.color[cy] = cache.color[cy * kCorners + columns];
     // 1/z is affine over the plane, so in every pixel the nearest of the four samples is the
     // one furthest along its gradient: one sample per pixel, eight pixels at a time.
     int near_sample = 0;
