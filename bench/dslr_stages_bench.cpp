@@ -83,17 +83,26 @@ void BM_Exposure(benchmark::State& state) {
   for (auto _ : state) rigc::dslr::expose_in_place(f.scene.camera, work);
 }
 
-// Argument 1: as the pipeline runs it on a preview frame, with the tile ranges the renderer
-// recorded, so the frame is not scanned for them; 0: the frame scanned (other renderers).
+// Argument 2: as the pipeline runs it on a preview frame, in place (sharp tiles untouched) with
+// the tile ranges the renderer recorded; 1: the same into another buffer (every tile written);
+// 0: into another buffer, the frame scanned for its ranges (other renderers).
 void BM_DepthOfField(benchmark::State& state) {
   Fixture& f = fixture();
-  std::vector<float> out(f.frame.rgb.size());
+  std::vector<float> out(f.frame.rgb.size()), spare(f.frame.rgb.size());
   const double focus = f.scene.shots[3].focus_distance_m;
   rigc::dslr::DepthOfFieldOptions options;
   if (state.range(0) != 0) options.tile_ranges = &f.frame.tile_ranges;
   for (auto _ : state) {
-    rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
-                                     f.frame.depth_m, out, options);
+    if (state.range(0) == 2) {
+      state.PauseTiming();
+      std::copy(f.frame.rgb.begin(), f.frame.rgb.end(), out.begin());
+      state.ResumeTiming();
+      rigc::dslr::apply_depth_of_field_in_place(f.scene.camera, focus, f.frame.intrinsics(), out,
+                                                f.frame.depth_m, spare, options);
+    } else {
+      rigc::dslr::apply_depth_of_field(f.scene.camera, focus, f.frame.intrinsics(), f.frame.rgb,
+                                       f.frame.depth_m, out, options);
+    }
   }
 }
 
@@ -196,7 +205,7 @@ void BM_WriteJpegAndMask(benchmark::State& state) {
 
 BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Exposure)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_DepthOfField)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DepthOfField)->Arg(2)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Diffraction)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DistortionVignetting)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SensorNoise)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -342,13 +342,15 @@ constexpr int kMaxCoarseLevel = 3;
 void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Intrinsics& canvas,
                     std::span<const float> rgb, std::span<const float> depth_m,
                     std::vector<float>& out, int level, const std::vector<char>* needed_tiles,
-                    const DepthOfFieldOptions& options) {
+                    const DepthOfFieldOptions& options, std::vector<float>* half_input = nullptr) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
+  // In place (`rgb` is `out`'s values): tiles that stay sharp are not touched at all.
+  const bool in_place = rgb.data() == out.data() && rgb.size() == out.size();
   resize_frame_buffer(out, rgb.size());
   const double f = camera.focal_length_m, f_number = camera.aperture_f_number;
   if (depth_m.size() != n || !(focus_distance_m > f) || !(f > 0)) {
-    std::copy(rgb.begin(), rgb.end(), out.begin());
+    if (!in_place) std::copy(rgb.begin(), rgb.end(), out.begin());
     return;
   }
   // The thin-lens radius in canvas pixels, factored as K·|1 - S1/z| (K: the radius at infinity)
@@ -430,7 +432,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
   }
   if (reach_max <= 0.5f) {  // everything is sharp
-    std::copy(rgb.begin(), rgb.end(), out.begin());
+    if (!in_place) std::copy(rgb.begin(), rgb.end(), out.begin());
     return;
   }
 
@@ -515,11 +517,17 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     half.cy = canvas.cy / 2;
     // The half-size input (a third of this level's output in size) is kept in this level's
     // output buffer: nothing is written there before the level below has read it all, and the
-    // first shot faults in 100 MB fewer fresh pages.
+    // first shot faults in 100 MB fewer fresh pages. In place, the output is the input: the
+    // caller's spare buffer holds it instead.
     const std::size_t half_pixels = static_cast<std::size_t>(half.width) * half.height;
+    std::vector<float> own_half_input;
+    std::vector<float>& half_store =
+        in_place ? (half_input != nullptr ? *half_input : own_half_input) : out;
+    if (in_place && half_store.size() < 4 * half_pixels)
+      resize_frame_buffer(half_store, 4 * half_pixels);
     // 3·w·h values hold the 4·(w/2)·(h/2) (rounded up) of the input: w and h are 8 tiles or more.
-    float* half_rgb = out.data();
-    float* half_depth = out.data() + 3 * half_pixels;
+    float* half_rgb = half_store.data();
+    float* half_depth = half_store.data() + 3 * half_pixels;
     tbb::parallel_for(0, half.height, [&](int hy) {
       // Eight half pixels at a time away from the right edge: per value, the same sums in the
       // same order as the loop below (0 + the four pixels, row by row), then the 24 values
@@ -705,6 +713,82 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   // Each thread's strip planes, kept between frames.
   thread_local Planes thread_planes;
 
+  // Each strip's widest disc among the tiles it gathers, and the columns those tiles span (their
+  // taps read no further than `pad` beyond).
+  struct StripPlan {
+    float reach = 0.5f;
+    int span_x0 = 0, span_x1 = 0;
+    bool fills() const { return reach > 0.5f; }
+  };
+  std::vector<StripPlan> plans(static_cast<std::size_t>(strips));
+  for (int strip = 0; strip < strips; ++strip) {
+    StripPlan& plan = plans[static_cast<std::size_t>(strip)];
+    const int ty0 = strip * strip_rows / kTile;
+    const int ty1 = (std::min(h, (strip + 1) * strip_rows) + kTile - 1) / kTile;
+    plan.span_x0 = w;
+    for (int ty = ty0; ty < ty1; ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        if (!active(t) || coarse[t]) continue;
+        plan.reach = std::max(plan.reach, reach[t]);
+        if (reach[t] <= 0.5f) continue;
+        plan.span_x0 = std::min(plan.span_x0, tx * kTile);
+        plan.span_x1 = std::max(plan.span_x1, (tx + 1) * kTile);
+      }
+    }
+  }
+  // Written in place, a strip's rows would change under its neighbours' padding: before any strip
+  // writes, the rows within `pad` of each border between strips are kept (those columns that a
+  // strip on either side reads), and the strips read them from there.
+  struct Halo {
+    std::size_t offset = 0;  // into halo_values: rows first_row .. first_row + rows, x0 .. x1
+    int first_row = 0, rows = 0, x0 = 0, x1 = 0;
+  };
+  std::vector<Halo> halos(in_place ? static_cast<std::size_t>(strips) : 0);  // above strip k
+  std::vector<float> halo_values;
+  if (in_place) {
+    std::size_t total = 0;
+    for (int strip = 1; strip < strips; ++strip) {
+      const StripPlan &above = plans[static_cast<std::size_t>(strip) - 1],
+                      &below = plans[static_cast<std::size_t>(strip)];
+      if (!above.fills() && !below.fills()) continue;
+      Halo& halo = halos[static_cast<std::size_t>(strip)];
+      const int border = strip * strip_rows;
+      halo.first_row = std::max(0, border - pad);
+      halo.rows = std::min(h, border + pad) - halo.first_row;
+      halo.x0 = w;
+      for (const StripPlan* plan : {&above, &below}) {
+        if (!plan->fills()) continue;
+        halo.x0 = std::min(halo.x0, std::max(0, plan->span_x0 - pad));
+        halo.x1 = std::max(halo.x1, std::min(w, plan->span_x1 + pad));
+      }
+      halo.offset = total;
+      total += 3 * static_cast<std::size_t>(halo.rows) * std::max(0, halo.x1 - halo.x0);
+    }
+    halo_values = take_floats(total);
+    tbb::parallel_for(1, std::max(1, strips), [&](int strip) {
+      const Halo& halo = halos[static_cast<std::size_t>(strip)];
+      const std::size_t row_values = 3 * static_cast<std::size_t>(std::max(0, halo.x1 - halo.x0));
+      for (int k = 0; k < halo.rows; ++k) {
+        const float* from = &rgb[3 * (static_cast<std::size_t>(halo.first_row + k) * w + halo.x0)];
+        std::copy(from, from + row_values, &halo_values[halo.offset + k * row_values]);
+      }
+    });
+  }
+  // Where row y of the input is to be read, for strip `strip` (its own rows from the frame, the
+  // others from the halos), as a pointer to the row's pixel x = 0 minus `column_base` pixels.
+  auto input_row = [&](int strip, int y, int* column_base) -> const float* {
+    const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
+    if (!in_place || (y >= sy0 && y < sy1)) {
+      *column_base = 0;
+      return &rgb[3 * static_cast<std::size_t>(y) * w];
+    }
+    const Halo& halo = halos[static_cast<std::size_t>(y < sy0 ? strip : strip + 1)];
+    *column_base = halo.x0;
+    return &halo_values[halo.offset + 3 * static_cast<std::size_t>(y - halo.first_row) *
+                                          static_cast<std::size_t>(halo.x1 - halo.x0)];
+  };
+
   std::atomic<std::int64_t> groups_with_fewer_taps{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& r) {
     Planes& pl = thread_planes;
@@ -713,20 +797,22 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     for (int strip = r.begin(); strip < r.end(); ++strip) {
       const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
       const int ty0 = sy0 / kTile, ty1 = (sy1 + kTile - 1) / kTile;
-      float strip_reach = 0.5f;
-      for (int ty = ty0; ty < ty1; ++ty) {
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-          if (!active(t)) continue;
-          if (coarse[t]) {
+      const StripPlan& plan = plans[static_cast<std::size_t>(strip)];
+      // Coarse tiles come from the half-size result; in place, only once the strip's own rows
+      // are in its planes.
+      auto upsample_coarse_tiles = [&] {
+        for (int ty = ty0; ty < ty1; ++ty) {
+          for (int tx = 0; tx < tiles_x; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+            if (!active(t) || !coarse[t]) continue;
             upsample_tile(tx * kTile, std::min(w, (tx + 1) * kTile), ty * kTile,
                           std::min(h, (ty + 1) * kTile));
-          } else {
-            strip_reach = std::max(strip_reach, reach[t]);
           }
         }
-      }
-      if (strip_reach <= 0.5f) {  // sharp, apart from any coarse tiles done above
+      };
+      if (!plan.fills()) {  // sharp, apart from any coarse tiles
+        upsample_coarse_tiles();
+        if (in_place) continue;  // the sharp tiles keep their values where they are
         for (int y = sy0; y < sy1; ++y) {
           for (int tx = 0; tx < tiles_x; ++tx) {
             const std::size_t t = static_cast<std::size_t>(y / kTile) * tiles_x + tx;
@@ -749,15 +835,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       }
       // Only the columns the gathered tiles' taps read are filled: their tiles' span widened
       // by the padding (the rest of the planes is never read).
-      int span_x0 = w, span_x1 = 0;
-      for (int ty = ty0; ty < ty1; ++ty) {
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-          if (!active(t) || coarse[t] || reach[t] <= 0.5f) continue;
-          span_x0 = std::min(span_x0, tx * kTile);
-          span_x1 = std::max(span_x1, (tx + 1) * kTile);
-        }
-      }
+      const int span_x0 = plan.span_x0, span_x1 = plan.span_x1;
       const int fill_x0 = std::max(-pad, span_x0 - pad);
       const int fill_x1 = std::min(w + pad + kTile, span_x1 + pad);
       // Padding (outside the image) holds no energy and sits in front of everything.
@@ -808,13 +886,15 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           radii[x] = radius;
           inv_area[x] = 1 / (std::numbers::pi_v<float> * radius * radius);
         }
-        const float* colour_row = &rgb[3 * image_row];
+        int column_base = 0;
+        const float* colour_row = input_row(strip, y, &column_base);
         for (int x = fill_begin; x < fill_end; ++x) {
-          r[x] = colour_row[3 * x];
-          g[x] = colour_row[3 * x + 1];
-          b[x] = colour_row[3 * x + 2];
+          r[x] = colour_row[3 * (x - column_base)];
+          g[x] = colour_row[3 * (x - column_base) + 1];
+          b[x] = colour_row[3 * (x - column_base) + 2];
         }
       }
+      upsample_coarse_tiles();
       for (int ty = ty0; ty < ty1; ++ty) {
         for (int tx = 0; tx < tiles_x; ++tx) {
           const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
@@ -823,6 +903,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           if (coarse[t] || !active(t)) continue;  // done above, or not asked for
           const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
           if (radius <= 0.5f) {  // everything here and around it is sharp
+            if (in_place) continue;
             for (int y = y0; y < y1; ++y) {
               const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
               std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
@@ -935,6 +1016,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
     groups_with_fewer_taps.fetch_add(strip_groups_with_fewer_taps, std::memory_order_relaxed);
   });
+  recycle(std::move(halo_values));
   if (options.groups_with_fewer_taps != nullptr) {
     *options.groups_with_fewer_taps += groups_with_fewer_taps.load();
   }
@@ -948,6 +1030,14 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const DepthOfFieldOptions& options) {
   if (options.groups_with_fewer_taps != nullptr) *options.groups_with_fewer_taps = 0;
   depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr, options);
+}
+
+void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distance_m,
+                                   const Intrinsics& canvas, std::vector<float>& rgb,
+                                   const std::vector<float>& depth_m, std::vector<float>& spare,
+                                   const DepthOfFieldOptions& options) {
+  if (options.groups_with_fewer_taps != nullptr) *options.groups_with_fewer_taps = 0;
+  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, rgb, 0, nullptr, options, &spare);
 }
 
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,

@@ -59,6 +59,12 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
                           const std::vector<float>& depth_m, std::vector<float>& out,
                           const DepthOfFieldOptions& options = {});
+// The same result, written over `rgb`: tiles that stay sharp are not copied. `spare` (contents
+// unspecified, kept at least its size) holds the half-size frame of the big discs meanwhile.
+void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distance_m,
+                                   const Intrinsics& canvas, std::vector<float>& rgb,
+                                   const std::vector<float>& depth_m, std::vector<float>& spare,
+                                   const DepthOfFieldOptions& options = {});
 
 // Diffraction as a separable Gaussian of σ = 0.42·λ·N (λ = 550 nm) in canvas pixels, skipped
 // below 0.2 px. Applied after the disc blur it adds variances as CAMERA.md combines them

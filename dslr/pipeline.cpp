@@ -77,9 +77,8 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
     // pass has scaled them.
     DepthOfFieldOptions options;
     if (frame.rgb_clean) options.tile_ranges = &frame.tile_ranges;
-    apply_depth_of_field(camera, shot.focus_distance_m, canvas, work, frame.depth_m, scratch,
-                         options);
-    work.swap(scratch);
+    apply_depth_of_field_in_place(camera, shot.focus_distance_m, canvas, work, frame.depth_m,
+                                  scratch, options);
   }
   result.timings.depth_of_field_ms = clock.lap_ms();
 

@@ -353,6 +353,48 @@ TEST(Preview, TileRangesAreTheFramesOwnAndTheDepthOfFieldAlike) {
   EXPECT_NE(scanned, frame.rgb);
 }
 
+// The pipeline blurs in place: the sharp tiles stay untouched and the strips read their
+// neighbours' rows from copies kept before any strip writes. The result must be the copying
+// blur's, value for value: in full-size windows (coarse levels, the statue's silhouette against
+// the blurred green screen, the turntable's rim) and in a whole frame at 0.3 scale.
+TEST(Preview, DepthOfFieldInPlaceIsTheCopyingOnesResult) {
+  const ir::Scene scene = paper_scene();
+  ASSERT_FALSE(scene.shots.empty());
+  const StudioScene studio = prepare_studio_scene(scene);
+  const dslr::Intrinsics full = dslr::render_geometry_for(scene.camera, 1.0);
+  std::vector<FrameRequest> requests;
+  for (const auto& [x, y] : {std::pair{0.5, 0.5}, {0.5, 0.83}, {0.35, 0.3}}) {
+    FrameRequest request = shot_request(scene, 3, 1.0);
+    request.canvas = full;
+    request.canvas.width = 1600;
+    request.canvas.height = 1000;
+    request.canvas.cx = full.cx - (x * full.width - 800);
+    request.canvas.cy = full.cy - (y * full.height - 500);
+    requests.push_back(request);
+  }
+  requests.push_back(shot_request(scene, 3, 0.3));
+  const double focus = scene.shots[3].focus_distance_m;
+  for (const FrameRequest& request : requests) {
+    SCOPED_TRACE(::testing::Message() << request.canvas.width << " x " << request.canvas.height
+                                      << ", cx " << request.canvas.cx);
+    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    dslr::DepthOfFieldOptions options;
+    options.tile_ranges = &frame.tile_ranges;
+    std::vector<float> copied;
+    dslr::apply_depth_of_field(scene.camera, focus, frame.intrinsics(), frame.rgb, frame.depth_m,
+                               copied, options);
+    std::vector<float> in_place = frame.rgb, spare(frame.rgb.size(), -1.0f);
+    dslr::apply_depth_of_field_in_place(scene.camera, focus, frame.intrinsics(), in_place,
+                                        frame.depth_m, spare, options);
+    ASSERT_EQ(in_place.size(), copied.size());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < copied.size(); ++i) differing += in_place[i] != copied[i];
+    EXPECT_EQ(differing, 0u);
+    EXPECT_NE(copied, frame.rgb);
+    EXPECT_GE(spare.size(), frame.rgb.size());
+  }
+}
+
 // At full resolution the studio planes are lit at sparse corners (every 8 or 16 pixels where
 // the light is smooth). Two full-density windows of shot 3: the statue's foot on the turntable
 // (contact shadow) and the statue's soft shadow on the green screen, against per-pixel lighting.
