@@ -745,7 +745,12 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     int first_row = 0, rows = 0, x0 = 0, x1 = 0;
   };
   std::vector<Halo> halos(in_place ? static_cast<std::size_t>(strips) : 0);  // above strip k
-  std::vector<float> halo_values;
+  // Kept by the thread between frames, as the levels' outputs are (from the pool, a few MB of
+  // padding rows could take a whole spare frame that the next shot then has to fault in anew).
+  // (Named by reference: in the strips' lambdas, on other threads, the thread_local itself
+  // would be theirs.)
+  thread_local std::vector<float> kept_halo_values;
+  std::vector<float>& halo_values = kept_halo_values;
   if (in_place) {
     std::size_t total = 0;
     for (int strip = 1; strip < strips; ++strip) {
@@ -765,7 +770,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       halo.offset = total;
       total += 3 * static_cast<std::size_t>(halo.rows) * std::max(0, halo.x1 - halo.x0);
     }
-    halo_values = take_floats(total);
+    if (halo_values.size() < total) resize_frame_buffer(halo_values, total);
     tbb::parallel_for(1, std::max(1, strips), [&](int strip) {
       const Halo& halo = halos[static_cast<std::size_t>(strip)];
       const std::size_t row_values = 3 * static_cast<std::size_t>(std::max(0, halo.x1 - halo.x0));
@@ -1016,7 +1021,6 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
     groups_with_fewer_taps.fetch_add(strip_groups_with_fewer_taps, std::memory_order_relaxed);
   });
-  recycle(std::move(halo_values));
   if (options.groups_with_fewer_taps != nullptr) {
     *options.groups_with_fewer_taps += groups_with_fewer_taps.load();
   }
