@@ -1095,7 +1095,8 @@ inline void store4(std::int32_t* p, Int4 v) {
 // uniform_tile(x0, y0, x1, y1, id) is offered each tile where only the plane of screen triangle
 // `id` shows (the studio's big planes; see below): returning true, it has written the tile itself
 // and the samples are skipped. face_of(triangle) names the convex planar face a triangle belongs
-// to (-1: none), so that the triangles of one face may cover a tile together.
+// to (-1: none), so that the triangles of one face may cover a tile together; nullptr: no tile is
+// offered (the callers that shade every pixel themselves).
 template <int Samples, typename FaceOf, typename UniformTile, typename ResolveTile>
 void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                      const FaceOf& face_of, const UniformTile& uniform_tile,
@@ -1124,7 +1125,8 @@ void rasterize_tiles(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
           const int x0 = tx * kTileSize, y0 = ty * kTileSize;
           const int x1 = std::min(x0 + kTileSize, canvas.width);
           const int y1 = std::min(y0 + kTileSize, canvas.height);
-          {
+          // Without a face_of (nullptr), no tile is offered whole.
+          if constexpr (!std::is_same_v<FaceOf, std::nullptr_t>) {
             // Each triangle against the box of the tile's samples: inside all three edges at
             // the four corners (covers), outside one edge at all four (misses), or neither.
             // The planes are affine, so the corners decide; a margin keeps rounding out.
@@ -1302,8 +1304,7 @@ template <int Samples, typename Resolve>
 void rasterize_pixels(const ScreenSetup& setup, const dslr::Intrinsics& canvas,
                       const Resolve& resolve) {
   rasterize_tiles<Samples>(
-      setup, canvas, [](const ScreenTriangle&) { return -1; },
-      [](int, int, int, int, std::int32_t) { return false; },
+      setup, canvas, nullptr, [](int, int, int, int, std::int32_t) { return false; },
       [&](int x0, int y0, int x1, int y1, const float* inv_z, const std::int32_t* tri) {
         for (int py = y0; py < y1; ++py) {
           for (int px = x0; px < x1; ++px) {
