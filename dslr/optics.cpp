@@ -345,7 +345,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
                     const DepthOfFieldOptions& options, std::vector<float>* half_input = nullptr) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
-  // In place (`rgb` is `out`'s values): tiles that stay sharp are not touched at all.
+  // In place (`rgb` is `out`'s values): tiles that stay sharp are not touched at all, and
+  // `half_input` (the caller's spare buffer, see apply_depth_of_field_in_place) holds the
+  // half-size input that the output holds otherwise.
   const bool in_place = rgb.data() == out.data() && rgb.size() == out.size();
   resize_frame_buffer(out, rgb.size());
   const double f = camera.focal_length_m, f_number = camera.aperture_f_number;
@@ -520,9 +522,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     // first shot faults in 100 MB fewer fresh pages. In place, the output is the input: the
     // caller's spare buffer holds it instead.
     const std::size_t half_pixels = static_cast<std::size_t>(half.width) * half.height;
-    std::vector<float> own_half_input;
-    std::vector<float>& half_store =
-        in_place ? (half_input != nullptr ? *half_input : own_half_input) : out;
+    std::vector<float>& half_store = in_place ? *half_input : out;
     if (in_place && half_store.size() < 4 * half_pixels)
       resize_frame_buffer(half_store, 4 * half_pixels);
     // 3·w·h values hold the 4·(w/2)·(h/2) (rounded up) of the input: w and h are 8 tiles or more.
