@@ -339,17 +339,38 @@ namespace {
 // on a quarter of the pixels at each level.
 constexpr int kMaxCoarseLevel = 3;
 
+// The values the coarse levels below a w x h frame at `level` take for their outputs: three per
+// pixel of each half-size frame down to kMaxCoarseLevel.
+std::size_t coarse_output_values(int w, int h, int level) {
+  std::size_t total = 0;
+  for (int k = level; k < kMaxCoarseLevel; ++k) {
+    w = (w + 1) / 2;
+    h = (h + 1) / 2;
+    total += 3 * static_cast<std::size_t>(w) * h;
+  }
+  return total;
+}
+
+// The values an in-place call at the top level needs in its spare memory: the half-size input
+// (four per half-size pixel) and the levels' outputs after it.
+std::size_t in_place_spare_values(int w, int h) {
+  return 4 * (static_cast<std::size_t>(w + 1) / 2) * ((h + 1) / 2) + coarse_output_values(w, h, 0);
+}
+
+// `spare`: memory this call may use as it likes (contents unspecified), at least
+// coarse_output_values(w, h, level) values, or in_place_spare_values(w, h) in place. The levels'
+// outputs take its end (each level's output, then the levels below it); in place, its start holds
+// the half-size input and, once the levels below are done, the strips' kept border rows.
 void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Intrinsics& canvas,
                     std::span<const float> rgb, std::span<const float> depth_m,
-                    std::vector<float>& out, int level, const std::vector<char>* needed_tiles,
-                    const DepthOfFieldOptions& options, std::vector<float>* half_input = nullptr) {
+                    std::span<float> out, int level, const std::vector<char>* needed_tiles,
+                    const DepthOfFieldOptions& options, std::span<float> spare) {
   const int w = canvas.width, h = canvas.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
-  // In place (`rgb` is `out`'s values): tiles that stay sharp are not touched at all, and
-  // `half_input` (the caller's spare buffer, see apply_depth_of_field_in_place) holds the
-  // half-size input that the output holds otherwise.
+  // In place (`rgb` is `out`'s values): tiles that stay sharp are not touched at all, and the
+  // start of `spare` holds the half-size input that the output holds otherwise.
   const bool in_place = rgb.data() == out.data() && rgb.size() == out.size();
-  resize_frame_buffer(out, rgb.size());
+  const std::size_t levels_values = coarse_output_values(w, h, level);
   const double f = camera.focal_length_m, f_number = camera.aperture_f_number;
   if (depth_m.size() != n || !(focus_distance_m > f) || !(f > 0)) {
     if (!in_place) std::copy(rgb.begin(), rgb.end(), out.begin());
@@ -505,11 +526,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     }
   }
   Intrinsics half;
-  // The half-size results of the levels below, kept by the thread between frames (a fresh
-  // buffer costs its zeroing and page faults on every shot). Entry k holds level k's output
-  // (entry 0, the canvas's, stays unused).
-  thread_local std::array<std::vector<float>, kMaxCoarseLevel + 2> level_outputs;
-  std::vector<float>& half_out = level_outputs[level + 1];
+  // The half-size result, at the start of the levels' part of `spare` (the rest of it is the
+  // level below's own spare memory).
+  std::span<float> half_out;
   if (any_coarse) {
     half.width = (w + 1) / 2;
     half.height = (h + 1) / 2;
@@ -522,9 +541,9 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     // first shot faults in 100 MB fewer fresh pages. In place, the output is the input: the
     // caller's spare buffer holds it instead.
     const std::size_t half_pixels = static_cast<std::size_t>(half.width) * half.height;
-    std::vector<float>& half_store = in_place ? *half_input : out;
-    if (in_place && half_store.size() < 4 * half_pixels)
-      resize_frame_buffer(half_store, 4 * half_pixels);
+    const std::span<float> levels = spare.last(levels_values);
+    half_out = levels.first(3 * half_pixels);
+    const std::span<float> half_store = in_place ? spare.first(4 * half_pixels) : out;
     // 3·w·h values hold the 4·(w/2)·(h/2) (rounded up) of the input: w and h are 8 tiles or more.
     float* half_rgb = half_store.data();
     float* half_depth = half_store.data() + 3 * half_pixels;
@@ -614,7 +633,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       }
     }
     depth_of_field(camera, focus_distance_m, half, {half_rgb, 3 * half_pixels},
-                   {half_depth, half_pixels}, half_out, level + 1, &half_needed, options);
+                   {half_depth, half_pixels}, half_out, level + 1, &half_needed, options,
+                   levels.subspan(3 * half_pixels));
   }
   // Bilinear from the half-size result: full pixel centre x + 0.5 sits at half x (x + 0.5) / 2.
   auto upsample_tile = [&](int x0, int x1, int y0, int y1) {
@@ -745,12 +765,12 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
     int first_row = 0, rows = 0, x0 = 0, x1 = 0;
   };
   std::vector<Halo> halos(in_place ? static_cast<std::size_t>(strips) : 0);  // above strip k
-  // Kept by the thread between frames, as the levels' outputs are (from the pool, a few MB of
-  // padding rows could take a whole spare frame that the next shot then has to fault in anew).
-  // (Named by reference: in the strips' lambdas, on other threads, the thread_local itself
-  // would be theirs.)
+  // The kept rows go where the half-size input was (the levels below have read it by now), in
+  // `spare` before the levels' outputs; when they need more, into a buffer the thread keeps
+  // between frames. (Named by reference: in the strips' lambdas, on other threads, the
+  // thread_local itself would be theirs.)
   thread_local std::vector<float> kept_halo_values;
-  std::vector<float>& halo_values = kept_halo_values;
+  float* halo_values = nullptr;
   if (in_place) {
     std::size_t total = 0;
     for (int strip = 1; strip < strips; ++strip) {
@@ -770,7 +790,12 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       halo.offset = total;
       total += 3 * static_cast<std::size_t>(halo.rows) * std::max(0, halo.x1 - halo.x0);
     }
-    if (halo_values.size() < total) resize_frame_buffer(halo_values, total);
+    if (total <= spare.size() - levels_values) {
+      halo_values = spare.data();
+    } else {
+      if (kept_halo_values.size() < total) resize_frame_buffer(kept_halo_values, total);
+      halo_values = kept_halo_values.data();
+    }
     tbb::parallel_for(1, std::max(1, strips), [&](int strip) {
       const Halo& halo = halos[static_cast<std::size_t>(strip)];
       const std::size_t row_values = 3 * static_cast<std::size_t>(std::max(0, halo.x1 - halo.x0));
@@ -1033,7 +1058,10 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const std::vector<float>& depth_m, std::vector<float>& out,
                           const DepthOfFieldOptions& options) {
   if (options.groups_with_fewer_taps != nullptr) *options.groups_with_fewer_taps = 0;
-  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr, options);
+  resize_frame_buffer(out, rgb.size());
+  std::vector<float> spare = take_floats(coarse_output_values(canvas.width, canvas.height, 0));
+  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, out, 0, nullptr, options, spare);
+  recycle(std::move(spare));
 }
 
 void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distance_m,
@@ -1041,7 +1069,9 @@ void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distan
                                    const std::vector<float>& depth_m, std::vector<float>& spare,
                                    const DepthOfFieldOptions& options) {
   if (options.groups_with_fewer_taps != nullptr) *options.groups_with_fewer_taps = 0;
-  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, rgb, 0, nullptr, options, &spare);
+  const std::size_t needed = in_place_spare_values(canvas.width, canvas.height);
+  if (spare.size() < needed) resize_frame_buffer(spare, needed);
+  depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, rgb, 0, nullptr, options, spare);
 }
 
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
