@@ -1776,6 +1776,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // plane changes far less than that across 16 px; a shadow edge or a penumbra changes more.
   const bool wide_corners = coarse_corners && 4 * kBlock / fx <= 2.5e-3f;
   constexpr float kWideCellTolerance = 0.01f;
+  // And where 32 pixels (a tile) subtend under 5 mrad, the same one level up: the plane is first
+  // shaded at the tiles' corners, and a tile whose corners agree within kTileCellTolerance takes
+  // its 16 px corners from them (the full-resolution frames of a normal lens, whose green screen
+  // is mostly such tiles). Half the cells' tolerance: a curve's departure from the blend grows
+  // with the square of the cell's size.
+  const bool tile_corners = wide_corners && 8 * kBlock / fx <= 5e-3f;
+  constexpr float kTileCellTolerance = 0.005f;
   // Radiance at the corners of a tile's 4 x 4 blocks on a plain studio plane, cached per tile
   // and plane. On the plane: unclamped barycentrics reach past the triangle's edges along it.
   struct PlaneCorners {
@@ -1793,21 +1800,31 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     if (cache.plane[slot] == plane.source) return cache.color[slot];
     auto at = [&](int ax, int ay) { return self(self, cache, plane, x0, y0, ax, ay); };
     Vector3f color;
-    if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
+    // Interpolated within the cell whose corners are (ax, ay) and (bx, by) when those agree
+    // within `tolerance` (relative, per channel); shaded otherwise.
+    auto from_cell = [&](int ax, int bx, int ay, int by, int cell, float tolerance) {
+      const Vector3f c00 = at(ax, ay), c10 = at(bx, ay), c01 = at(ax, by), c11 = at(bx, by);
+      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
+      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
+      if (((hi - lo).array() <= tolerance * hi.array()).all()) {
+        const float tx = static_cast<float>(cx % cell) / static_cast<float>(cell);
+        const float ty = static_cast<float>(cy % cell) / static_cast<float>(cell);
+        return Vector3f((1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11));
+      }
+      return shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
+                            static_cast<float>(y0 + kBlock * cy));
+    };
+    if (tile_corners && cx % 4 == 0 && cy % 4 == 0 && (cx % 8 || cy % 8)) {
+      // A corner on a tile's edge looks at that edge's two ends only, as below.
+      const int ax = cx - cx % 8, bx = cx % 8 ? ax + 8 : ax;
+      const int ay = cy - cy % 8, by = cy % 8 ? ay + 8 : ay;
+      color = from_cell(ax, bx, ay, by, 8, kTileCellTolerance);
+    } else if (wide_corners && cx % 2 == 0 && cy % 2 == 0 && (cx % 4 || cy % 4)) {
       // A corner on a 16 px cell's edge looks at that edge's two ends only (all that its
       // interpolation uses), so the tiles on both sides of a tile border decide alike.
       const int ax = cx - cx % 4, bx = cx % 4 ? ax + 4 : ax;
       const int ay = cy - cy % 4, by = cy % 4 ? ay + 4 : ay;
-      const Vector3f c00 = at(ax, ay), c10 = at(bx, ay), c01 = at(ax, by), c11 = at(bx, by);
-      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
-      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
-      if (((hi - lo).array() <= kWideCellTolerance * hi.array()).all()) {
-        const float tx = (cx % 4) / 4.0f, ty = (cy % 4) / 4.0f;
-        color = (1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11);
-      } else {
-        color = shade_on_plane(plane, static_cast<float>(x0 + kBlock * cx),
-                               static_cast<float>(y0 + kBlock * cy));
-      }
+      color = from_cell(ax, bx, ay, by, 4, kWideCellTolerance);
     } else if (coarse_corners && (cx % 2 || cy % 2)) {
       const int ax = cx - cx % 2, bx = cx + cx % 2;
       const int ay = cy - cy % 2, by = cy + cy % 2;
@@ -1848,7 +1865,36 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
         cache.color[cy * kCorners] = left.color[cy];
       }
     }
-    for (int cy = 0; cy <= rows; ++cy) {
+    // A whole tile whose four corners agree is smooth: every corner inside it would come out as
+    // their bilinear blend (the 16 px and 8 px corners from agreeing cells, the odd ones as
+    // means of those), so the inner ones are blended straight from the four. The left and right
+    // columns, which the tiles beside it share, still follow the rule they do there.
+    bool smooth = false;
+    if (tile_corners && columns == kCorners - 1 && rows == kCorners - 1) {
+      constexpr int kLast = kCorners - 1;
+      const Vector3f c00 = plane_corner(cache, plane, x0, y0, 0, 0);
+      const Vector3f c10 = plane_corner(cache, plane, x0, y0, kLast, 0);
+      const Vector3f c01 = plane_corner(cache, plane, x0, y0, 0, kLast);
+      const Vector3f c11 = plane_corner(cache, plane, x0, y0, kLast, kLast);
+      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
+      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
+      smooth = ((hi - lo).array() <= kTileCellTolerance * hi.array()).all();
+      if (smooth) {
+        for (int cy = 0; cy <= kLast; ++cy) {
+          plane_corner(cache, plane, x0, y0, 0, cy);
+          plane_corner(cache, plane, x0, y0, kLast, cy);
+          const float ty = static_cast<float>(cy) / kLast;
+          const Vector3f left = (1 - ty) * c00 + ty * c01, right = (1 - ty) * c10 + ty * c11;
+          for (int cx = 1; cx < kLast; ++cx) {
+            const float tx = static_cast<float>(cx) / kLast;
+            const int slot = cy * kCorners + cx;
+            cache.color[slot] = (1 - tx) * left + tx * right;
+            cache.plane[slot] = plane.source;
+          }
+        }
+      }
+    }
+    for (int cy = 0; cy <= rows && !smooth; ++cy) {
       for (int cx = 0; cx <= columns; ++cx) plane_corner(cache, plane, x0, y0, cx, cy);
     }
     left.frame = frame_serial;
