@@ -269,8 +269,13 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   // with the plane's depth there rather than the point's. Otherwise a surface sloping away from
   // the light finds "blockers" in its own texels a few texels off (the taps reach 24), and most
   // lit points paid for the whole soft-shadow search only to come out fully lit.
-  float slope_u = 0, slope_v = 0;
-  {
+  // Worked out only once taps are to be compared (follow_plane): most points are settled lit
+  // before that. slope_per_texel: see receiver_at.
+  float slope_u = 0, slope_v = 0, slope_per_texel = 0;
+  bool plane_followed = false;
+  auto follow_plane = [&] {
+    if (plane_followed) return;
+    plane_followed = true;
     const Vector3f m = light_from_world * normal;
     // Orthographic: z = L.z - (m.x dx + m.y dy) / m.z with dx = du / focal. Perspective, along the
     // ray through texel (u + du, v + dv), to first order: L.z - L.z^2 (m.x du + m.y dv) / (focal
@@ -287,7 +292,10 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
       slope_u = -m.x() / along;
       slope_v = -m.y() / along;
     }
-  }
+    slope_per_texel =
+        texel * 1.5f + (slope_u != 0 || slope_v != 0 ? std::abs(slope_u) + std::abs(slope_v)
+                                                     : texel * 2.0f * tan_theta);
+  };
   // Taps reach at most kReach texels of their level from (u, v): away from the map's border a
   // level-0 disc needs no clamping.
   constexpr float kReach = 24;
@@ -367,10 +375,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
   // plane's own slope where it is followed, the bias's slope term where not), so the bias grows
   // by that much and no more. Growing the whole bias with 2^k made a grazing receiver's bias jump
   // by centimetres where the filter moved to the next level: on a turntable top behind a box, a
-  // hard line where the box's low part stopped counting.
-  const float slope_per_texel =
-      texel * 1.5f + (slope_u != 0 || slope_v != 0 ? std::abs(slope_u) + std::abs(slope_v)
-                                                   : texel * 2.0f * tan_theta);
+  // hard line where the box's low part stopped counting. (After follow_plane.)
   auto receiver_at = [&](const TapGroup& taps, float radius, int level) {
     const float coarser_bias = static_cast<float>((1 << level) - 1) * slope_per_texel;
     return receiver - coarser_bias + (taps.u * slope_u + taps.v * slope_v) * radius;
@@ -485,6 +490,7 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     const bool near_clear = lookup(u, v) >= receiver &&
                             clear_from(reach_nearest[reach_block], std::max(search, outside_by));
     if (!near_clear) {
+      follow_plane();
       float blocker = 0;
       const int blockers = search_blockers(kSearchTaps, search, 0, blocker);
       if (blockers > 0) {
@@ -508,11 +514,13 @@ float ShadowMap::visibility(const Vector3f& world, const Vector3f& normal, float
     }
     static_assert(kBlock == 16);
     if (far_clear) return 1;
+    follow_plane();
     float blocker = 0;
     if (search_blockers(wide_search_taps, full_search, search_level, blocker) == 0) return 1;
     return filter(penumbra_texels(blocker));
   }
   // Other lights: a hard edge, smoothed over the smallest filter.
+  follow_plane();
   int lit = 0;
   for (const TapGroup& taps : kSearchTaps) {
     lit += 8 - simd::count(blocks8(disc8(taps, kSmallestFilter, 0), taps, kSmallestFilter, 0));
