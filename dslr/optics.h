@@ -60,7 +60,8 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const std::vector<float>& depth_m, std::vector<float>& out,
                           const DepthOfFieldOptions& options = {});
 // The same result, written over `rgb`: tiles that stay sharp are not copied. `spare` (contents
-// unspecified, kept at least its size) holds the half-size frame of the big discs meanwhile.
+// unspecified; grown to about two thirds of `rgb` when it is smaller, never shrunk) holds the
+// half-size frames of the big discs and the strips' kept border rows meanwhile.
 void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distance_m,
                                    const Intrinsics& canvas, std::vector<float>& rgb,
                                    const std::vector<float>& depth_m, std::vector<float>& spare,

@@ -1876,7 +1876,10 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // A whole tile whose four corners agree is smooth: every corner inside it would come out as
     // their bilinear blend (the 16 px and 8 px corners from agreeing cells, the odd ones as
     // means of those), so the inner ones are blended straight from the four. The left and right
-    // columns, which the tiles beside it share, still follow the rule they do there.
+    // columns, which the tiles beside it share (see RightColumn), still follow the rule they do
+    // there. The top and bottom rows are blended too: a tile above or below that is not smooth
+    // reaches the same values by the rule's steps, which may round an ulp apart (the seam is
+    // 1e-7 of the light; it does not depend on which thread draws which tile).
     bool smooth = false;
     if (tile_corners && columns == kCorners - 1 && rows == kCorners - 1) {
       constexpr int kLast = kCorners - 1;
@@ -1892,11 +1895,12 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
           plane_corner(cache, plane, x0, y0, 0, cy);
           plane_corner(cache, plane, x0, y0, kLast, cy);
           const float ty = static_cast<float>(cy) / kLast;
-          const Vector3f left = (1 - ty) * c00 + ty * c01, right = (1 - ty) * c10 + ty * c11;
+          const Vector3f row_left = (1 - ty) * c00 + ty * c01;
+          const Vector3f row_right = (1 - ty) * c10 + ty * c11;
           for (int cx = 1; cx < kLast; ++cx) {
             const float tx = static_cast<float>(cx) / kLast;
             const int slot = cy * kCorners + cx;
-            cache.color[slot] = (1 - tx) * left + tx * right;
+            cache.color[slot] = (1 - tx) * row_left + tx * row_right;
             cache.plane[slot] = plane.source;
           }
         }
