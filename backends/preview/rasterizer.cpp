@@ -1791,6 +1791,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
   // with the square of the cell's size.
   const bool tile_corners = wide_corners && 8 * kBlock / fx <= 5e-3f;
   constexpr float kTileCellTolerance = 0.005f;
+  // Whether a cell's four corner radiances agree within `tolerance` (relative, per channel).
+  auto corners_agree = [](const Vector3f& c00, const Vector3f& c10, const Vector3f& c01,
+                          const Vector3f& c11, float tolerance) {
+    const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
+    const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
+    return ((hi - lo).array() <= tolerance * hi.array()).all();
+  };
   // Radiance at the corners of a tile's 4 x 4 blocks on a plain studio plane, cached per tile
   // and plane. On the plane: unclamped barycentrics reach past the triangle's edges along it.
   struct PlaneCorners {
@@ -1812,9 +1819,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
     // within `tolerance` (relative, per channel); shaded otherwise.
     auto from_cell = [&](int ax, int bx, int ay, int by, int cell, float tolerance) {
       const Vector3f c00 = at(ax, ay), c10 = at(bx, ay), c01 = at(ax, by), c11 = at(bx, by);
-      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
-      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
-      if (((hi - lo).array() <= tolerance * hi.array()).all()) {
+      if (corners_agree(c00, c10, c01, c11, tolerance)) {
         const float tx = static_cast<float>(cx % cell) / static_cast<float>(cell);
         const float ty = static_cast<float>(cy % cell) / static_cast<float>(cell);
         return Vector3f((1 - ty) * ((1 - tx) * c00 + tx * c10) + ty * ((1 - tx) * c01 + tx * c11));
@@ -1887,9 +1892,7 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const StudioScene& studio
       const Vector3f c10 = plane_corner(cache, plane, x0, y0, kLast, 0);
       const Vector3f c01 = plane_corner(cache, plane, x0, y0, 0, kLast);
       const Vector3f c11 = plane_corner(cache, plane, x0, y0, kLast, kLast);
-      const Vector3f lo = c00.cwiseMin(c10).cwiseMin(c01).cwiseMin(c11);
-      const Vector3f hi = c00.cwiseMax(c10).cwiseMax(c01).cwiseMax(c11);
-      smooth = ((hi - lo).array() <= kTileCellTolerance * hi.array()).all();
+      smooth = corners_agree(c00, c10, c01, c11, kTileCellTolerance);
       if (smooth) {
         for (int cy = 0; cy <= kLast; ++cy) {
           plane_corner(cache, plane, x0, y0, 0, cy);
