@@ -51,7 +51,23 @@ struct Row {
   // process's fresh memory, and the median of the others.
   double first_shot_ms = 0;
   double other_shots_median_ms = 0;
+  // The first shot's stages, and the second's, to see where the first shot's extra time goes.
+  std::map<std::string, double> first_shot_stage_ms;
+  std::map<std::string, double> second_shot_stage_ms;
 };
+
+std::map<std::string, double> stages_of(const ShotTiming& t) {
+  return {{"shadows", t.raster.shadow_ms},
+          {"setup+bin", t.raster.setup_ms},
+          {"raster+shade", t.raster.raster_ms},
+          {"exposure", t.develop.exposure_ms},
+          {"dof", t.develop.depth_of_field_ms},
+          {"diffraction", t.develop.diffraction_ms},
+          {"distortion", t.develop.distortion_ms},
+          // The preview runs the sensor and the sRGB development as one pass (timed as noise).
+          {"noise+develop", t.develop.noise_ms + t.develop.develop_ms},
+          {"encode+write", t.write_ms}};
+}
 
 Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int shot_count) {
   const fs::path dir = fs::temp_directory_path() / ("rigc_bench_" + std::to_string(getpid()));
@@ -75,7 +91,7 @@ Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int
     std::cerr << log.str();
     std::exit(2);
   }
-  Row row{name, static_cast<int>(options.shots.size()), seconds, cpu, {}};
+  Row row{name, static_cast<int>(options.shots.size()), seconds, cpu, {}, 0, 0, {}, {}};
   std::vector<double> render_ms;
   for (const auto& t : timings) render_ms.push_back(t.total_ms - t.write_ms);
   if (!render_ms.empty()) {
@@ -87,16 +103,11 @@ Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int
     }
   }
   for (const auto& t : timings) {
-    row.stage_ms["shadows"] += t.raster.shadow_ms;
-    row.stage_ms["setup+bin"] += t.raster.setup_ms;
-    row.stage_ms["raster+shade"] += t.raster.raster_ms;
-    row.stage_ms["exposure"] += t.develop.exposure_ms;
-    row.stage_ms["dof"] += t.develop.depth_of_field_ms;
-    row.stage_ms["diffraction"] += t.develop.diffraction_ms;
-    row.stage_ms["distortion"] += t.develop.distortion_ms;
-    // The preview runs the sensor and the sRGB development as one pass (timed as noise).
-    row.stage_ms["noise+develop"] += t.develop.noise_ms + t.develop.develop_ms;
-    row.stage_ms["encode+write"] += t.write_ms;
+    for (const auto& [stage, ms] : stages_of(t)) row.stage_ms[stage] += ms;
+  }
+  if (timings.size() >= 2) {
+    row.first_shot_stage_ms = stages_of(timings[0]);
+    row.second_shot_stage_ms = stages_of(timings[1]);
   }
   return row;
 }
@@ -174,6 +185,17 @@ int main(int argc, char** argv) {
   for (const auto& row : rows) {
     std::cout << fmt::format("{:<24} first shot {:.0f} ms, other shots median {:.0f} ms\n",
                              row.name, row.first_shot_ms, row.other_shots_median_ms);
+  }
+  std::cout << fmt::format("{:<24} {:>35}", "shot 1 / shot 2 ms", "");
+  for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
+  std::cout << '\n';
+  for (const auto& row : rows) {
+    if (row.first_shot_stage_ms.empty()) continue;
+    std::cout << fmt::format("{:<24} {:>35}", row.name, "");
+    for (const auto& [stage, ms] : row.first_shot_stage_ms) {
+      std::cout << fmt::format(" {:>5.0f} /{:>5.0f}", ms, row.second_shot_stage_ms.at(stage));
+    }
+    std::cout << '\n';
   }
   std::cout << fmt::format("peak memory: {:.0f} MB\n", peak_rss_mb());
 }
