@@ -186,12 +186,13 @@ int main(int argc, char** argv) {
     std::cout << fmt::format("{:<24} first shot {:.0f} ms, other shots median {:.0f} ms\n",
                              row.name, row.first_shot_ms, row.other_shots_median_ms);
   }
-  std::cout << fmt::format("{:<24} {:>35}", "shot 1 / shot 2 ms", "");
+  // Rows named "shots 1/2, ..." (bench/preview_full.sh reads the rows that start "full res").
+  std::cout << fmt::format("{:<34} {:>25}", "ms in shot 1 / shot 2", "");
   for (const auto& [stage, ms] : rows[0].stage_ms) std::cout << fmt::format(" {:>12}", stage);
   std::cout << '\n';
   for (const auto& row : rows) {
     if (row.first_shot_stage_ms.empty()) continue;
-    std::cout << fmt::format("{:<24} {:>35}", row.name, "");
+    std::cout << fmt::format("{:<34} {:>25}", "shots 1/2, " + row.name, "");
     for (const auto& [stage, ms] : row.first_shot_stage_ms) {
       std::cout << fmt::format(" {:>5.0f} /{:>5.0f}", ms, row.second_shot_stage_ms.at(stage));
     }
