@@ -1074,13 +1074,19 @@ void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distan
   depth_of_field(camera, focus_distance_m, canvas, rgb, depth_m, rgb, 0, nullptr, options, spare);
 }
 
+int diffraction_radius_px(double sigma_px) {
+  // exp(-r² / 2σ²) >= 1e-3 for r <= σ·sqrt(2 ln 1000).
+  const double kept = sigma_px * std::sqrt(2 * std::log(1000.0));
+  return std::max(1, static_cast<int>(std::min(std::ceil(3 * sigma_px), std::floor(kept))));
+}
+
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
                          std::vector<float>& rgb, std::vector<float>& scratch) {
   if (!(camera.focal_length_m > 0)) return 0;
   const double sigma =
       diffraction_sigma_m(camera.aperture_f_number) * canvas.fx / camera.focal_length_m;
   if (sigma < 0.2) return 0;
-  const int radius = static_cast<int>(std::ceil(3 * sigma));
+  const int radius = diffraction_radius_px(sigma);
   std::vector<float> kernel(2 * radius + 1);
   double sum = 0;
   for (int k = -radius; k <= radius; ++k)

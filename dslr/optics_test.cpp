@@ -341,7 +341,7 @@ TEST(DslrDiffraction, BandedPassEqualsTheSeparableGaussian) {
       std::vector<float> scratch;
       const double sigma = apply_diffraction(camera, canvas, rgb, scratch);
       ASSERT_GE(sigma, 0.2) << "f/" << f_number << " leaves the frame as it is";
-      const int radius = static_cast<int>(std::ceil(3 * sigma));
+      const int radius = diffraction_radius_px(sigma);
       radii.insert(radius);
       std::vector<double> kernel(2 * radius + 1);
       double total = 0;
