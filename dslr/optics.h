@@ -73,9 +73,8 @@ void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distan
 
 // Diffraction as a separable Gaussian of σ = 0.42·λ·N (λ = 550 nm) in canvas pixels, skipped
 // below 0.2 px. Applied after the disc blur it adds variances as CAMERA.md combines them
-// (σ² = σ_diffraction² + (c/4)²). Returns the σ used (0 when skipped). The result is in `rgb`;
-// the two buffers are swapped, so `scratch` then holds the input.
+// (σ² = σ_diffraction² + (c/4)²). Returns the σ used (0 when skipped). Written over `rgb`.
 double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
-                         std::vector<float>& rgb, std::vector<float>& scratch);
+                         std::vector<float>& rgb);
 
 }  // namespace rigc::dslr

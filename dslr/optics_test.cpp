@@ -338,8 +338,7 @@ TEST(DslrDiffraction, BandedPassEqualsTheSeparableGaussian) {
         rgb[i] = static_cast<float>((i * 2654435761u) % 1000) / 10;
       }
       const std::vector<float> input = rgb;
-      std::vector<float> scratch;
-      const double sigma = apply_diffraction(camera, canvas, rgb, scratch);
+      const double sigma = apply_diffraction(camera, canvas, rgb);
       ASSERT_GE(sigma, 0.2) << "f/" << f_number << " leaves the frame as it is";
       const int radius = diffraction_radius_px(sigma);
       radii.insert(radius);

@@ -82,7 +82,7 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
   }
   result.timings.depth_of_field_ms = clock.lap_ms();
 
-  if (camera.effects.diffraction) apply_diffraction(camera, canvas, work, scratch);
+  if (camera.effects.diffraction) apply_diffraction(camera, canvas, work);
   result.timings.diffraction_ms = clock.lap_ms();
 
   static const std::vector<float> no_depth;
