@@ -211,13 +211,13 @@ const TapSet& tap_set() {
 // pixels have no energy (inv_area 0) and sit in front of everything (z = -inf): they never
 // contribute. Strips keep the working set small (no 500 MB of planes for a full frame).
 struct Planes {
-  int pad = 0, stride = 0, y0 = 0;  // y0: the first image row of the strip
+  int pad = 0, stride = 0, x0 = 0, y0 = 0;  // the first image column and row they hold
   std::vector<float> r, g, b;
   std::vector<float> z;         // metres, +inf for unknown or background
   std::vector<float> radius;    // blur disc radius in pixels, at least 0.5 (a pixel's footprint)
   std::vector<float> inv_area;  // 1 / (π radius²): a pixel's energy per covered pixel
   std::size_t index(int x, int y) const {
-    return static_cast<std::size_t>(y - y0 + pad) * stride + (x + pad);
+    return static_cast<std::size_t>(y - y0 + pad) * stride + (x - x0 + pad);
   }
 };
 
@@ -730,8 +730,14 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
   const int strip_rows = std::max(2 * kTile, (4 * pad + kTile - 1) / kTile * kTile);
   const int strips = (h + strip_rows - 1) / strip_rows;
   const float inf = std::numeric_limits<float>::infinity();
-  // Each thread's strip planes, kept between frames.
-  thread_local Planes thread_planes;
+  // Each thread's planes for two blocks of a strip's columns (see below), kept between frames.
+  thread_local std::array<Planes, 2> thread_planes;
+  // A strip is filled and gathered in blocks of this many columns: a block's planes (about
+  // 450 KB) are still in the core's cache when its tiles gather from them, and the next block
+  // but one fills the same memory again. Planes as wide as the strip were written out to memory
+  // and read back.
+  constexpr int kBlockColumns = 256;
+  static_assert(kBlockColumns % kTile == 0);
 
   // Each strip's widest disc among the tiles it gathers, and the columns those tiles span (their
   // taps read no further than `pad` beyond).
@@ -821,7 +827,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
 
   std::atomic<std::int64_t> groups_with_fewer_taps{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& r) {
-    Planes& pl = thread_planes;
+    std::array<Planes, 2>& block_planes = thread_planes;
     GroupSums sums;
     std::int64_t strip_groups_with_fewer_taps = 0;
     for (int strip = r.begin(); strip < r.end(); ++strip) {
@@ -855,190 +861,231 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         }
         continue;
       }
-      pl.pad = pad;
-      pl.stride = w + 2 * pad + kTile;  // a tile's last group may run past the right edge
-      pl.y0 = sy0;
       const int plane_rows = sy1 - sy0 + 2 * pad;
-      const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
-      for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
-        if (plane->size() < size) resize_frame_buffer(*plane, size);
-      }
-      // Only the columns the gathered tiles' taps read are filled: their tiles' span widened
-      // by the padding (the rest of the planes is never read).
       const int span_x0 = plan.span_x0, span_x1 = plan.span_x1;
-      const int fill_x0 = std::max(-pad, span_x0 - pad);
-      const int fill_x1 = std::min(w + pad + kTile, span_x1 + pad);
-      // Padding (outside the image) holds no energy and sits in front of everything.
-      auto clear_span = [&](std::size_t begin, std::size_t end) {
-        for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.inv_area}) {
-          std::fill(plane->begin() + begin, plane->begin() + end, 0.0f);
+      const Planes* previous = nullptr;  // the block to the left, as it was filled
+      int parity = 0;
+      for (int bx0 = span_x0; bx0 < span_x1; bx0 += kBlockColumns, parity ^= 1) {
+        const int bx1 = std::min(span_x1, bx0 + kBlockColumns);
+        Planes& pl = block_planes[parity];
+        pl.pad = pad;
+        pl.x0 = bx0;
+        pl.y0 = sy0;
+        pl.stride = bx1 - bx0 + 2 * pad;
+        const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
+        for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
+          if (plane->size() < size) resize_frame_buffer(*plane, size);
         }
-        std::fill(pl.z.begin() + begin, pl.z.begin() + end, -inf);
-        std::fill(pl.radius.begin() + begin, pl.radius.begin() + end, 0.5f);
-      };
-      for (int y = sy0 - pad; y < sy1 + pad; ++y) {
-        const std::size_t row_begin = pl.index(0, y);  // x = 0 of this row in the planes
-        if (y < 0 || y >= h) {
-          clear_span(row_begin + fill_x0, row_begin + fill_x1);
-          continue;
-        }
-        if (fill_x0 < 0) clear_span(row_begin + fill_x0, row_begin);
-        if (fill_x1 > w) clear_span(row_begin + w, row_begin + fill_x1);
-        const std::size_t image_row = static_cast<std::size_t>(y) * w;
-        float* r = &pl.r[row_begin];
-        float* g = &pl.g[row_begin];
-        float* b = &pl.b[row_begin];
-        float* zs = &pl.z[row_begin];
-        float* radii = &pl.radius[row_begin];
-        float* inv_area = &pl.inv_area[row_begin];
-        // Depth-derived planes and the colour planes in two loops: each reads one contiguous
-        // input, so both vectorise.
-        const int fill_begin = std::max(0, fill_x0), fill_end = std::min(w, fill_x1);
-        const float* depth_row = &depth_m[image_row];
-        // Eight at a time (the compiler leaves the plain loop scalar), then the rest.
-        int x = fill_begin;
-        {
-          const Floats zero = {}, infinity = zero + inf;
-          for (; x + kLanes <= fill_end; x += kLanes) {
-            const Floats depth = load8(depth_row + x);
-            const Floats z = depth > zero ? depth : infinity;
-            const Floats radius = radius_at(z);
-            const Floats area = 1 / (std::numbers::pi_v<float> * radius * radius);
-            std::memcpy(zs + x, &z, sizeof z);
-            std::memcpy(radii + x, &radius, sizeof radius);
-            std::memcpy(inv_area + x, &area, sizeof area);
+        // Only the columns the block's taps read: its tiles' columns widened by the padding
+        // (a partial last tile's last group reads on to the tile's edge, inside the span).
+        const int fill_x0 = std::max(-pad, bx0 - pad);
+        const int fill_x1 = std::min(w + pad + kTile, bx1 + pad);
+        // In place, the block to the left has written its tiles by now: the columns of its
+        // that this block's taps read come from its planes, as they were filled.
+        const int copied_x1 = previous != nullptr ? bx0 : fill_x0;
+        // Padding (outside the image) holds no energy and sits in front of everything.
+        auto clear_span = [&](std::size_t begin, std::size_t end) {
+          for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.inv_area}) {
+            std::fill(plane->begin() + begin, plane->begin() + end, 0.0f);
           }
-        }
-        for (; x < fill_end; ++x) {
-          const float z = depth_row[x] > 0 ? depth_row[x] : inf;
-          const float radius = radius_at(z);
-          zs[x] = z;
-          radii[x] = radius;
-          inv_area[x] = 1 / (std::numbers::pi_v<float> * radius * radius);
-        }
-        int column_base = 0;
-        const float* colour_row = input_row(strip, y, &column_base);
-        for (int x = fill_begin; x < fill_end; ++x) {
-          r[x] = colour_row[3 * (x - column_base)];
-          g[x] = colour_row[3 * (x - column_base) + 1];
-          b[x] = colour_row[3 * (x - column_base) + 2];
-        }
-      }
-      upsample_coarse_tiles();
-      for (int ty = ty0; ty < ty1; ++ty) {
-        for (int tx = 0; tx < tiles_x; ++tx) {
-          const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
-          const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-          if (coarse[t] || !active(t)) continue;  // done above, or not asked for
-          const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
-          if (radius <= 0.5f) {  // everything here and around it is sharp
-            if (in_place) continue;
-            for (int y = y0; y < y1; ++y) {
-              const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
-              std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
-            }
+          std::fill(pl.z.begin() + begin, pl.z.begin() + end, -inf);
+          std::fill(pl.radius.begin() + begin, pl.radius.begin() + end, 0.5f);
+        };
+        for (int y = sy0 - pad; y < sy1 + pad; ++y) {
+          const std::size_t row_begin = pl.index(fill_x0, y);  // x = fill_x0 of this row
+          // Plane positions of x, for x from fill_x0 on.
+          auto at = [&](int x) { return row_begin + static_cast<std::size_t>(x - fill_x0); };
+          if (y < 0 || y >= h) {
+            clear_span(at(fill_x0), at(fill_x1));
             continue;
           }
-          const int tap_count = set.taps_for(radius);
-          // Every pixel a tap can reach on one surface: the cheaper gather, same sums.
-          const auto gather = one_surface[t] ? gather_group_one_surface : gather_group;
-          // The taps a group of eight pixels needs. A tap at distance d weighs nothing unless the
-          // disc it tests reaches d: the disc of the pixel q there when q is in front of or level
-          // with the group's pixel, the pixel's own when q is behind. So beyond the largest of
-          // the group's own discs and the discs of every q within the tile's taps that is not
-          // behind the group's furthest pixel, the remaining taps add exact zeros. Along a
-          // silhouette that spares the object's pixels the background's big discs, which lie
-          // behind them. Only for the three-layer gather: one surface has no "behind".
-          const int extent = set.extent_of_count[tap_count];
-          const bool per_group =
-              options.taps_per_group && !one_surface[t] && tap_count > set.taps_for(2.0f);
-          // Also the taps from which no pixel is behind any of the group's (behind its nearest)
-          // and no disc of a pixel in front of one of them (of its furthest) reaches: from
-          // there on the cheaper arithmetic of one surface gives the same sums.
-          struct GroupTaps {
-            int three_layer, count;
-          };
-          auto group_taps = [&](int x, int y) -> GroupTaps {
-            if (!per_group) return {tap_count, tap_count};
-            const std::size_t i = pl.index(x, y);
-            const Floats zp = load8(&pl.z[i]);
-            float z_furthest = zp[0], z_nearest = zp[0];
-            for (int k = 1; k < kLanes; ++k) {
-              z_furthest = std::max(z_furthest, zp[k]);
-              z_nearest = std::min(z_nearest, zp[k]);
+          if (copied_x1 > fill_x0) {
+            const std::size_t from = previous->index(fill_x0, y);
+            const auto count = static_cast<std::size_t>(copied_x1 - fill_x0);
+            for (auto plane : {&Planes::r, &Planes::g, &Planes::b, &Planes::z, &Planes::radius,
+                               &Planes::inv_area}) {
+              std::copy_n((previous->*plane).begin() + from, count,
+                          (pl.*plane).begin() + at(fill_x0));
             }
-            const float z_behind = z_furthest * (1 + kSameDepth);
-            // As gather_group compares: behind the nearest pixel, in front of the furthest.
-            const float z_behind_nearest = z_nearest * (1 + kSameDepth);
-            const float z_front_furthest = z_furthest * (1 - kSameDepth);
-            Floats front_largest = {};
-            simd::I32x8 any_behind = {};
-            // The window's columns in whole registers, the last one overlapping the one before
-            // (columns counted twice change no maximum).
-            const int columns = kLanes + 2 * extent;
-            Floats largest = {};
-            for (int dy = -extent; dy <= extent; ++dy) {
-              const std::size_t row = pl.index(x - extent, y + dy);
-              for (int dx = 0; dx < columns; dx += kLanes) {
-                const std::size_t q = row + std::min(dx, columns - kLanes);
-                const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
-                const Floats counted = zq > z_behind ? Floats{} : rq;
-                largest = largest > counted ? largest : counted;
-                const Floats front = zq < z_front_furthest ? rq : Floats{};
-                front_largest = front_largest > front ? front_largest : front;
-                any_behind |= zq > z_behind_nearest;
+          }
+          if (copied_x1 < 0) clear_span(at(copied_x1), at(0));
+          if (fill_x1 > w) clear_span(at(std::max(w, copied_x1)), at(fill_x1));
+          const std::size_t image_row = static_cast<std::size_t>(y) * w;
+          const int fill_begin = std::max(0, copied_x1), fill_end = std::min(w, fill_x1);
+          // Pointers at x = fill_begin.
+          float* r = &pl.r[at(fill_begin)];
+          float* g = &pl.g[at(fill_begin)];
+          float* b = &pl.b[at(fill_begin)];
+          float* zs = &pl.z[at(fill_begin)];
+          float* radii = &pl.radius[at(fill_begin)];
+          float* inv_area = &pl.inv_area[at(fill_begin)];
+          // Depth-derived planes and the colour planes in two loops: each reads one contiguous
+          // input, so both vectorise.
+          const float* depth_row = &depth_m[image_row + fill_begin];
+          const int count = std::max(0, fill_end - fill_begin);
+          // Eight at a time (the compiler leaves the plain loop scalar), then the rest.
+          int x = 0;
+          {
+            const Floats zero = {}, infinity = zero + inf;
+            for (; x + kLanes <= count; x += kLanes) {
+              const Floats depth = load8(depth_row + x);
+              const Floats z = depth > zero ? depth : infinity;
+              const Floats radius = radius_at(z);
+              const Floats area = 1 / (std::numbers::pi_v<float> * radius * radius);
+              std::memcpy(zs + x, &z, sizeof z);
+              std::memcpy(radii + x, &radius, sizeof radius);
+              std::memcpy(inv_area + x, &area, sizeof area);
+            }
+          }
+          for (; x < count; ++x) {
+            const float z = depth_row[x] > 0 ? depth_row[x] : inf;
+            const float radius = radius_at(z);
+            zs[x] = z;
+            radii[x] = radius;
+            inv_area[x] = 1 / (std::numbers::pi_v<float> * radius * radius);
+          }
+          int column_base = 0;
+          const float* colour_row =
+              input_row(strip, y, &column_base) + 3 * static_cast<std::ptrdiff_t>(fill_begin);
+          for (int x = 0; x < count; ++x) {
+            r[x] = colour_row[3 * (x - column_base)];
+            g[x] = colour_row[3 * (x - column_base) + 1];
+            b[x] = colour_row[3 * (x - column_base) + 2];
+          }
+        }
+        previous = &pl;
+        for (int ty = ty0; ty < ty1; ++ty) {
+          for (int tx = bx0 / kTile; tx < (bx1 + kTile - 1) / kTile; ++tx) {
+            const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
+            const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+            if (coarse[t] || !active(t)) continue;  // done above, or not asked for
+            const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
+            if (radius <= 0.5f) {  // everything here and around it is sharp
+              if (in_place) continue;
+              for (int y = y0; y < y1; ++y) {
+                const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
+                std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
+              }
+              continue;
+            }
+            const int tap_count = set.taps_for(radius);
+            // Every pixel a tap can reach on one surface: the cheaper gather, same sums.
+            const auto gather = one_surface[t] ? gather_group_one_surface : gather_group;
+            // The taps a group of eight pixels needs. A tap at distance d weighs nothing unless the
+            // disc it tests reaches d: the disc of the pixel q there when q is in front of or level
+            // with the group's pixel, the pixel's own when q is behind. So beyond the largest of
+            // the group's own discs and the discs of every q within the tile's taps that is not
+            // behind the group's furthest pixel, the remaining taps add exact zeros. Along a
+            // silhouette that spares the object's pixels the background's big discs, which lie
+            // behind them. Only for the three-layer gather: one surface has no "behind".
+            const int extent = set.extent_of_count[tap_count];
+            const bool per_group =
+                options.taps_per_group && !one_surface[t] && tap_count > set.taps_for(2.0f);
+            // Also the taps from which no pixel is behind any of the group's (behind its nearest)
+            // and no disc of a pixel in front of one of them (of its furthest) reaches: from
+            // there on the cheaper arithmetic of one surface gives the same sums.
+            struct GroupTaps {
+              int three_layer, count;
+            };
+            auto group_taps = [&](int x, int y) -> GroupTaps {
+              if (!per_group) return {tap_count, tap_count};
+              const std::size_t i = pl.index(x, y);
+              const Floats zp = load8(&pl.z[i]);
+              float z_furthest = zp[0], z_nearest = zp[0];
+              for (int k = 1; k < kLanes; ++k) {
+                z_furthest = std::max(z_furthest, zp[k]);
+                z_nearest = std::min(z_nearest, zp[k]);
+              }
+              const float z_behind = z_furthest * (1 + kSameDepth);
+              // As gather_group compares: behind the nearest pixel, in front of the furthest.
+              const float z_behind_nearest = z_nearest * (1 + kSameDepth);
+              const float z_front_furthest = z_furthest * (1 - kSameDepth);
+              Floats front_largest = {};
+              simd::I32x8 any_behind = {};
+              // The window's columns in whole registers, the last one overlapping the one before
+              // (columns counted twice change no maximum).
+              const int columns = kLanes + 2 * extent;
+              Floats largest = {};
+              for (int dy = -extent; dy <= extent; ++dy) {
+                const std::size_t row = pl.index(x - extent, y + dy);
+                for (int dx = 0; dx < columns; dx += kLanes) {
+                  const std::size_t q = row + std::min(dx, columns - kLanes);
+                  const Floats zq = load8(&pl.z[q]), rq = load8(&pl.radius[q]);
+                  const Floats counted = zq > z_behind ? Floats{} : rq;
+                  largest = largest > counted ? largest : counted;
+                  const Floats front = zq < z_front_furthest ? rq : Floats{};
+                  front_largest = front_largest > front ? front_largest : front;
+                  any_behind |= zq > z_behind_nearest;
+                }
+              }
+              // The group's own pixels lie in the window and are never behind the furthest of
+              // them: their discs are in `largest`.
+              float needed = 0, front_needed = 0;
+              for (int k = 0; k < kLanes; ++k) {
+                needed = std::max(needed, largest[k]);
+                front_needed = std::max(front_needed, front_largest[k]);
+              }
+              const int taps = std::min(tap_count, set.taps_for(needed));
+              strip_groups_with_fewer_taps += taps < tap_count;
+              if (simd::any(any_behind)) return {taps, taps};
+              return {std::min(taps, set.taps_for(front_needed)), taps};
+            };
+            // Part-coarse tiles: a group of pixels whose discs, and all discs within
+            // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
+            // tile. The smallest disc over each row's window, per group, then over the rows.
+            constexpr int d = kSmallDiscReachPx;
+            constexpr int kGroups = kTile / kLanes;
+            const bool split = part_coarse[t] && pl.pad >= d;
+            std::array<float, (kTile + 2 * d) * kGroups> row_smallest;
+            if (split) {
+              for (int y = y0 - d; y < y1 + d; ++y) {
+                const float* radii = &pl.radius[pl.index(x0 - d, y)];  // from x0 - d
+                for (int g = 0; g < kGroups; ++g) {
+                  const int gx = g * kLanes;  // from x0
+                  float smallest = radii[gx];
+                  for (int x = gx + 1; x < gx + kLanes + 2 * d; ++x) {
+                    smallest = std::min(smallest, radii[x]);
+                  }
+                  row_smallest[(y - y0 + d) * kGroups + g] = smallest;
+                }
               }
             }
-            // The group's own pixels lie in the window and are never behind the furthest of
-            // them: their discs are in `largest`.
-            float needed = 0, front_needed = 0;
-            for (int k = 0; k < kLanes; ++k) {
-              needed = std::max(needed, largest[k]);
-              front_needed = std::max(front_needed, front_largest[k]);
-            }
-            const int taps = std::min(tap_count, set.taps_for(needed));
-            strip_groups_with_fewer_taps += taps < tap_count;
-            if (simd::any(any_behind)) return {taps, taps};
-            return {std::min(taps, set.taps_for(front_needed)), taps};
-          };
-          // Part-coarse tiles: a group of pixels whose discs, and all discs within
-          // kSmallDiscReachPx of it, have kCoarseRadiusPx or more is upsampled like a coarse
-          // tile. The smallest disc over each row's window, per group, then over the rows.
-          constexpr int d = kSmallDiscReachPx;
-          constexpr int kGroups = kTile / kLanes;
-          const bool split = part_coarse[t] && pl.pad >= d;
-          std::array<float, (kTile + 2 * d) * kGroups> row_smallest;
-          if (split) {
-            for (int y = y0 - d; y < y1 + d; ++y) {
-              const float* radii = &pl.radius[pl.index(0, y)];
-              for (int g = 0; g < kGroups; ++g) {
-                const int gx = x0 + g * kLanes;
-                float smallest = radii[gx - d];
-                for (int x = gx - d + 1; x < gx + kLanes + d; ++x) {
-                  smallest = std::min(smallest, radii[x]);
+            for (int y = y0; y < y1; ++y) {
+              for (int x = x0; x < x1; x += kLanes) {
+                if (split) {
+                  const int g = (x - x0) / kLanes;
+                  float smallest = row_smallest[(y - y0) * kGroups + g];
+                  for (int k = 1; k <= 2 * d; ++k) {
+                    smallest = std::min(smallest, row_smallest[(y - y0 + k) * kGroups + g]);
+                  }
+                  if (smallest >= kCoarseRadiusPx) {
+                    upsample_tile(x, std::min(x + kLanes, x1), y, y + 1);
+                    continue;
+                  }
                 }
-                row_smallest[(y - y0 + d) * kGroups + g] = smallest;
+                const GroupTaps taps = group_taps(x, y);
+                gather(pl, set, taps.count, pl.index(x, y), sums, taps.three_layer);
+                composite(sums, std::min(kLanes, x1 - x),
+                          &out[3 * (static_cast<std::size_t>(y) * w + x)]);
               }
             }
           }
-          for (int y = y0; y < y1; ++y) {
-            for (int x = x0; x < x1; x += kLanes) {
-              if (split) {
-                const int g = (x - x0) / kLanes;
-                float smallest = row_smallest[(y - y0) * kGroups + g];
-                for (int k = 1; k <= 2 * d; ++k) {
-                  smallest = std::min(smallest, row_smallest[(y - y0 + k) * kGroups + g]);
-                }
-                if (smallest >= kCoarseRadiusPx) {
-                  upsample_tile(x, std::min(x + kLanes, x1), y, y + 1);
-                  continue;
-                }
-              }
-              const GroupTaps taps = group_taps(x, y);
-              gather(pl, set, taps.count, pl.index(x, y), sums, taps.three_layer);
-              composite(sums, std::min(kLanes, x1 - x),
-                        &out[3 * (static_cast<std::size_t>(y) * w + x)]);
+        }
+      }  // blocks
+      // In place, only now: coarse tiles within a block's padding were read as they were.
+      upsample_coarse_tiles();
+      // The sharp tiles outside the gathered span, when the result goes to a copy.
+      if (!in_place) {
+        for (int ty = ty0; ty < ty1; ++ty) {
+          for (int tx = 0; tx < tiles_x; ++tx) {
+            if (tx * kTile >= span_x0 && tx * kTile < span_x1) continue;  // done in a block
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+            if (coarse[t] || !active(t)) continue;
+            const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
+            for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
+              const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
+              std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
             }
           }
         }
