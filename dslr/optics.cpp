@@ -207,9 +207,10 @@ const TapSet& tap_set() {
   return set;
 }
 
-// A horizontal strip of the canvas as padded planes, so taps never need bounds checks. Padding
-// pixels have no energy (inv_area 0) and sit in front of everything (z = -inf): they never
-// contribute. Strips keep the working set small (no 500 MB of planes for a full frame).
+// A block of columns of a horizontal strip of the canvas as padded planes, so taps never need
+// bounds checks. Padding pixels have no energy (inv_area 0) and sit in front of everything
+// (z = -inf): they never contribute. Blocks keep the working set in cache (a whole frame's
+// planes would take 500 MB, a strip's several MB).
 struct Planes {
   int pad = 0, stride = 0, x0 = 0, y0 = 0;  // the first image column and row they hold
   std::vector<float> r, g, b;
@@ -834,8 +835,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       const int sy0 = strip * strip_rows, sy1 = std::min(h, sy0 + strip_rows);
       const int ty0 = sy0 / kTile, ty1 = (sy1 + kTile - 1) / kTile;
       const StripPlan& plan = plans[static_cast<std::size_t>(strip)];
-      // Coarse tiles come from the half-size result; in place, only once the strip's own rows
-      // are in its planes.
+      // Coarse tiles come from the half-size result; in place, only once every block of the
+      // strip has its rows in its planes.
       auto upsample_coarse_tiles = [&] {
         for (int ty = ty0; ty < ty1; ++ty) {
           for (int tx = 0; tx < tiles_x; ++tx) {
@@ -873,15 +874,19 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
         pl.y0 = sy0;
         pl.stride = bx1 - bx0 + 2 * pad;
         const std::size_t size = static_cast<std::size_t>(pl.stride) * plane_rows;
+        // A plain resize (under 1 MB a plane, even for the widest padding): the frame buffers'
+        // first touch runs a nested parallel loop, during which this thread could take up
+        // another strip with these same thread_local planes.
         for (auto* plane : {&pl.r, &pl.g, &pl.b, &pl.z, &pl.radius, &pl.inv_area}) {
-          if (plane->size() < size) resize_frame_buffer(*plane, size);
+          if (plane->size() < size) plane->resize(size);
         }
         // Only the columns the block's taps read: its tiles' columns widened by the padding
         // (a partial last tile's last group reads on to the tile's edge, inside the span).
         const int fill_x0 = std::max(-pad, bx0 - pad);
         const int fill_x1 = std::min(w + pad + kTile, bx1 + pad);
-        // In place, the block to the left has written its tiles by now: the columns of its
-        // that this block's taps read come from its planes, as they were filled.
+        // The block to the left has written its tiles by now (in place, into the frame): the
+        // columns of its that this block's taps read come from its planes, as they were filled.
+        // (So in both modes; the copying mode's test cannot tell them apart.)
         const int copied_x1 = previous != nullptr ? bx0 : fill_x0;
         // Padding (outside the image) holds no energy and sits in front of everything.
         auto clear_span = [&](std::size_t begin, std::size_t end) {
@@ -1133,6 +1138,7 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
   const double sigma =
       diffraction_sigma_m(camera.aperture_f_number) * canvas.fx / camera.focal_length_m;
   if (sigma < 0.2) return 0;
+  if (canvas.width <= 0 || canvas.height <= 0) return sigma;
   const int radius = diffraction_radius_px(sigma);
   std::vector<float> kernel(2 * radius + 1);
   double sum = 0;
@@ -1209,7 +1215,7 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
       take_floats(static_cast<std::size_t>(borders) * border_span * row_values);
   // The horizontally blurred row y from `border_rows`, or null when y is near no border.
   auto border_row = [&](int y) -> float* {
-    const int k = (y + radius) / band_rows - 1;  // the border at or just below y + radius
+    const int k = (y + radius) / band_rows - 1;  // the last border at or above row y + radius
     if (k < 0 || k >= borders) return nullptr;
     const int from = (k + 1) * band_rows - radius;
     if (y < from || y >= from + border_span) return nullptr;

@@ -24,7 +24,8 @@ double hyperfocal_m(double focal_length_m, double f_number, double coc_m);
 double diffraction_sigma_m(double f_number, double wavelength_m = 550e-9);
 // The taps the diffraction Gaussian of `sigma_px` keeps on each side: out to 3σ, but not those
 // below a thousandth of the centre tap's weight (at f/13 on a 6D, σ = 0.46 px: the taps at ±2 px
-// weigh 8e-5 of it, and a 5-tap pass took 24 ms a full frame against 20 ms for 3).
+// weigh 8e-5 of it, and a 5-tap pass took 24 ms a full frame against 20 ms for 3). At least one
+// (σ from 0.2 px, where diffraction starts, to 0.27 px keeps lighter ±1 taps).
 int diffraction_radius_px(double sigma_px);
 
 // Depth of field on an undistorted canvas (rgb: 3 per pixel, depth_m: 1 per pixel).
