@@ -1,6 +1,7 @@
 #include "backends/preview/preview_backend.h"
 
 #include <fmt/format.h>
+#include <tbb/task_group.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <memory>
 #include <optional>
 #include <ostream>
 
@@ -131,9 +133,9 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   const StudioScene studio = prepare_studio_scene(scene);
   int failures = 0, done = 0;
 
-  // A shot's files are encoded and written on a thread of their own while the next shot
-  // renders: JPEG encoding is serial, and the renderer keeps both cores busy meanwhile. The
-  // manifest records a shot only once its files are in place.
+  // A shot's files are encoded and written while the next shot renders: JPEG encoding is
+  // serial, and the renderer keeps both cores busy meanwhile. The manifest records a shot only
+  // once its files are in place.
   struct WriteOutcome {
     std::string error;  // empty when both files are in place
     double ms = 0;
@@ -145,6 +147,13 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     std::future<WriteOutcome> outcome;
   };
   std::optional<PendingWrite> pending;
+  // The writes run as tasks of the renderer's own threads: a thread of their own made three
+  // threads share the two cores, and the renderer's loops waited for whichever was descheduled.
+  tbb::task_group writers;
+  struct WaitForWriters {  // every return waits for the last write (task_group requires it)
+    tbb::task_group& group;
+    ~WaitForWriters() { group.wait(); }
+  } wait_for_writers{writers};
   bool manifest_failed = false;
   // Saved after a shot once half a second has passed since the last save, and at the end, so an
   // interrupted run resumes about where it stopped (the shots of that last half second render
@@ -168,6 +177,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     if (!pending) return;
     PendingWrite write = std::move(*pending);
     pending.reset();
+    writers.wait();  // runs the write here if no other thread has taken it up
     const WriteOutcome outcome = write.outcome.get();
     const std::string& error = outcome.error;
     const ir::Shot& shot = *write.shot;
@@ -235,8 +245,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     write.image = backends::image_relative_path(scene.camera, shot);
     write.mask = backends::mask_relative_path(shot);
     write.timing = timing;
-    write.outcome = std::async(
-        std::launch::async,
+    auto task = std::make_shared<std::packaged_task<WriteOutcome()>>(
         [&scene, &run_dir, image = write.image, mask = write.mask,
          result = std::move(result)]() mutable -> WriteOutcome {
           const auto start = Clock::now();
@@ -253,6 +262,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
           outcome.ms = ms_since(start);
           return outcome;
         });
+    write.outcome = task->get_future();
+    writers.run([task] { (*task)(); });
     pending = std::move(write);
   }
   finish_pending();
