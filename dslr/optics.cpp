@@ -847,19 +847,25 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
           }
         }
       };
-      if (!plan.fills()) {  // sharp, apart from any coarse tiles
-        upsample_coarse_tiles();
-        if (in_place) continue;  // the sharp tiles keep their values where they are
-        for (int y = sy0; y < sy1; ++y) {
+      // Tiles where everything, around them too, is sharp keep their values: in place they
+      // are not touched, and a copy takes them as they are.
+      auto copy_sharp_tiles = [&] {
+        if (in_place) return;
+        for (int ty = ty0; ty < ty1; ++ty) {
           for (int tx = 0; tx < tiles_x; ++tx) {
-            const std::size_t t = static_cast<std::size_t>(y / kTile) * tiles_x + tx;
-            if (coarse[t] || !active(t)) continue;
-            const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + tx * kTile);
-            const std::size_t b =
-                3 * (static_cast<std::size_t>(y) * w + std::min(w, (tx + 1) * kTile));
-            std::copy(rgb.begin() + a, rgb.begin() + b, out.begin() + a);
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+            if (coarse[t] || !active(t) || reach[t] > 0.5f) continue;
+            const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
+            for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
+              const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
+              std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
+            }
           }
         }
+      };
+      if (!plan.fills()) {  // sharp, apart from any coarse tiles
+        upsample_coarse_tiles();
+        copy_sharp_tiles();
         continue;
       }
       const int plane_rows = sy1 - sy0 + 2 * pad;
@@ -965,15 +971,8 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
             const int y0 = ty * kTile, y1 = std::min(h, y0 + kTile);
             const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
             if (coarse[t] || !active(t)) continue;  // done above, or not asked for
-            const float radius = reach[static_cast<std::size_t>(ty) * tiles_x + tx];
-            if (radius <= 0.5f) {  // everything here and around it is sharp
-              if (in_place) continue;
-              for (int y = y0; y < y1; ++y) {
-                const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
-                std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
-              }
-              continue;
-            }
+            const float radius = reach[t];
+            if (radius <= 0.5f) continue;  // copy_sharp_tiles
             const int tap_count = set.taps_for(radius);
             // Every pixel a tap can reach on one surface: the cheaper gather, same sums.
             const auto gather = one_surface[t] ? gather_group_one_surface : gather_group;
@@ -1080,21 +1079,7 @@ void depth_of_field(const ir::Camera& camera, double focus_distance_m, const Int
       }  // blocks
       // In place, only now: coarse tiles within a block's padding were read as they were.
       upsample_coarse_tiles();
-      // The sharp tiles outside the gathered span, when the result goes to a copy.
-      if (!in_place) {
-        for (int ty = ty0; ty < ty1; ++ty) {
-          for (int tx = 0; tx < tiles_x; ++tx) {
-            if (tx * kTile >= span_x0 && tx * kTile < span_x1) continue;  // done in a block
-            const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-            if (coarse[t] || !active(t)) continue;
-            const int x0 = tx * kTile, x1 = std::min(w, x0 + kTile);
-            for (int y = ty * kTile; y < std::min(h, (ty + 1) * kTile); ++y) {
-              const std::size_t a = 3 * (static_cast<std::size_t>(y) * w + x0);
-              std::copy(rgb.begin() + a, rgb.begin() + a + 3 * (x1 - x0), out.begin() + a);
-            }
-          }
-        }
-      }
+      copy_sharp_tiles();
     }
     groups_with_fewer_taps.fetch_add(strip_groups_with_fewer_taps, std::memory_order_relaxed);
   });
