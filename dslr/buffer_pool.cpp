@@ -48,24 +48,22 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
   return buffer.capacity() * sizeof(T);
 }
 
-// Asks the kernel to back [data, data + bytes) with huge pages where it can (THP in "madvise"
-// mode, Debian's default); a hint only, so a refusal changes nothing but speed.
-void advise_huge_pages(const void* data, std::size_t bytes) {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  const std::uintptr_t begin =
-      (reinterpret_cast<std::uintptr_t>(data) + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHugePage - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
-
-// Faults fresh memory in with every core. Its first touch is the expensive part: on the 2-core
-// VM this project is measured on, a fault that the host has to back costs about 1.7 s per GB on
-// one core and 1.0 s per GB shared by two (a one-off per page, but a full-resolution shot first
-// asks for over a GB). The kernel populates the pages itself where it can (Linux 5.14 and
-// later): the pages come zeroed, so a memset over them would only write them a second time.
+// Faults fresh memory in with every core. Its first touch is the expensive part of a fresh
+// buffer (a full-resolution shot first asks for about 800 MB). The kernel populates the pages
+// itself where it can (Linux 5.14 and later): the pages come zeroed, so a memset over them would
+// only write them a second time.
+//
+// The pages stay 4 KB ones (no MADV_HUGEPAGE; Debian's THP mode is "madvise"). On the KVM guest
+// this project is measured on, a 2 MB page that the guest has not used for a few seconds has
+// been handed back to the host (free page reporting works on 2 MB blocks), and faulting it in
+// costs 2.2-2.5 s per GB of CPU; 4 KB pages come from memory the host still backs, at 0.3-0.4 s
+// per GB (bench: 800 MB populated 10 s after the last run). Later shots reuse the pool's
+// buffers, and were no slower on 4 KB pages in the full-size benchmark (median 460-464 against
+// 463-466 ms a shot), while a cold `rigc render` of the paper scene took 8.95-9.16 s against
+// 9.62-9.99 s, its system CPU 0.41-0.46 s against 1.92-2.17 s.
 void first_touch(void* data, std::size_t bytes) {
-  // Pieces within the huge pages' 2 MB boundaries. madvise needs a page boundary: the first
-  // piece starts at the page holding `data` (populating a page changes none of its bytes).
+  // Pieces of 2 MB, one per task. madvise needs a page boundary: the first piece starts at the
+  // page holding `data` (populating a page changes none of its bytes).
   constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20, kPage = 4096;
   const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t end = start + bytes;
@@ -84,12 +82,11 @@ void first_touch(void* data, std::size_t bytes) {
 }
 
 template <typename T>
-void resize_huge(std::vector<T>& buffer, std::size_t size) {
+void resize_populated(std::vector<T>& buffer, std::size_t size) {
   static_assert(std::is_trivially_copyable_v<T>);
   if (size > buffer.capacity() && size * sizeof(T) >= kMinPooledBytes) {
     std::vector<T> bigger;
-    bigger.reserve(size);  // allocated, not yet touched: the advice applies to its first faults
-    advise_huge_pages(bigger.data(), size * sizeof(T));
+    bigger.reserve(size);  // allocated, not yet touched
     // Trivial element type: the allocation's bytes may be written before the elements exist
     // (a container-overflow checker would flag it; resize then zeroes them again, warm).
     first_touch(bigger.data(), size * sizeof(T));
@@ -120,7 +117,7 @@ std::vector<T> take(std::size_t size) {
     }
   }
   // Only the part past the old size is written (value-initialised) here.
-  resize_huge(out, size);
+  resize_populated(out, size);
   return out;
 }
 
@@ -172,16 +169,16 @@ void recycle(std::vector<std::uint16_t>&& buffer) {
 }
 
 void resize_frame_buffer(std::vector<float>& buffer, std::size_t size) {
-  resize_huge(buffer, size);
+  resize_populated(buffer, size);
 }
 void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size) {
-  resize_huge(buffer, size);
+  resize_populated(buffer, size);
 }
 void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size) {
-  resize_huge(buffer, size);
+  resize_populated(buffer, size);
 }
 void resize_frame_buffer(std::vector<std::uint16_t>& buffer, std::size_t size) {
-  resize_huge(buffer, size);
+  resize_populated(buffer, size);
 }
 
 std::size_t pooled_bytes() {

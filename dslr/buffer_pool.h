@@ -21,8 +21,8 @@ void recycle(std::vector<float>&& buffer);
 void recycle(std::vector<std::uint8_t>&& buffer);
 void recycle(std::vector<std::uint16_t>&& buffer);
 
-// Resizes `buffer` to `size`; new memory is asked for in transparent huge pages (2 MB), so a
-// first frame faults in 120 pages instead of 60 000 per 240 MB. Existing values are kept.
+// Resizes `buffer` to `size`; new memory is faulted in by the kernel with every core, before
+// the caller's loops touch it. Existing values are kept.
 void resize_frame_buffer(std::vector<float>& buffer, std::size_t size);
 void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size);
 void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size);

@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+
 namespace rigc::dslr {
 namespace {
 
@@ -52,6 +57,49 @@ TEST(BufferPool, GrowsABufferThatIsTooSmall) {
   const std::vector<float> bigger = take_floats(3 << 20);
   EXPECT_EQ(bigger.size(), std::size_t{3} << 20);
   EXPECT_EQ(bigger.back(), 0.0f);  // the part past a reused buffer's old size is zeroed
+  release_pooled_buffers();
+}
+
+// The smaps fields of the mapping holding `address`: "VmFlags" ("hg": advised huge pages) and
+// "Rss" (kB), each line as it stands.
+struct MappingFields {
+  std::string vm_flags;
+  long rss_kb = -1;
+};
+MappingFields mapping_at(const void* address) {
+  const auto wanted = reinterpret_cast<std::uintptr_t>(address);
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  MappingFields fields;
+  while (std::getline(smaps, line)) {
+    std::uintptr_t begin = 0, end = 0;
+    char dash = 0;
+    std::istringstream range(line);
+    if (range >> std::hex >> begin >> dash >> end && dash == '-') {
+      if (inside) break;
+      inside = begin <= wanted && wanted < end;
+    } else if (inside && line.rfind("VmFlags:", 0) == 0) {
+      fields.vm_flags = line;
+    } else if (inside && line.rfind("Rss:", 0) == 0) {
+      fields.rss_kb = std::stol(line.substr(4));
+    }
+  }
+  return fields;
+}
+
+// Fresh frame buffers stay on 4 KB pages: on the VM this is measured on, a cold 2 MB page costs
+// six times as much to fault in (see first_touch). They are populated before they are handed
+// out, so the caller's loops take no faults.
+TEST(BufferPool, FreshBuffersArePopulatedOnSmallPages) {
+  release_pooled_buffers();
+  constexpr std::size_t kValues = std::size_t{16} << 20;  // 64 MB of floats
+  std::vector<float> frame = take_floats(kValues);
+  const MappingFields fields = mapping_at(frame.data());
+  ASSERT_FALSE(fields.vm_flags.empty()) << "no mapping found in /proc/self/smaps";
+  EXPECT_EQ(fields.vm_flags.find(" hg"), std::string::npos) << fields.vm_flags;
+  EXPECT_GE(fields.rss_kb, static_cast<long>(kValues * sizeof(float) / 1024));
+  recycle(std::move(frame));
   release_pooled_buffers();
 }
 
