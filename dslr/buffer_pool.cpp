@@ -54,10 +54,11 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
 // only write them a second time.
 //
 // The pages stay 4 KB ones (no MADV_HUGEPAGE; Debian's THP mode is "madvise"). On the KVM guest
-// this project is measured on, a 2 MB page that the guest has not used for a few seconds has
-// been handed back to the host (free page reporting works on 2 MB blocks), and faulting it in
-// costs 2.2-2.5 s per GB of CPU; 4 KB pages come from memory the host still backs, at 0.3-0.4 s
-// per GB (bench: 800 MB populated 10 s after the last run). Later shots reuse the pool's
+// this project is measured on, a 2 MB page costs 2.2-2.5 s per GB of CPU to fault in once the
+// memory has been free for a few seconds (0.16 s per GB after 1 s), and a 4 KB page 0.3-0.4 s
+// per GB even then (800 MB populated 10 s after the last run, alternated). Most likely the
+// guest's free 2 MB blocks go back to the host (virtio-balloon free page reporting, order 9
+// here) while its scattered 4 KB pages stay backed. Later shots reuse the pool's
 // buffers, and were no slower on 4 KB pages in the full-size benchmark (median 460-464 against
 // 463-466 ms a shot), while a cold `rigc render` of the paper scene took 8.95-9.16 s against
 // 9.62-9.99 s, its system CPU 0.41-0.46 s against 1.92-2.17 s.
