@@ -29,6 +29,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -226,6 +227,32 @@ std::vector<unsigned char> read_file_bytes(const fs::path& path) {
   return bytes;
 }
 
+// A PNG's size and channels from its header (IHDR, which the format puts first), or nothing if
+// `bytes` is no PNG. Read only to explain a decoding failure: stb_image refuses a PNG of 1 GB or
+// more decoded, and tinygltf reports every failure alike.
+struct PngHeader {
+  std::uint32_t width = 0, height = 0;
+  int channels = 0;
+};
+std::optional<PngHeader> png_header(const std::vector<unsigned char>& bytes) {
+  static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (bytes.size() < 33 || !std::equal(kSignature, kSignature + 8, bytes.begin()) ||
+      std::string_view(reinterpret_cast<const char*>(bytes.data()) + 12, 4) != "IHDR") {
+    return std::nullopt;
+  }
+  const auto big_endian = [&](std::size_t at) {
+    return std::uint32_t{bytes[at]} << 24 | std::uint32_t{bytes[at + 1]} << 16 |
+           std::uint32_t{bytes[at + 2]} << 8 | std::uint32_t{bytes[at + 3]};
+  };
+  PngHeader header{big_endian(16), big_endian(20), 0};
+  // Channels by colour type (grey, -, RGB, palette, grey + alpha, -, RGBA); a palette counts as
+  // 4, as stb_image counts it.
+  static constexpr int kChannels[7] = {1, 0, 3, 4, 2, 0, 4};
+  if (bytes[25] >= 7 || kChannels[bytes[25]] == 0) return std::nullopt;
+  header.channels = kChannels[bytes[25]];
+  return header;
+}
+
 // Decodes an encoded image (PNG, JPEG, ...) with the stb_image inside tinygltf.
 ir::Texture decode_image(std::string source, const std::vector<unsigned char>& bytes,
                          const std::string& what) {
@@ -236,6 +263,16 @@ ir::Texture decode_image(std::string source, const std::vector<unsigned char>& b
   std::string err, warn;
   if (!tinygltf::LoadImageData(&image, 0, &err, &warn, 0, 0, bytes.data(),
                                static_cast<int>(bytes.size()), nullptr)) {
+    if (const std::optional<PngHeader> png = png_header(bytes)) {
+      // stb_image's own test, in its integer arithmetic.
+      if (png->width > 0 && (std::uint32_t{1} << 30) / png->width / png->channels < png->height) {
+        const double decoded = static_cast<double>(png->width) * png->height * png->channels;
+        fail(
+            "{} is {} x {} pixels, {:.1f} GB decoded: over the 1 GB the image decoder takes; "
+            "scale it down (16384 x 16384 RGB fits)",
+            what, png->width, png->height, decoded / (1 << 30));
+      }
+    }
     fail("{} could not be decoded (unknown or broken image format)", what);
   }
   return make_texture(std::move(source), image.width, image.height, image.component, image.bits,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -326,6 +327,35 @@ TEST(MeshIoObj, MissingTextureIsAnErrorNamingIt) {
   fs::copy_file(kModels + "OBJ/spider.obj", dir.file("spider.obj"));
   fs::copy_file(kModels + "OBJ/spider.mtl", dir.file("spider.mtl"));
   expect_load_error(dir.file("spider.obj"), "wal67ar_small.jpg");
+}
+
+// A PNG that is only its signature and header, claiming width x height RGB pixels.
+std::string png_header_only(std::uint32_t width, std::uint32_t height) {
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += std::string("\0\0\0\x0dIHDR", 8);
+  for (const std::uint32_t v : {width, height}) {
+    for (int shift = 24; shift >= 0; shift -= 8) png += static_cast<char>((v >> shift) & 0xFF);
+  }
+  png += std::string("\x08\x02\0\0\0", 5);  // 8 bits, RGB, deflate, no filter, no interlace
+  png += std::string(4, '\0');              // the CRC (stb_image does not check it)
+  return png;
+}
+
+// A texture over stb_image's 1 GB decoded says so and gives its size, instead of calling the
+// file broken; a broken one still reads as broken.
+TEST(MeshIoObj, ATextureTooLargeToDecodeSaysItsSize) {
+  TempDir dir;
+  write_file(dir.file("box.obj"),
+             "mtllib box.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+             "f 1/1 2/2 3/3\n");
+  write_file(dir.file("box.mtl"), "newmtl m\nmap_Kd big.png\n");
+  write_file(dir.file("big.png"), png_header_only(20000, 20000));
+  expect_load_error(dir.file("box.obj"),
+                    "big.png' is 20000 x 20000 pixels, 1.1 GB decoded: over the 1 GB the image "
+                    "decoder takes");
+  // 16384 x 16384 RGB is under the limit: this truncated one fails as broken.
+  write_file(dir.file("big.png"), png_header_only(16384, 16384));
+  expect_load_error(dir.file("box.obj"), "could not be decoded (unknown or broken image format)");
 }
 
 TEST(MeshIoObj, AMissingMaterialLibraryLoadsWithAWarning) {
