@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dslr/exposure.h"
+#include "dslr/lens.h"
 
 namespace rigc::analysis {
 namespace {
@@ -145,6 +146,15 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
                              "full scale, where sensor noise hides texture; {} more light: "
                              "lengthen the shutter, raise the ISO or add light",
                              100 * dark / visible, 100 * settings.min_signal, stops_text(stops)));
+  }
+  // A distortion that draws the frame's edge from beyond the canvas the renderers make (at most
+  // twice the sensor's extent): the pixels there repeat the canvas's border, a smear that is not
+  // the scene, and nothing else would tell.
+  if (camera.effects.distortion && dslr::render_geometry_for(camera, 1.0).clipped) {
+    diag.warning(first_known(camera.distortion_loc, camera.loc),
+                 "the distortion draws the frame's edge from further out than twice the "
+                 "sensor's extent, where the rendered canvas ends: pixels near that edge repeat "
+                 "the canvas's border instead of the scene; make the coefficients smaller");
   }
   // Motion blur from a turning table, per shot group (reported once per source line).
   int last_line = -1;

@@ -171,6 +171,25 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
   }
 }
 
+// A distortion the compiler takes (no fold-over) but that draws the frame's edge from beyond
+// the rendered canvas is pointed out at the distortion's line; a usual one is not.
+TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
+  const auto with_lens = [](const std::string& distortion) {
+    std::string text = scene_text(kStatue, kGoodExposure, kGoodShots);
+    const std::string lens = "lens: {focal_length: 50mm}";
+    text.replace(text.find(lens), lens.size(),
+                 "lens: {focal_length: 50mm, distortion: " + distortion + "}");
+    return text;
+  };
+  const std::string expected = "the distortion draws the frame's edge from further out";
+  const Analysed strong =
+      analyse(with_lens("{k1: 0.056, k2: -0.0025, p1: -0.027, p2: -0.24, k3: 0.046}"));
+  EXPECT_NE(strong.warnings.find("test.yaml:14:42: warning: " + expected), std::string::npos)
+      << strong.warnings;
+  const Analysed usual = analyse(with_lens("{k1: -0.05, k2: 0.01, p1: 0.001, p2: -0.002}"));
+  EXPECT_EQ(usual.warnings.find(expected), std::string::npos) << usual.warnings;
+}
+
 // The over-exposure advice names a shutter; taking it, the warning goes (it said "one stop" at
 // any setting, at 30 s too, where nine were needed).
 TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {

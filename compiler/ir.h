@@ -189,8 +189,9 @@ struct Camera {
   int jpeg_quality = 95;
   double circle_of_confusion_m = 0.03e-3;  // acceptable blur for DOF advice (diagonal / 1500)
   SourceLoc loc;
-  // Where the exposure settings were written, for capture advice at the responsible line.
-  SourceLoc aperture_loc, shutter_loc, iso_loc, focus_loc;
+  // Where the exposure settings and the lens's distortion were written, for capture advice at
+  // the responsible line.
+  SourceLoc aperture_loc, shutter_loc, iso_loc, focus_loc, distortion_loc;
 };
 
 // Thresholds of the coverage analysis: when a view of a face is usable by SfM.

@@ -17,7 +17,8 @@ struct Intrinsics {
 
 // What a renderer must render: an undistorted pinhole canvas that covers every sensor pixel once
 // the lens distortion is applied. `clipped` is set when the growth cap was hit (very strong
-// distortion): some sensor pixels then sample the canvas edge.
+// distortion the compiler still takes): some sensor pixels then sample the canvas edge, and the
+// capture advice says so at the distortion's line.
 struct RenderGeometry : Intrinsics {
   bool clipped = false;
 };

@@ -76,6 +76,17 @@ TEST(DslrRenderGeometry, WithoutDistortionTheCanvasIsTheSensor) {
   }
 }
 
+// A strong tangential term the compiler accepts (no fold-over before the frame's edge) still
+// asks for more canvas than the cap of twice the sensor: the geometry says so.
+TEST(DslrRenderGeometry, TheCapIsReportedAsClipped) {
+  ir::Camera camera = canon_6d();
+  camera.effects.distortion = true;
+  camera.distortion = {0.056, -0.0025, -0.027, -0.24, 0.046};
+  const RenderGeometry g = render_geometry_for(camera, 0.25);
+  EXPECT_TRUE(g.clipped);
+  EXPECT_EQ(g.width, 2 * 1368);
+}
+
 TEST(DslrRenderGeometry, EverySensorPixelMapsInsideTheCanvas) {
   ir::Camera camera = canon_6d();
   camera.effects.distortion = true;
