@@ -1,14 +1,8 @@
 #include "eval/colmap.h"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -17,8 +11,6 @@
 
 #include "backends/common/child_processes.h"
 #include "backends/common/files.h"
-
-extern char** environ;
 
 namespace rigc::eval {
 
@@ -40,52 +32,15 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
     for (const auto& a : argv) header << " " << a;
     header << "\n";
   }
-  std::vector<std::string> env_strings;
-  bool has_qt = false;
-  for (char** e = environ; *e; ++e) {
-    env_strings.emplace_back(*e);
-    if (std::strncmp(*e, "QT_QPA_PLATFORM=", 16) == 0) has_qt = true;
-  }
-  if (!has_qt) env_strings.emplace_back("QT_QPA_PLATFORM=offscreen");
-  std::vector<char*> envp;
-  for (auto& s : env_strings) envp.push_back(s.data());
-  envp.push_back(nullptr);
-  std::vector<std::string> args = argv;
-  std::vector<char*> cargv;
-  for (auto& a : args) cargv.push_back(a.data());
-  cargv.push_back(nullptr);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, cargv[0], &actions, nullptr, cargv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    *error = fmt::format("cannot run {}: {}", argv[0], std::strerror(rc));
+  // COLMAP's Qt needs no display to extract and match.
+  const backends::ChildResult child =
+      backends::run_child({argv, log, {}, {"QT_QPA_PLATFORM=offscreen"}});
+  if (!child.started || child.exit_code < 0) {
+    *error = child.error;
     return -1;
   }
-  backends::WatchedChild watched(pid);
-  int status = 0;
-  rusage usage{};
-  while (wait4(pid, &status, 0, &usage) < 0) {
-    if (errno != EINTR) {
-      *error = fmt::format("waiting for {} failed: {}", argv[0], std::strerror(errno));
-      return -1;
-    }
-  }
-  watched.release();
-  if (cpu_seconds) {
-    auto seconds = [](const timeval& t) {
-      return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6;
-    };
-    *cpu_seconds = seconds(usage.ru_utime) + seconds(usage.ru_stime);
-  }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return -1;
+  if (cpu_seconds) *cpu_seconds = child.cpu_seconds;
+  return child.exit_code;
 }
 
 namespace {

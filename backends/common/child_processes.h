@@ -1,33 +1,38 @@
-// Programs that rigc starts (POV-Ray, Blender, COLMAP) stop when rigc is stopped.
+// Programs that rigc starts (POV-Ray, Blender, COLMAP): always an argument vector (posix_spawn),
+// never a shell string, with their output in a log file; and they stop when rigc is stopped.
 #pragma once
 
-#include <sys/types.h>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace rigc::backends {
 
-// While a child is watched, a SIGINT, SIGTERM or SIGHUP that stops rigc sends the child a
-// SIGTERM first. A signal sent to rigc alone (`kill`, `timeout`, a closed ssh session) left
-// POV-Ray rendering on its own, into the folder a rerun then rendered into as well. (A SIGKILL
-// cannot be caught: its children still run on; nor can a signal in the microseconds between
-// the spawn and the watch.)
-void watch_child(pid_t pid);
-void unwatch_child(pid_t pid);
+// The full path of `name` found in $PATH (or `name` itself when it contains a '/' and is
+// executable); nullopt when there is none.
+std::optional<std::filesystem::path> find_executable(const std::string& name);
 
-// Unwatches on scope exit, or at release(): call that as soon as the child is reaped, so that
-// a signal cannot reach another process that is given its pid.
-class WatchedChild {
- public:
-  explicit WatchedChild(pid_t pid) : pid_(pid) { watch_child(pid_); }
-  ~WatchedChild() { release(); }
-  void release() {
-    if (pid_ > 0) unwatch_child(pid_);
-    pid_ = 0;
-  }
-  WatchedChild(const WatchedChild&) = delete;
-  WatchedChild& operator=(const WatchedChild&) = delete;
-
- private:
-  pid_t pid_;
+struct ChildRun {
+  std::vector<std::string> argv;      // argv[0] is searched in $PATH
+  std::filesystem::path log;          // stdout and stderr are appended here; stdin is /dev/null
+  std::filesystem::path working_dir;  // empty: rigc's own
+  // NAME=value entries added to rigc's environment, each only where NAME is not set already.
+  std::vector<std::string> default_env;
 };
+
+struct ChildResult {
+  bool started = false;  // false: it could not be started, `error` says why
+  int exit_code = -1;    // 128 + signal when killed by a signal; -1 when the wait failed
+  double cpu_seconds = 0;
+  std::string error;
+};
+
+// Runs the program and waits for it. While it runs, a SIGINT, SIGTERM or SIGHUP that stops rigc
+// sends it a SIGTERM first: a signal sent to rigc alone (`kill`, `timeout`, a closed ssh
+// session) had left POV-Ray rendering on its own, into the folder a rerun then rendered into as
+// well. A signal that comes while the child is being started stops it too. (A SIGKILL cannot be
+// caught: the child then runs on.)
+ChildResult run_child(const ChildRun& run);
 
 }  // namespace rigc::backends

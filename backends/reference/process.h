@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "backends/common/child_processes.h"
+
 namespace rigc::reference {
 
-// The full path of `name` found in $PATH (or `name` itself when it contains a '/' and is
-// executable); nullopt when there is none.
-std::optional<std::filesystem::path> find_executable(const std::string& name);
+using backends::find_executable;
 
 struct ProgramResult {
   bool started = false;  // false: spawn failed, `error` says why
