@@ -49,7 +49,11 @@ void stop_children_and_die(int signal_number) {
   if (g_starting.load() > 0) {
     // A child being started would outlive rigc: its starter stops it, then rigc.
     g_deferred_signal.store(signal_number);
-    return;
+    if (g_starting.load() > 0) return;
+    // The last starter finished meanwhile and may have looked before the store: unless it took
+    // the signal, it is this handler's again.
+    if (g_deferred_signal.exchange(0) == 0) return;
+    stop_children();
   }
   die_of(signal_number);
 }
