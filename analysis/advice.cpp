@@ -152,9 +152,9 @@ void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& s
   // the scene, and nothing else would tell.
   if (camera.effects.distortion && dslr::render_geometry_for(camera, 1.0).clipped) {
     diag.warning(first_known(camera.distortion_loc, camera.loc),
-                 "the distortion draws the frame's edge from further out than twice the "
-                 "sensor's extent, where the rendered canvas ends: pixels near that edge repeat "
-                 "the canvas's border instead of the scene; make the coefficients smaller");
+                 "the distortion draws part of the frame from beyond the canvas the renderers "
+                 "make (at most twice the sensor's extent): pixels there repeat the canvas's "
+                 "border instead of the scene; make the coefficients smaller");
   }
   // Motion blur from a turning table, per shot group (reported once per source line).
   int last_line = -1;

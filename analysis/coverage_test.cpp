@@ -181,7 +181,7 @@ TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
                  "lens: {focal_length: 50mm, distortion: " + distortion + "}");
     return text;
   };
-  const std::string expected = "the distortion draws the frame's edge from further out";
+  const std::string expected = "the distortion draws part of the frame from beyond the canvas";
   const Analysed strong =
       analyse(with_lens("{k1: 0.056, k2: -0.0025, p1: -0.027, p2: -0.24, k3: 0.046}"));
   EXPECT_NE(strong.warnings.find("test.yaml:14:42: warning: " + expected), std::string::npos)

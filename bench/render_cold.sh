@@ -8,13 +8,17 @@
 # Usage: bench/render_cold.sh [RUNS] [GAP]   (defaults 3 runs, 8 s; about 18 s a run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export LC_ALL=C  # `time` and awk in one decimal notation
 runs=${1:-3}
 gap=${2:-8}
 rigc=./build/rigc
 [ -x "$rigc" ] || { echo "render_cold: build first ($rigc is missing)" >&2; exit 2; }
 [[ "$runs" =~ ^[1-9][0-9]*$ ]] || { echo "render_cold: RUNS must be a positive integer" >&2; exit 2; }
 [[ "$gap" =~ ^[0-9]+$ ]] || { echo "render_cold: GAP must be a whole number of seconds" >&2; exit 2; }
-out=$(mktemp -d)
+# On disk under build/, not in a tmpfs /tmp, whose files would hold memory between the runs.
+out=build/render_cold
+rm -rf "$out"
+mkdir -p "$out"
 trap 'rm -rf "$out"' EXIT
 
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -24,8 +28,12 @@ for ((k = 1; k <= runs; ++k)); do
   rm -rf "$out/run"
   sleep "$gap"
   TIMEFORMAT='%R %U %S'
-  times=$( { time "$rigc" render scenes/paper-turntable.yaml --backend preview -o "$out/run" \
-    >/dev/null 2>"$out/log" || { cat "$out/log" >&2; exit 1; }; } 2>&1)
+  if ! times=$( { time "$rigc" render scenes/paper-turntable.yaml --backend preview \
+    -o "$out/run" >/dev/null 2>"$out/log"; } 2>&1); then
+    echo "render_cold: run $k failed:" >&2
+    cat "$out/log" >&2
+    exit 1
+  fi
   read -r wall user sys <<<"$times"
   [ "$(find "$out/run/images" -name '*.jpg' | wc -l)" -eq 18 ] ||
     { echo "render_cold: run $k did not write 18 images" >&2; exit 1; }

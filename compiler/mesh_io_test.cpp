@@ -330,14 +330,15 @@ TEST(MeshIoObj, MissingTextureIsAnErrorNamingIt) {
 }
 
 // A PNG that is only its signature and header, claiming width x height RGB pixels.
-std::string png_header_only(std::uint32_t width, std::uint32_t height) {
+std::string png_header_only(std::uint32_t width, std::uint32_t height, int bits = 8) {
   std::string png = "\x89PNG\r\n\x1a\n";
   png += std::string("\0\0\0\x0dIHDR", 8);
   for (const std::uint32_t v : {width, height}) {
     for (int shift = 24; shift >= 0; shift -= 8) png += static_cast<char>((v >> shift) & 0xFF);
   }
-  png += std::string("\x08\x02\0\0\0", 5);  // 8 bits, RGB, deflate, no filter, no interlace
-  png += std::string(4, '\0');              // the CRC (stb_image does not check it)
+  png += static_cast<char>(bits);
+  png += std::string("\x02\0\0\0", 4);  // RGB, deflate, no filter, no interlace
+  png += std::string(4, '\0');          // the CRC (stb_image does not check it)
   return png;
 }
 
@@ -349,12 +350,17 @@ TEST(MeshIoObj, ATextureTooLargeToDecodeSaysItsSize) {
              "mtllib box.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
              "f 1/1 2/2 3/3\n");
   write_file(dir.file("box.mtl"), "newmtl m\nmap_Kd big.png\n");
+  const std::string too_large = "more than the image decoder takes";
   write_file(dir.file("big.png"), png_header_only(20000, 20000));
-  expect_load_error(dir.file("box.obj"),
-                    "big.png' is 20000 x 20000 pixels, 1.1 GB decoded: over the 1 GB the image "
-                    "decoder takes");
-  // 16384 x 16384 RGB is under the limit: this truncated one fails as broken.
-  write_file(dir.file("big.png"), png_header_only(16384, 16384));
+  expect_load_error(dir.file("box.obj"), "big.png' is 20000 x 20000 pixels: " + too_large);
+  // The header test's edge: 2^30 / 16384 / 3 = 21845 rows of RGB.
+  write_file(dir.file("big.png"), png_header_only(16384, 21846));
+  expect_load_error(dir.file("box.obj"), "is 16384 x 21846 pixels: " + too_large);
+  // 16 bits: 16384 x 16384 as 16-bit RGBA is 2 GB.
+  write_file(dir.file("big.png"), png_header_only(16384, 16384, 16));
+  expect_load_error(dir.file("box.obj"), "is 16384 x 16384 pixels at 16 bits: " + too_large);
+  // Under both limits (8-bit 16384 x 21845): this truncated one fails as broken.
+  write_file(dir.file("big.png"), png_header_only(16384, 21845));
   expect_load_error(dir.file("box.obj"), "could not be decoded (unknown or broken image format)");
 }
 

@@ -21,8 +21,8 @@ void recycle(std::vector<float>&& buffer);
 void recycle(std::vector<std::uint8_t>&& buffer);
 void recycle(std::vector<std::uint16_t>&& buffer);
 
-// Resizes `buffer` to `size`; new memory is faulted in by the kernel with every core, before
-// the caller's loops touch it. Existing values are kept.
+// Resizes `buffer` to `size`; new memory is faulted in with every core (by the kernel where it
+// can), on 4 KB pages, before the caller's loops touch it. Existing values are kept.
 void resize_frame_buffer(std::vector<float>& buffer, std::size_t size);
 void resize_frame_buffer(std::vector<std::uint8_t>& buffer, std::size_t size);
 void resize_frame_buffer(std::vector<std::int8_t>& buffer, std::size_t size);

@@ -1,6 +1,7 @@
 #include "backends/common/child_processes.h"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/resource.h>
@@ -14,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <system_error>
 
 extern char** environ;
 
@@ -28,6 +30,9 @@ static_assert(std::atomic<pid_t>::is_always_lock_free, "the signal handler reads
 // meanwhile, which the last of them to be watched then acts on.
 std::atomic<int> g_starting{0};
 std::atomic<int> g_deferred_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler uses them");
+// Called between a child's spawn and its watch (tests only; see the header).
+void (*g_spawn_hook)() = nullptr;
 
 constexpr std::array kStopSignals = {SIGINT, SIGTERM, SIGHUP};
 
@@ -45,16 +50,24 @@ void die_of(int signal_number) {
 }
 
 void stop_children_and_die(int signal_number) {
-  stop_children();
   if (g_starting.load() > 0) {
-    // A child being started would outlive rigc: its starter stops it, then rigc.
+    // A child being started would outlive rigc: its starter stops every child, then rigc. The
+    // others are left running until then, so that no caller meanwhile takes their SIGTERM for
+    // a failure of its own. The handler returns: the interrupted thread keeps its errno.
+    const int saved_errno = errno;
     g_deferred_signal.store(signal_number);
-    if (g_starting.load() > 0) return;
+    if (g_starting.load() > 0) {
+      errno = saved_errno;
+      return;
+    }
     // The last starter finished meanwhile and may have looked before the store: unless it took
     // the signal, it is this handler's again.
-    if (g_deferred_signal.exchange(0) == 0) return;
-    stop_children();
+    if (g_deferred_signal.exchange(0) == 0) {
+      errno = saved_errno;
+      return;
+    }
   }
+  stop_children();
   die_of(signal_number);
 }
 
@@ -66,16 +79,20 @@ void install_handlers() {
     if (previous.sa_handler != SIG_DFL) continue;
     struct sigaction action {};
     action.sa_handler = stop_children_and_die;
+    // While a signal is deferred the handler returns: other threads' calls carry on.
+    action.sa_flags = SA_RESTART;
     sigemptyset(&action.sa_mask);
     sigaction(signal_number, &action, nullptr);
   }
 }
 
-void watch_child(pid_t pid) {
+// False when every slot is taken (rigc runs a few children at once at most).
+bool watch_child(pid_t pid) {
   for (auto& child : g_children) {
     pid_t expected = 0;
-    if (child.compare_exchange_strong(expected, pid)) return;
+    if (child.compare_exchange_strong(expected, pid)) return true;
   }
+  return false;
 }
 
 void unwatch_child(pid_t pid) {
@@ -113,6 +130,10 @@ bool is_executable_file(const fs::path& path) {
 
 }  // namespace
 
+void set_spawn_hook_for_tests(void (*hook)()) {
+  g_spawn_hook = hook;
+}
+
 std::optional<fs::path> find_executable(const std::string& name) {
   if (name.empty()) return std::nullopt;
   if (name.find('/') != std::string::npos) {
@@ -137,18 +158,27 @@ ChildResult run_child(const ChildRun& run) {
     result.error = "no program to run";
     return result;
   }
-  const std::optional<fs::path> program = find_executable(run.argv[0]);
+  std::optional<fs::path> program = find_executable(run.argv[0]);
   if (!program) {
-    result.error = "'" + run.argv[0] + "' was not found in PATH";
+    result.error = run.argv[0].find('/') != std::string::npos
+                       ? "'" + run.argv[0] + "' is not an executable file"
+                       : "'" + run.argv[0] + "' was not found in PATH";
+    return result;
+  }
+  // The child changes to working_dir before it runs the program: a path relative to rigc's
+  // folder would be looked up there.
+  std::error_code absolute_error;
+  program = fs::absolute(*program, absolute_error);
+  if (absolute_error) {
+    result.error = "cannot locate '" + run.argv[0] + "': " + absolute_error.message();
     return result;
   }
   std::vector<std::string> env_strings;
   for (char** e = environ; *e != nullptr; ++e) env_strings.emplace_back(*e);
   for (const std::string& entry : run.default_env) {
-    const std::string name = entry.substr(0, entry.find('=') + 1);
-    if (name.size() < 2 || std::getenv(name.substr(0, name.size() - 1).c_str()) == nullptr) {
-      env_strings.push_back(entry);
-    }
+    const std::size_t equals = entry.find('=');
+    if (equals == 0 || equals == std::string::npos) continue;  // no NAME=value
+    if (std::getenv(entry.substr(0, equals).c_str()) == nullptr) env_strings.push_back(entry);
   }
   std::vector<char*> envp;
   for (std::string& entry : env_strings) envp.push_back(entry.data());
@@ -164,6 +194,10 @@ ChildResult run_child(const ChildRun& run) {
   posix_spawn_file_actions_addopen(&actions, 1, run.log.c_str(), O_WRONLY | O_CREAT | O_APPEND,
                                    0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  // Nothing else of rigc's: a descriptor without O_CLOEXEC (a stream's, a library's) would stay
+  // open in the child for as long as it runs, as would a pipe's write end that someone reads to
+  // its end.
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
   if (!run.working_dir.empty()) {
     posix_spawn_file_actions_addchdir_np(&actions, run.working_dir.c_str());
   }
@@ -174,23 +208,35 @@ ChildResult run_child(const ChildRun& run) {
   const int rc = posix_spawn(&pid, program->c_str(), &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) {
-    result.error = "cannot start '" + program->string() + "': " + std::strerror(rc);
+    // The program was found: the log or the working folder may be what failed.
+    result.error = fmt::format(
+        "cannot start '{}' (log {}{}): {}", program->string(), run.log.string(),
+        run.working_dir.empty() ? "" : ", in " + run.working_dir.string(), std::strerror(rc));
     return result;  // a signal deferred meanwhile is carried out by `starting`
   }
   result.started = true;
-  watch_child(pid);
+  if (g_spawn_hook != nullptr) g_spawn_hook();
+  const bool watched = watch_child(pid);
   starting.done();
+  if (!watched) {
+    kill(pid, SIGTERM);
+    result.error = "too many programs running at once";
+  }
+  // Waited for without reaping first: the pid stays this child's until it is unwatched, so that
+  // a signal cannot reach another process that is given the pid.
+  siginfo_t info{};
+  while (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOWAIT) < 0 && errno == EINTR) {
+  }
+  unwatch_child(pid);
   int status = 0;
   rusage usage{};
   while (wait4(pid, &status, 0, &usage) < 0) {
     if (errno != EINTR) {
-      unwatch_child(pid);
       result.error = "waiting for '" + program->string() + "' failed: " + std::strerror(errno);
       return result;
     }
   }
-  // Unwatched once reaped, so that a signal cannot reach another process given its pid.
-  unwatch_child(pid);
+  if (!watched) return result;
   const auto seconds = [](const timeval& t) {
     return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6;
   };

@@ -35,4 +35,8 @@ struct ChildResult {
 // caught: the child then runs on.)
 ChildResult run_child(const ChildRun& run);
 
+// Tests only: `hook` runs in run_child between the child's spawn and its watch, where a stop
+// signal has to be deferred (nullptr: none).
+void set_spawn_hook_for_tests(void (*hook)());
+
 }  // namespace rigc::backends

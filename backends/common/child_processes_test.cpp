@@ -1,8 +1,13 @@
 #include "backends/common/child_processes.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <fstream>
+#include <string>
+#include <thread>
 
 #include "tests/test_support.h"
 
@@ -41,6 +46,44 @@ TEST(ChildProcesses, ReportsTheChildsCpuTimeAndWhyItDidNotStart) {
   const ChildResult missing = run_child({{"rigc-no-such-program"}, log, {}, {}});
   EXPECT_FALSE(missing.started);
   EXPECT_EQ(missing.error, "'rigc-no-such-program' was not found in PATH");
+}
+
+// Whether a process runs whose command line is `words` (NUL-separated in /proc/PID/cmdline).
+bool process_runs(const std::vector<std::string>& words) {
+  std::string wanted;
+  for (const std::string& word : words) wanted += word + '\0';
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    std::ifstream in(entry.path() / "cmdline", std::ios::binary);
+    const std::string cmdline((std::istreambuf_iterator<char>(in)), {});
+    if (cmdline == wanted) return true;
+  }
+  return false;
+}
+
+// A stop signal that comes while a child is being started (here, raised by the test hook between
+// the spawn and the watch) is carried out once the child is watched: the child is stopped, then
+// the process dies of the signal. Before, the handler killed the watched children (none yet) and
+// died at once, and the child ran on.
+TEST(ChildProcessesDeathTest, AStopSignalWhileAChildStartsStopsTheChildThenRigc) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  rigc::testing::TempDir dir;
+  // sleep adds its arguments: the odd second one marks this test's child. (A constant: the
+  // threadsafe death test runs this body again in a process of its own.)
+  const std::vector<std::string> argv = {"sleep", "30", "0.000271828"};
+  const std::filesystem::path log = dir.path() / "log.txt";
+  EXPECT_EXIT(
+      {
+        set_spawn_hook_for_tests([] { raise(SIGTERM); });
+        run_child({argv, log, {}, {}});
+        std::exit(0);
+      },
+      ::testing::KilledBySignal(SIGTERM), "");
+  bool runs = true;
+  for (int k = 0; k < 50 && runs; ++k) {
+    runs = process_runs(argv);
+    if (runs) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_FALSE(runs) << "the child outlived the process that started it";
 }
 
 }  // namespace
