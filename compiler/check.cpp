@@ -805,8 +805,7 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
       }
       if (const YAML::Node distortion = lens["distortion"]) {
         if (expect_map(distortion, "distortion")) {
-          scene.distortion_loc = loc(distortion);
-          camera.distortion_loc = scene.distortion_loc;
+          camera.distortion_loc = loc(distortion);
           check_keys(distortion, {"k1", "k2", "k3", "p1", "p2"}, "distortion");
           auto read = [&](const char* key, double& out) {
             if (!distortion[key]) return;

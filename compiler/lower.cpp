@@ -275,7 +275,7 @@ void Lowering::lower_camera() {
       camera.effects.distortion
           ? distortion_problem(camera.distortion, camera.cx / camera.fx, camera.cy / camera.fy)
           : std::string();
-  if (!lens_problem.empty()) error(spec_.distortion_loc, lens_problem);
+  if (!lens_problem.empty()) error(camera.distortion_loc, lens_problem);
   // The photographer's acceptable circle of confusion unless the scene sets its own.
   if (scene_.coverage.max_blur_px <= 0) {
     scene_.coverage.max_blur_px =

@@ -104,7 +104,6 @@ struct SceneSpec {
   bool focus_auto = true;
   double focus_distance_m = 1;
   SourceLoc focus_loc;
-  SourceLoc distortion_loc;  // the lens's distortion mapping, where it is given
   std::vector<ShotGroupSpec> shots;
   ir::CoverageSettings coverage;
 };
