@@ -54,29 +54,27 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
 // only write them a second time.
 //
 // The pages are asked to stay 4 KB ones (MADV_NOHUGEPAGE, which also holds where THP is
-// "always"; Debian's mode is "madvise"). On the KVM guest
-// this project is measured on, a 2 MB page costs 2.2-2.5 s per GB of CPU to fault in once the
-// memory has been free for a few seconds (0.16 s per GB after 1 s), and a 4 KB page 0.3-0.4 s
-// per GB even then (800 MB populated 10 s after the last run, alternated). Most likely the
-// guest's free 2 MB blocks go back to the host (virtio-balloon free page reporting, order 9
-// here) while its scattered 4 KB pages stay backed. Later shots reuse the pool's
-// buffers, and were no slower on 4 KB pages in the full-size benchmark (median 460-464 against
-// 463-466 ms a shot), while a cold `rigc render` of the paper scene took 8.95-9.16 s against
-// 9.62-9.99 s, its system CPU 0.41-0.46 s against 1.92-2.17 s.
+// "always"; Debian's mode is "madvise"). On the KVM guest this project is measured on, a 2 MB
+// page costs 2.2-2.5 s per GB of CPU to fault in once the memory has been free for a few seconds
+// (0.16 s per GB after 1 s), and a 4 KB page 0.3-0.4 s per GB even then (800 MB populated 10 s
+// after the last run, alternated). Most likely the guest's free 2 MB blocks go back to the host
+// (virtio-balloon free page reporting, order 9 here) while its scattered 4 KB pages stay backed.
+// Later shots reuse the pool's buffers, and were no slower on 4 KB pages in the full-size benchmark
+// (median 460-464 against 463-466 ms a shot), while a cold `rigc render` of the paper scene
+// took 8.95-9.16 s against 9.62-9.99 s, its system CPU 0.41-0.46 s against 1.92-2.17 s.
 void first_touch(void* data, std::size_t bytes) {
-  {
-    // The advice needs page boundaries: the pages wholly inside the buffer.
-    constexpr std::uintptr_t kPageSize = 4096;
-    const std::uintptr_t begin =
-        (reinterpret_cast<std::uintptr_t>(data) + kPageSize - 1) & ~(kPageSize - 1);
-    const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kPageSize - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_NOHUGEPAGE);
-  }
-  // Pieces of 2 MB, one per task. madvise needs a page boundary: the first piece starts at the
-  // page holding `data` (populating a page changes none of its bytes).
   constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20, kPage = 4096;
   const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t end = start + bytes;
+  // The advice needs page boundaries: the pages wholly inside the buffer.
+  const std::uintptr_t first_whole_page = (start + kPage - 1) & ~(kPage - 1);
+  const std::uintptr_t last_whole_page_end = end & ~(kPage - 1);
+  if (last_whole_page_end > first_whole_page) {
+    madvise(reinterpret_cast<void*>(first_whole_page), last_whole_page_end - first_whole_page,
+            MADV_NOHUGEPAGE);
+  }
+  // Pieces of 2 MB, one per task. madvise needs a page boundary: the first piece starts at the
+  // page holding `data` (populating a page changes none of its bytes).
   const std::uintptr_t first = start & ~(kPiece - 1);
   tbb::parallel_for(std::uintptr_t{0}, (end - first + kPiece - 1) / kPiece, [&](std::uintptr_t k) {
     const std::uintptr_t piece = std::max(first + k * kPiece, start & ~(kPage - 1));
