@@ -101,6 +101,19 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
   return result;
 }
 
+std::map<std::string, double> stage_ms(const ShotTiming& timing) {
+  return {{"shadows", timing.raster.shadow_ms},
+          {"setup", timing.raster.setup_ms},
+          {"raster_and_shading", timing.raster.raster_ms},
+          {"exposure", timing.develop.exposure_ms},
+          {"depth_of_field", timing.develop.depth_of_field_ms},
+          {"diffraction", timing.develop.diffraction_ms},
+          {"distortion_vignetting", timing.develop.distortion_ms},
+          {"noise", timing.develop.noise_ms},
+          {"develop", timing.develop.develop_ms},
+          {"write", timing.write_ms}};
+}
+
 int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostream& log,
                 std::vector<ShotTiming>* timings) {
   const fs::path run_dir = options.output_dir;
@@ -194,16 +207,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     record.name = shot.name;
     record.key = write.key;
     record.render_ms = timing.total_ms;
-    record.stage_ms = {{"shadows", timing.raster.shadow_ms},
-                       {"setup", timing.raster.setup_ms},
-                       {"raster_and_shading", timing.raster.raster_ms},
-                       {"exposure", timing.develop.exposure_ms},
-                       {"depth_of_field", timing.develop.depth_of_field_ms},
-                       {"diffraction", timing.develop.diffraction_ms},
-                       {"distortion_vignetting", timing.develop.distortion_ms},
-                       {"noise", timing.develop.noise_ms},
-                       {"develop", timing.develop.develop_ms},
-                       {"write", timing.write_ms}};
+    record.stage_ms = stage_ms(timing);
     record.files = {write.image, write.mask};
     manifest.record(record);
     unsaved = true;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct ShotTiming {
   int subframes = 1;
   bool skipped = false;  // already in the manifest with the same inputs
 };
+
+// A shot's time by stage in milliseconds, under the names the manifest records ("stage_ms").
+std::map<std::string, double> stage_ms(const ShotTiming& timing);
 
 // Renders one shot to developed pixels (no files). For tests and benchmarks. Without
 // `keep_linear` the result's linear image is left empty (what a run that writes files does).
