@@ -862,7 +862,7 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     error(node, "the camera needs an 'exposure' {aperture, shutter, iso}");
   }
   if (const YAML::Node focus = node["focus"]) {
-    scene.focus_loc = camera.focus_loc = loc(focus);
+    camera.focus_loc = loc(focus);
     if (focus.IsScalar() && focus.Scalar() == "auto") {
       scene.focus_auto = true;
     } else if (auto d =

@@ -324,7 +324,7 @@ void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double
   shot.focus_distance_m = spec_.focus_auto ? camera_space_depth : spec_.focus_distance_m;
   const double f = scene_.camera.focal_length_m;
   if (shot.focus_distance_m <= f * 1.01) {
-    error(spec_.focus_auto ? loc : spec_.focus_loc,
+    error(spec_.focus_auto ? loc : scene_.camera.focus_loc,
           fmt::format("{}: focus distance {:.3f} m is not beyond the focal length {:.0f} mm",
                       shot.name, shot.focus_distance_m, f * 1000));
   }

@@ -103,7 +103,6 @@ struct SceneSpec {
   ir::Camera camera;  // intrinsics not yet computed
   bool focus_auto = true;
   double focus_distance_m = 1;
-  SourceLoc focus_loc;
   std::vector<ShotGroupSpec> shots;
   ir::CoverageSettings coverage;
 };
