@@ -68,7 +68,7 @@ double next_standard_f_number(double f_number) {
   return 64;
 }
 
-void report_capture_advice(const ir::Scene& scene, const preview::StudioScene& studio,
+void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag) {
   const ir::Camera& camera = scene.camera;
   const ir::CoverageSettings& settings = scene.coverage;

@@ -8,11 +8,11 @@
 #include <cmath>
 #include <numbers>
 
-#include "backends/preview/rasterizer.h"
 #include "compiler/color.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/optics.h"
+#include "raster/rasterizer.h"
 
 namespace rigc::analysis {
 namespace {
@@ -34,17 +34,17 @@ struct ShotSums {
 };
 
 // Mean albedo luminance of each face: material colour, texture average, pattern average.
-std::vector<float> face_albedo(const ir::Scene& scene, const preview::StudioScene& studio) {
+std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene& studio) {
   std::vector<float> material_albedo;
   for (size_t m = 0; m < scene.materials.size(); ++m) {
-    const preview::ShadedMaterial& material = studio.materials[m];
+    const scene::ShadedMaterial& material = studio.materials[m];
     Vector3f color = material.base_color;
     if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size()) &&
         !studio.textures[material.texture].levels.empty()) {
       color = color.cwiseProduct(studio.textures[material.texture].levels.back().texels[0]);
     }
     // A footprint far larger than the pattern gives the pattern's mean.
-    const float pattern_mean = preview::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
+    const float pattern_mean = scene::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
     material_albedo.push_back(static_cast<float>(luminance(color.cast<double>()) * pattern_mean *
                                                  (1 - material.metallic)));
   }
@@ -58,11 +58,11 @@ std::vector<float> face_albedo(const ir::Scene& scene, const preview::StudioScen
 
 }  // namespace
 
-CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioScene& studio,
+CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options) {
   const ir::Camera& camera = scene.camera;
   const ir::CoverageSettings& settings = scene.coverage;
-  const preview::Geometry& mesh = studio.object;
+  const scene::Geometry& mesh = studio.object;
   const size_t face_count = mesh.triangles.size();
   const int shot_count = static_cast<int>(scene.shots.size());
 
@@ -107,11 +107,11 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
 
   for (int s = 0; s < shot_count; ++s) {
     const ir::Shot& shot = scene.shots[s];
-    preview::FrameRequest request;
+    raster::FrameRequest request;
     request.world_from_camera = shot.world_from_camera;
     request.turntable_angle_rad = shot.turntable_angle_rad;
     request.canvas = canvas;
-    const preview::VisibilityBuffer buffer = preview::render_visibility(scene, studio, request);
+    const raster::VisibilityBuffer buffer = raster::render_visibility(scene, studio, request);
     const ir::Mat4 camera_from_object = shot.object_from_camera.inverse();
     const Eigen::Matrix3d rotation = camera_from_object.block<3, 3>(0, 0);
     const Vector3d translation = camera_from_object.block<3, 1>(0, 3);
@@ -176,7 +176,7 @@ CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioSce
             double illuminance = scene.studio.ambient_lx;
             for (const auto& light : scene.studio.lights) {
               illuminance += luminance(
-                  preview::light_illuminance(light, world_center, world_normal).cast<double>());
+                  raster::light_illuminance(light, world_center, world_normal).cast<double>());
             }
             const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
 

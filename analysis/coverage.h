@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "backends/preview/studio_scene.h"
-#include "compiler/ir.h"
+#include "ir/ir.h"
+#include "scene/studio_scene.h"
 
 namespace rigc::analysis {
 
@@ -52,7 +52,7 @@ struct CoverageOptions {
   double visibility_scale = 0;
 };
 
-CoverageResult analyse_coverage(const ir::Scene& scene, const preview::StudioScene& studio,
+CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options = {});
 
 }  // namespace rigc::analysis

@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
-#include "backends/common/files.h"
-#include "backends/preview/rasterizer.h"
 #include "dslr/lens.h"
 #include "io/atomic_file.h"
+#include "io/files.h"
+#include "raster/rasterizer.h"
 
 namespace rigc::analysis {
 namespace {
@@ -28,7 +28,7 @@ std::uint8_t to_srgb8(float linear) {
 }
 
 // Binary PLY with one colour per face (CloudCompare and MeshLab read face colours).
-bool write_face_color_ply(const fs::path& path, const preview::Geometry& mesh,
+bool write_face_color_ply(const fs::path& path, const scene::Geometry& mesh,
                           const std::vector<Vector3f>& colors, std::string* error) {
   std::string data = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment RigC coverage\nelement vertex {}\n"
@@ -51,11 +51,11 @@ bool write_face_color_ply(const fs::path& path, const preview::Geometry& mesh,
                                  to_srgb8(colors[f].z())};
     append(rgb, 3);
   }
-  return backends::write_file_atomically(path, data, error);
+  return rigc::write_file_atomically(path, data, error);
 }
 
 // GLB with the faces unwelded so each carries its own vertex colour (COLOR_0, linear).
-bool write_face_color_glb(const fs::path& path, const preview::Geometry& mesh,
+bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
                           const std::vector<Vector3f>& colors, std::string* error) {
   const size_t vertex_count = mesh.triangles.size() * 3;
   std::vector<float> positions, normals, vertex_colors;
@@ -171,7 +171,7 @@ bool write_png(const fs::path& path, const std::vector<float>& rgb, int width, i
 }
 
 // A camera orbiting the object at `azimuth`/`elevation` (radians), framing it whole.
-ir::Mat4 picture_camera(const ir::Scene& scene, const preview::StudioScene& studio, double azimuth,
+ir::Mat4 picture_camera(const ir::Scene& scene, const scene::StudioScene& studio, double azimuth,
                         double elevation, double horizontal_fov) {
   const ir::Vec3 center =
       (ir::world_from_object(scene, 0) * studio.object_center.homogeneous()).head<3>();
@@ -208,7 +208,7 @@ Vector3f heat_color(int views, int max_views) {
   return stops[i] + (stops[i + 1] - stops[i]) * (x - i);
 }
 
-bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& studio,
+bool write_coverage_outputs(const ir::Scene& scene, const scene::StudioScene& studio,
                             const CoverageResult& coverage, const fs::path& dir, int picture_width,
                             std::string* error) {
   std::error_code ec;
@@ -233,7 +233,7 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
   }
 
   // Pictures: the object on its own (turntable angle 0), from four sides and from above.
-  preview::FrameRequest request;
+  raster::FrameRequest request;
   const double fov = 2 * std::atan(0.5 * scene.camera.sensor_width_m / scene.camera.focal_length_m);
   const int width = picture_width;
   const int height = picture_width * 2 / 3;
@@ -249,7 +249,7 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
   for (const auto& view : views) {
     request.world_from_camera = picture_camera(scene, studio, view.azimuth_deg * M_PI / 180,
                                                view.elevation_deg * M_PI / 180, fov);
-    const auto rgb = preview::render_face_colors(scene, studio, request, paper);
+    const auto rgb = raster::render_face_colors(scene, studio, request, paper);
     if (!write_png(dir / "pictures" / fmt::format("view_{}.png", view.name), rgb, width, height,
                    error)) {
       return false;
@@ -263,7 +263,7 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
       const int views_so_far = (coverage.first_seen[f] <= s) + (coverage.second_seen[f] <= s);
       colors[f] = paper_color(views_so_far);
     }
-    const auto rgb = preview::render_face_colors(scene, studio, request, colors);
+    const auto rgb = raster::render_face_colors(scene, studio, request, colors);
     if (!write_png(dir / "pictures" / fmt::format("after_{}.png", scene.shots[s].name), rgb, width,
                    height, error)) {
       return false;
@@ -313,7 +313,7 @@ bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& 
                      {"frame_fill", shot.frame_fill}});
   }
   json["shots"] = shots;
-  return backends::write_file_atomically(dir / "coverage.json", json.dump(2) + "\n", error);
+  return rigc::write_file_atomically(dir / "coverage.json", json.dump(2) + "\n", error);
 }
 
 void print_coverage_table(const ir::Scene& scene, const CoverageResult& coverage,

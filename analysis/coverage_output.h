@@ -6,8 +6,8 @@
 #include <string>
 
 #include "analysis/coverage.h"
-#include "backends/preview/studio_scene.h"
-#include "compiler/ir.h"
+#include "ir/ir.h"
+#include "scene/studio_scene.h"
 
 namespace rigc::analysis {
 
@@ -18,7 +18,7 @@ Eigen::Vector3f heat_color(int views, int max_views);
 
 // Writes into `dir`: coverage.ply/.glb (paper colours), views.ply/.glb (heat map),
 // pictures/view_*.png, pictures/after_shot_*.png (cumulative), coverage.json. Atomic files.
-bool write_coverage_outputs(const ir::Scene& scene, const preview::StudioScene& studio,
+bool write_coverage_outputs(const ir::Scene& scene, const scene::StudioScene& studio,
                             const CoverageResult& coverage, const std::filesystem::path& dir,
                             int picture_width, std::string* error);
 

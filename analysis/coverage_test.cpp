@@ -8,8 +8,8 @@
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
+#include "assets/mesh_io.h"
 #include "compiler/frontend.h"
-#include "compiler/mesh_io.h"
 #include "tests/test_support.h"
 
 namespace rigc::analysis {
@@ -33,7 +33,7 @@ Analysed analyse(const std::string& text) {
   EXPECT_TRUE(scene) << messages;
   if (!scene) return out;
   out.scene = *scene;
-  const preview::StudioScene studio = preview::prepare_studio_scene(out.scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(out.scene);
   CoverageOptions options;
   options.visibility_scale = 0.2;
   out.coverage = analyse_coverage(out.scene, studio, options);
@@ -214,7 +214,7 @@ TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
   Analysed a = analyse(scene_text(
       "  primitive: box\n  fit: {size: 10cm}", kGoodExposure,
       "  - turntable: {steps: 4, step: 90deg, camera: {distance: 60cm, height: 20cm}}\n"));
-  const preview::StudioScene studio = preview::prepare_studio_scene(a.scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(a.scene);
   std::string error;
   ASSERT_TRUE(write_coverage_outputs(a.scene, studio, a.coverage, dir.path(), 96, &error)) << error;
   for (const char* file :

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "assets/mesh_io.h"
+#include "assets/primitives.h"
 #include "compiler/frontend.h"
-#include "compiler/mesh_io.h"
-#include "compiler/primitives.h"
 
 namespace {
 

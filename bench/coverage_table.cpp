@@ -10,8 +10,8 @@
 #include <iostream>
 
 #include "analysis/coverage.h"
-#include "backends/common/allocator.h"
 #include "compiler/frontend.h"
+#include "io/allocator.h"
 
 int main(int argc, char** argv) {
   rigc::keep_freed_memory();  // as the rigc command does
@@ -39,7 +39,7 @@ shots:
     auto scene = rigc::compile_scene_text(text, "bench.yaml", ".", diag);
     if (!scene) return 1;
     const auto t0 = std::chrono::steady_clock::now();
-    const rigc::preview::StudioScene studio = rigc::preview::prepare_studio_scene(*scene);
+    const rigc::scene::StudioScene studio = rigc::scene::prepare_studio_scene(*scene);
     const auto t1 = std::chrono::steady_clock::now();
     rigc::analysis::CoverageOptions options;
     options.visibility_scale = visibility_scale;

@@ -10,9 +10,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "backends/common/allocator.h"
-#include "backends/preview/rasterizer.h"
-#include "backends/preview/studio_scene.h"
 #include "compiler/frontend.h"
 #include "dslr/buffer_pool.h"
 #include "dslr/develop.h"
@@ -21,6 +18,9 @@
 #include "dslr/lens.h"
 #include "dslr/optics.h"
 #include "dslr/sensor.h"
+#include "io/allocator.h"
+#include "raster/rasterizer.h"
+#include "scene/studio_scene.h"
 
 namespace {
 
@@ -28,8 +28,8 @@ double g_scale = 1.0;
 
 struct Fixture {
   rigc::ir::Scene scene;
-  rigc::preview::StudioScene studio;
-  rigc::preview::FrameRequest request;
+  rigc::scene::StudioScene studio;
+  rigc::raster::FrameRequest request;
   rigc::dslr::LinearFrame frame;  // radiance after exposure
   rigc::dslr::Intrinsics sensor;
 };
@@ -45,14 +45,14 @@ Fixture& fixture() {
         rigc::compile_scene_text(text.str(), "scenes/paper-turntable.yaml", "scenes", diag);
     if (!scene) std::exit(1);
     out.scene = *scene;
-    out.studio = rigc::preview::prepare_studio_scene(out.scene);
+    out.studio = rigc::scene::prepare_studio_scene(out.scene);
     const auto& shot = out.scene.shots[3];
     out.request.world_from_camera = shot.world_from_camera;
     out.request.turntable_angle_rad = shot.turntable_angle_rad;
     const auto geometry = rigc::dslr::render_geometry_for(out.scene.camera, g_scale);
     out.request.canvas = geometry;
     out.request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);
-    out.frame = rigc::preview::render_frame(out.scene, out.studio, out.request);
+    out.frame = rigc::raster::render_frame(out.scene, out.studio, out.request);
     rigc::dslr::expose_in_place(out.scene.camera, out.frame.rgb);
     out.sensor = rigc::dslr::sensor_intrinsics(out.scene.camera, g_scale);
     return out;
@@ -62,10 +62,10 @@ Fixture& fixture() {
 
 void BM_RenderFrame(benchmark::State& state) {
   Fixture& f = fixture();
-  rigc::preview::RasterTimings timings;
+  rigc::raster::RasterTimings timings;
   for (auto _ : state) {
     rigc::dslr::LinearFrame frame =
-        rigc::preview::render_frame(f.scene, f.studio, f.request, &timings);
+        rigc::raster::render_frame(f.scene, f.studio, f.request, &timings);
     benchmark::DoNotOptimize(frame.rgb.data());
     rigc::dslr::recycle(std::move(frame.rgb));
     rigc::dslr::recycle(std::move(frame.depth_m));

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "compiler/primitives.h"
+#include "assets/primitives.h"
 #include "eval/geometry.h"
 #include "eval/metrics.h"
 

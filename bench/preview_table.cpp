@@ -16,10 +16,10 @@
 #include <map>
 #include <sstream>
 
-#include "backends/common/allocator.h"
+#include "assets/primitives.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
-#include "compiler/primitives.h"
+#include "io/allocator.h"
 
 namespace {
 

@@ -10,11 +10,11 @@
 #include <iostream>
 #include <sstream>
 
-#include "backends/common/allocator.h"
 #include "backends/cycles/cycles_backend.h"
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
 #include "compiler/frontend.h"
+#include "io/allocator.h"
 
 namespace {
 
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
 
   rigc::preview::RenderOptions preview_options;
   preview_options.scale = scale;
-  rigc::reference::ReferenceOptions reference_options;
+  rigc::external::ReferenceOptions reference_options;
   reference_options.scale = scale;
   reference_options.samples = samples;
   std::vector<Row> rows;

@@ -12,25 +12,25 @@
 #include "analysis/advice.h"
 #include "analysis/coverage.h"
 #include "analysis/coverage_output.h"
-#include "backends/common/command_line.h"
-#include "backends/common/shots.h"
 #include "backends/cycles/cycles_backend.h"
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
+#include "cli/options.h"
+#include "cli/verbs.h"
 #include "compiler/frontend.h"
-#include "compiler/ir_json.h"
 #include "compiler/units.h"
-#include "eval/eval.h"
 #include "io/atomic_file.h"
+#include "ir/ir_json.h"
+#include "run/shots.h"
 
 namespace rigc::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-using backends::finite_number;
-using backends::non_negative_number;
-using backends::parse_options;
+using cli::finite_number;
+using cli::non_negative_number;
+using cli::parse_options;
 
 nlohmann::json diagnostics_json(const DiagnosticEngine& diag) {
   nlohmann::json out = nlohmann::json::array();
@@ -62,7 +62,7 @@ int run_check(std::vector<std::string> args) {
   auto scene = compile_scene_file(scene_path, diag);
   if (scene && !no_advice) {
     // Capture advice from a coverage analysis at reduced resolution (about 700 px across).
-    const preview::StudioScene studio = preview::prepare_studio_scene(*scene);
+    const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
     analysis::CoverageOptions options;
     options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
     const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
@@ -180,15 +180,14 @@ int run_render(std::vector<std::string> args) {
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
   std::string error;
-  auto shots =
-      backends::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()), &error);
+  auto shots = run::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()), &error);
   if (!shots) {
     std::cerr << "rigc: error: --shots: " << error << '\n';
     return kExitUserError;
   }
   if (output.empty()) output = (fs::path("out") / scene->name / backend).string();
   if (backend != "preview") {
-    reference::ReferenceOptions options;
+    external::ReferenceOptions options;
     options.output_dir = output;
     options.shots = *shots;
     options.scale = scale;
@@ -220,7 +219,7 @@ int run_coverage(std::vector<std::string> args) {
   app.add_option("--visibility-scale", visibility_scale,
                  "resolution of the visibility buffers relative to the sensor (0: ~1400 px)")
       // 1e-9 made a buffer of a pixel or two: fill 100 %, two thirds unseen, and no warning.
-      ->check(backends::finite_number_where(
+      ->check(cli::finite_number_where(
           [](double value) { return value == 0 || (value >= 0.01 && value <= 1); },
           "is neither 0 (automatic) nor within 0.01..1", ""));
   if (auto code = parse_options(app, args)) return *code;
@@ -229,7 +228,7 @@ int run_coverage(std::vector<std::string> args) {
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
   if (output.empty()) output = (fs::path("out") / scene->name / "coverage").string();
-  const preview::StudioScene studio = preview::prepare_studio_scene(*scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
   analysis::CoverageOptions options;
   options.visibility_scale = visibility_scale;
   const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
@@ -260,9 +259,9 @@ const std::vector<Command>& commands() {
       {"render", "render every shot with a backend (preview, povray, cycles)", run_render},
       {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
       {"eval", "reconstruct a run with COLMAP and measure it against the ground truth",
-       eval::run_eval_command},
+       run_eval_command},
       {"compare", "render with several backends and compare reconstruction accuracy",
-       eval::run_compare_command},
+       run_compare_command},
       {"version", "print the version", run_version},
   };
   return table;

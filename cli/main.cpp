@@ -1,5 +1,5 @@
-#include "backends/common/allocator.h"
 #include "cli/commands.h"
+#include "io/allocator.h"
 
 int main(int argc, char** argv) {
   rigc::keep_freed_memory();

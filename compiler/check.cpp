@@ -8,8 +8,8 @@
 #include <numbers>
 #include <set>
 
+#include "assets/primitives.h"
 #include "compiler/presets.h"
-#include "compiler/primitives.h"
 #include "compiler/units.h"
 
 namespace rigc {

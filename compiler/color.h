@@ -1,7 +1,7 @@
 // Colour helpers shared by the compiler and the renderers.
 #pragma once
 
-#include "compiler/ir.h"
+#include "ir/ir.h"
 
 namespace rigc {
 

@@ -6,14 +6,9 @@
 #include <string>
 #include <vector>
 
-namespace rigc {
+#include "ir/source_location.h"
 
-// Where something came from in a scene file. Lines and columns are 1-based; 0 means unknown.
-struct SourceLoc {
-  std::string file;
-  int line = 0;
-  int col = 0;
-};
+namespace rigc {
 
 enum class Severity { kNote, kWarning, kError };
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "compiler/diagnostics.h"
-#include "compiler/ir.h"
 #include "compiler/spec.h"
+#include "ir/ir.h"
 
 namespace rigc {
 

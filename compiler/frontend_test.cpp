@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <numbers>
 
-#include "compiler/ir_json.h"
+#include "ir/ir_json.h"
 #include "tests/test_support.h"
 
 namespace rigc {

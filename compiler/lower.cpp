@@ -8,11 +8,11 @@
 #include <sstream>
 #include <tuple>
 
+#include "assets/mesh_io.h"
+#include "assets/primitives.h"
 #include "compiler/check.h"
 #include "compiler/color.h"
 #include "compiler/frontend.h"
-#include "compiler/mesh_io.h"
-#include "compiler/primitives.h"
 
 namespace rigc {
 namespace {
@@ -423,66 +423,6 @@ void Lowering::place_backdrop() {
 
 std::optional<ir::Scene> lower_scene(const spec::SceneSpec& scene, DiagnosticEngine& diag) {
   return Lowering(scene, diag).run();
-}
-
-std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::string& file,
-                                            const std::string& base_dir, DiagnosticEngine& diag) {
-  diag.add_source(file, text);
-  // Checking walks the tree section by section; its diagnostics are reported in file order.
-  DiagnosticEngine checking;
-  checking.set_handler([](const Diagnostic&, const std::string&) {});
-  std::optional<spec::SceneSpec> checked;
-  if (auto root = parse_yaml(text, file, checking)) {
-    checked = check_scene(*root, file, base_dir, checking);
-  }
-  std::vector<Diagnostic> found = checking.diagnostics();
-  std::stable_sort(found.begin(), found.end(), [](const Diagnostic& a, const Diagnostic& b) {
-    return std::tie(a.loc.line, a.loc.col) < std::tie(b.loc.line, b.loc.col);
-  });
-  for (auto& d : found) diag.report(std::move(d));
-  if (!checked || checking.has_errors()) return std::nullopt;
-  return lower_scene(*checked, diag);
-}
-
-std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
-  std::ifstream in(path, std::ios::binary);
-  std::error_code ec;
-  if (!in || fs::is_directory(path, ec)) {
-    diag.error({path, 0, 0}, "cannot read the scene file");
-    return std::nullopt;
-  }
-  // A scene is a few kilobytes; /dev/zero as the scene file grew memory without end.
-  constexpr std::size_t kMostBytes = 16 << 20;
-  std::string text;
-  std::array<char, 1 << 16> chunk;
-  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMostBytes) {
-      diag.error({path, 0, 0},
-                 "the scene file is larger than 16 MB (a scene is text; meshes and "
-                 "textures are files of their own)");
-      return std::nullopt;
-    }
-  }
-  std::string base_dir = fs::path(path).parent_path().string();
-  if (base_dir.empty()) base_dir.push_back('.');  // (GCC 12 warns, falsely, on = ".")
-  return compile_scene_text(text, path, base_dir, diag);
-}
-
-Mat4 ir::world_from_object(const ir::Scene& scene, double turntable_angle_rad) {
-  return translation(Vec3(0, 0, scene.studio.turntable.height_m)) *
-         rotation(Eigen::AngleAxisd(turntable_angle_rad, Vec3::UnitZ()).toRotationMatrix());
-}
-
-std::vector<Eigen::Vector3f> ir::object_frame_positions(const ir::Object& object) {
-  std::vector<Eigen::Vector3f> positions;
-  positions.reserve(object.mesh.positions.size());
-  for (const auto& p : object.mesh.positions) {
-    const Vec3 q = object.object_from_mesh.topLeftCorner<3, 3>() * p.cast<double>() +
-                   object.object_from_mesh.topRightCorner<3, 1>();
-    positions.push_back(q.cast<float>());
-  }
-  return positions;
 }
 
 }  // namespace rigc

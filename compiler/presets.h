@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "compiler/ir.h"
+#include "ir/ir.h"
 
 namespace rigc {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "compiler/diagnostics.h"
-#include "compiler/ir.h"
+#include "ir/ir.h"
 
 namespace rigc::spec {
 

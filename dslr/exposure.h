@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "compiler/ir.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr {
 

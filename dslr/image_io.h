@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "compiler/ir.h"
 #include "dslr/frame.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr {
 

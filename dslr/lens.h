@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "compiler/ir.h"
 #include "dslr/frame.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr {
 

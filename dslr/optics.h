@@ -3,8 +3,8 @@
 
 #include <vector>
 
-#include "compiler/ir.h"
 #include "dslr/frame.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr {
 

@@ -2,8 +2,8 @@
 // Cycles renders both run, so every renderer is judged by the same camera.
 #pragma once
 
-#include "compiler/ir.h"
 #include "dslr/frame.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr {
 

@@ -15,9 +15,9 @@
 #include <mutex>
 #include <numbers>
 
-#include "compiler/hash.h"
 #include "dslr/buffer_pool.h"
 #include "dslr/simd.h"
+#include "ir/hash.h"
 
 namespace rigc::dslr {
 

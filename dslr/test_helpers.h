@@ -5,9 +5,9 @@
 #include <limits>
 #include <vector>
 
-#include "compiler/ir.h"
 #include "dslr/frame.h"
 #include "dslr/lens.h"
+#include "ir/ir.h"
 
 namespace rigc::dslr::testing {
 

@@ -9,8 +9,8 @@
 #include <numeric>
 #include <sstream>
 
-#include "backends/common/child_processes.h"
-#include "backends/common/files.h"
+#include "io/child_processes.h"
+#include "io/files.h"
 
 namespace rigc::eval {
 
@@ -33,8 +33,7 @@ int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::s
     header << "\n";
   }
   // COLMAP's Qt needs no display to extract and match.
-  const backends::ChildResult child =
-      backends::run_child({argv, log, {}, {"QT_QPA_PLATFORM=offscreen"}});
+  const rigc::ChildResult child = rigc::run_child({argv, log, {}, {"QT_QPA_PLATFORM=offscreen"}});
   if (!child.started || child.exit_code < 0) {
     *error = child.error;
     return -1;
@@ -139,7 +138,7 @@ bool write_pair_list(const fs::path& path, const std::vector<std::string>& names
                      const std::vector<std::pair<int, int>>& pairs, std::string* error) {
   std::string text;
   for (const auto& [i, j] : pairs) text += names.at(i) + " " + names.at(j) + "\n";
-  return backends::write_file_atomically(path, text, error);
+  return rigc::write_file_atomically(path, text, error);
 }
 
 double SparseModel::mean_track_length() const {
@@ -187,9 +186,9 @@ std::optional<std::vector<Point3D>> read_colmap_points(const fs::path& path, std
 
 std::optional<SparseModel> read_sparse_model(const fs::path& dir, std::string* error) {
   SparseModel model;
-  auto cameras = backends::read_colmap_cameras(dir / "cameras.txt", error);
+  auto cameras = run::read_colmap_cameras(dir / "cameras.txt", error);
   if (!cameras) return std::nullopt;
-  auto images = backends::read_colmap_images(dir / "images.txt", error);
+  auto images = run::read_colmap_images(dir / "images.txt", error);
   if (!images) return std::nullopt;
   auto points = read_colmap_points(dir / "points3D.txt", error);
   if (!points) return std::nullopt;

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "backends/common/colmap_text.h"
-#include "compiler/ir.h"
+#include "ir/ir.h"
+#include "run/colmap_text.h"
 
 namespace rigc::eval {
 
@@ -62,8 +62,8 @@ struct Point3D {
 };
 
 struct SparseModel {
-  std::vector<backends::ColmapCamera> cameras;
-  std::vector<backends::ColmapImage> images;
+  std::vector<run::ColmapCamera> cameras;
+  std::vector<run::ColmapImage> images;
   std::vector<Point3D> points;
   double mean_track_length() const;
   double mean_reprojection_error() const;  // over observations, like COLMAP's own report

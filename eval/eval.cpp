@@ -15,14 +15,14 @@
 #include <set>
 #include <sstream>
 
-#include "backends/common/colmap_text.h"
-#include "backends/common/files.h"
-#include "backends/common/manifest.h"
+#include "assets/mesh_io.h"
 #include "compiler/frontend.h"
-#include "compiler/mesh_io.h"
 #include "eval/colmap.h"
 #include "eval/geometry.h"
 #include "eval/metrics.h"
+#include "io/files.h"
+#include "run/colmap_text.h"
+#include "run/manifest.h"
 
 namespace rigc::eval {
 
@@ -131,7 +131,7 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
     // (another object: F-score 0, and no word of why). Runs record the object's surface.
     if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
         m["inputs"].contains("object_sha256") && m["inputs"]["object_sha256"].is_string() &&
-        m["inputs"]["object_sha256"].get<std::string>() != backends::object_geometry_hash(*scene)) {
+        m["inputs"]["object_sha256"].get<std::string>() != run::object_geometry_hash(*scene)) {
       *warning = fmt::format(
           "the object of {} is not the one the run in {} was rendered with (its surface differs "
           "from manifest.json's object_sha256): the numbers measure against another object",
@@ -145,7 +145,7 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
   return gt;
 }
 
-ViewCamera view_camera(const backends::ColmapCamera& cam, const ir::Mat4& camera_from_world) {
+ViewCamera view_camera(const run::ColmapCamera& cam, const ir::Mat4& camera_from_world) {
   ViewCamera v;
   v.camera_from_world = camera_from_world;
   v.width = cam.width;
@@ -330,7 +330,7 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
   // The intrinsics prior: the run's ground-truth camera (exact), else COLMAP reads EXIF.
   bool exact_prior = false;
   std::string why;
-  auto cams = backends::read_colmap_cameras(run_dir / "sparse" / "cameras.txt", &why);
+  auto cams = run::read_colmap_cameras(run_dir / "sparse" / "cameras.txt", &why);
   if (cams && !cams->empty()) {
     const auto& c = cams->front();
     std::string params;
@@ -484,7 +484,7 @@ ColmapRun run_colmap(const EvalOptions& o, const fs::path& given_images_dir, con
                               conv_log, &error, &cpu_s);
     convert_cpu_s += cpu_s;
     if (rc != 0) continue;
-    auto images = backends::read_colmap_images(tmp / "images.txt", &why);
+    auto images = run::read_colmap_images(tmp / "images.txt", &why);
     if (images && images->size() > best_images) {
       best_images = images->size();
       best = tmp;
@@ -586,10 +586,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   }
   if (!gt_warning.empty()) log << "rigc eval: warning: " << gt_warning << "\n";
   std::map<std::string, ir::Mat4> gt_poses;
-  std::optional<backends::ColmapCamera> gt_camera;
+  std::optional<run::ColmapCamera> gt_camera;
   if (!photos && fs::exists(run_dir / "sparse" / "images.txt")) {
-    auto images = backends::read_colmap_images(run_dir / "sparse" / "images.txt", &error);
-    auto cams = backends::read_colmap_cameras(run_dir / "sparse" / "cameras.txt", &error);
+    auto images = run::read_colmap_images(run_dir / "sparse" / "images.txt", &error);
+    auto cams = run::read_colmap_cameras(run_dir / "sparse" / "cameras.txt", &error);
     if (!images || !cams || cams->empty()) {
       log << "rigc eval: error: " << error << "\n";
       return 1;
@@ -660,7 +660,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   sum.colmap_s = colmap.seconds;
   auto write_report = [&]() {
     std::string why;
-    if (!backends::write_file_atomically(out / "eval.json", report.dump(2) + "\n", &why)) {
+    if (!rigc::write_file_atomically(out / "eval.json", report.dump(2) + "\n", &why)) {
       log << "rigc eval: error: " << why << "\n";
       return false;
     }

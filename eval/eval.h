@@ -57,8 +57,4 @@ struct EvalSummary {
 // names the log).
 int evaluate(const EvalOptions& options, std::ostream& log, EvalSummary* summary);
 
-// The verbs; args[0] is the program name ("rigc eval"). 0 ok, 1 user error, 2 external failure.
-int run_eval_command(std::vector<std::string> args);
-int run_compare_command(std::vector<std::string> args);
-
 }  // namespace rigc::eval

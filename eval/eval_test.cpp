@@ -15,13 +15,14 @@
 #include <random>
 #include <sstream>
 
-#include "backends/common/manifest.h"
+#include "assets/mesh_io.h"
 #include "backends/preview/preview_backend.h"
+#include "cli/verbs.h"
 #include "compiler/frontend.h"
-#include "compiler/mesh_io.h"
 #include "eval/colmap.h"
 #include "eval/geometry.h"
 #include "eval/metrics.h"
+#include "run/manifest.h"
 #include "tests/test_support.h"
 
 namespace rigc::eval {
@@ -344,7 +345,7 @@ void write_small_image(const std::string& path, int side = 64) {
 
 TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   rigc::testing::TempDir dir;
-  EXPECT_EQ(run_eval_command({"rigc eval", dir.file("nothing")}), 1);
+  EXPECT_EQ(cli::run_eval_command({"rigc eval", dir.file("nothing")}), 1);
   // A run folder with images but a COLMAP that does not exist.
   fs::create_directories(dir.path() / "run" / "images");
   for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
@@ -471,10 +472,10 @@ TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
   diag.set_handler([](const Diagnostic&, const std::string&) {});
   auto paper = compile_scene_file(o.scene, diag);
   ASSERT_TRUE(paper);
-  const std::string paper_hash = backends::object_geometry_hash(*paper);
+  const std::string paper_hash = run::object_geometry_hash(*paper);
   auto scaled = *paper;  // the same mesh fitted 1 % taller: another ground truth
   scaled.object.object_from_mesh.topLeftCorner<3, 3>() *= 1.01;
-  ASSERT_NE(backends::object_geometry_hash(scaled), paper_hash);
+  ASSERT_NE(run::object_geometry_hash(scaled), paper_hash);
   for (const std::string& hash : {paper_hash, std::string("0123")}) {
     rigc::testing::write_text(
         dir.file("run/manifest.json"),

@@ -9,8 +9,8 @@
 #include <cstring>
 #include <limits>
 
-#include "backends/common/files.h"
 #include "io/atomic_file.h"
+#include "io/files.h"
 
 namespace rigc::eval {
 
@@ -185,7 +185,7 @@ bool write_colored_ply(const fs::path& path, const std::vector<Vec3>& points,
     std::memcpy(p + 15, &df, 4);
     p += 19;
   }
-  return backends::write_file_atomically(path, out, error);
+  return rigc::write_file_atomically(path, out, error);
 }
 
 bool write_histogram_png(const fs::path& path, const std::vector<double>& d_mm, double range_mm,

@@ -8,19 +8,19 @@
 #include <numbers>
 #include <ostream>
 
-#include "backends/common/files.h"
-#include "backends/preview/studio_scene.h"
-#include "backends/reference/process.h"
-#include "backends/reference/script_text.h"
+#include "backends/external/process.h"
+#include "backends/external/script_text.h"
 #include "dslr/lens.h"
+#include "io/files.h"
+#include "scene/studio_scene.h"
 
 namespace rigc::cycles {
 
 namespace {
 
 namespace fs = std::filesystem;
+using external::RenderedShot;
 using nlohmann::json;
-using reference::RenderedShot;
 
 constexpr double kPi = std::numbers::pi;
 constexpr int kDefaultSamples = 64;
@@ -77,7 +77,7 @@ json light_json(const ir::Light& light, int index) {
       break;
     case ir::LightType::kDirectional:
       spec["type"] = "SUN";
-      spec["energy"] = light.illuminance_lx / reference::kCandelaPerBlenderUnit;
+      spec["energy"] = light.illuminance_lx / external::kCandelaPerBlenderUnit;
       break;
   }
   return spec;
@@ -87,7 +87,7 @@ std::string texture_file_name(int texture) {
   return fmt::format("texture_{}.png", texture);
 }
 
-json material_json(const ir::Scene& scene, const preview::ShadedMaterial& material, int index,
+json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material, int index,
                    bool is_object) {
   std::string name = index < static_cast<int>(scene.materials.size())
                          ? scene.materials[index].name
@@ -114,7 +114,7 @@ json material_json(const ir::Scene& scene, const preview::ShadedMaterial& materi
 
 // Appends the mesh the way Blender's foreach_set wants it: per-vertex positions and normals,
 // per-loop vertex indices and UVs (v flipped: Blender's v = 0 is the image bottom).
-json append_geometry(std::string& bytes, const preview::Geometry& g, int material_offset,
+json append_geometry(std::string& bytes, const scene::Geometry& g, int material_offset,
                      int material_count) {
   auto append = [&](const void* data, size_t size) {
     const size_t offset = bytes.size();
@@ -151,7 +151,7 @@ json append_geometry(std::string& bytes, const preview::Geometry& g, int materia
 
 std::string script_text(const json& data) {
   const std::string literal =
-      reference::python_string_literal(data.dump(-1, ' ', true, json::error_handler_t::replace));
+      external::python_string_literal(data.dump(-1, ' ', true, json::error_handler_t::replace));
   std::string script = kScriptTemplate;
   const std::string placeholder = "@DATA@";
   script.replace(script.find(placeholder), placeholder.size(), literal);
@@ -159,12 +159,12 @@ std::string script_text(const json& data) {
       "# RigC: Blender Cycles scene '{}' (object {}).\n"
       "# Run: blender -b --factory-startup --python scene.py [-- --shot N[,N...] --samples N "
       "--out DIR]\n",
-      reference::comment_text(data["scene"].get<std::string>()),
-      reference::comment_text(data["object_source"].get<std::string>()));
+      external::comment_text(data["scene"].get<std::string>()),
+      external::comment_text(data["object_source"].get<std::string>()));
   return header + script;
 }
 
-class CyclesRenderer : public reference::Renderer {
+class CyclesRenderer : public external::Renderer {
  public:
   std::string name() const override { return "cycles"; }
   std::string executable() const override { return "blender"; }
@@ -183,8 +183,8 @@ class CyclesRenderer : public reference::Renderer {
 
 bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
                                 int samples, std::string* error) {
-  if (!reference::prepare_emit_folder(scene, dir, scale, error)) return false;
-  const preview::StudioScene studio = preview::prepare_studio_scene(scene);
+  if (!external::prepare_emit_folder(scene, dir, scale, error)) return false;
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());
   const ir::Camera& camera = scene.camera;
@@ -198,7 +198,7 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   data["height"] = canvas.height;
   data["samples"] = samples > 0 ? samples : kDefaultSamples;
   data["shutter_s"] = camera.shutter_s;
-  data["ambient_radiance"] = scene.studio.ambient_lx / reference::kCandelaPerBlenderUnit / kPi;
+  data["ambient_radiance"] = scene.studio.ambient_lx / external::kCandelaPerBlenderUnit / kPi;
   // The sensor width that gives the canvas's fx at the true focal length, so that Cycles' pupil
   // (focal length / f-number) is the real one.
   const double focal_mm = camera.focal_length_m * 1000;
@@ -216,8 +216,8 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   }
   data["materials"] = materials;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
-    if (!reference::write_texture_png(dir / texture_file_name(static_cast<int>(t)),
-                                      scene.textures[t], error)) {
+    if (!external::write_texture_png(dir / texture_file_name(static_cast<int>(t)),
+                                     scene.textures[t], error)) {
       return false;
     }
   }
@@ -226,7 +226,7 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   data["geometry"]["object"] = append_geometry(bytes, studio.object, 0, object_materials);
   data["geometry"]["studio"] =
       append_geometry(bytes, studio.studio, object_materials, total_materials - object_materials);
-  if (!backends::write_file_atomically(dir / "geometry.bin", bytes, error)) return false;
+  if (!rigc::write_file_atomically(dir / "geometry.bin", bytes, error)) return false;
 
   json lights = json::array();
   for (size_t l = 0; l < scene.studio.lights.size(); ++l) {
@@ -250,7 +250,7 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
                      {"motion_blur", camera.effects.motion_blur}});
   }
   data["shots"] = shots;
-  return backends::write_file_atomically(dir / "scene.py", script_text(data), error);
+  return rigc::write_file_atomically(dir / "scene.py", script_text(data), error);
 }
 
 bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
@@ -277,7 +277,7 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
     argv.push_back("--samples");
     argv.push_back(std::to_string(samples));
   }
-  const reference::ProgramResult result = reference::run_program(argv, dir, log_path);
+  const external::ProgramResult result = external::run_program(argv, dir, log_path);
   if (!result.started) {
     *error = result.error;
     return false;
@@ -287,9 +287,9 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
     return false;
   }
   const dslr::RenderGeometry canvas = dslr::render_geometry_for(scene.camera, scale);
-  reference::LinearImage image, mask;
-  if (!reference::read_linear_image(dir / (stem + ".exr"), &image, error) ||
-      !reference::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) {
+  external::LinearImage image, mask;
+  if (!external::read_linear_image(dir / (stem + ".exr"), &image, error) ||
+      !external::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) {
     return false;
   }
   if (image.width != canvas.width || image.height != canvas.height || mask.width != canvas.width ||
@@ -306,7 +306,7 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
   frame.cx = canvas.cx;
   frame.cy = canvas.cy;
   frame.rgb = std::move(image.rgb);
-  for (float& v : frame.rgb) v *= static_cast<float>(reference::kCandelaPerBlenderUnit);
+  for (float& v : frame.rgb) v *= static_cast<float>(external::kCandelaPerBlenderUnit);
   frame.mask.resize(mask.alpha.size());
   for (size_t i = 0; i < mask.alpha.size(); ++i) frame.mask[i] = mask.alpha[i] >= 0.5f ? 255 : 0;
   out->depth_of_field_rendered = scene.camera.effects.depth_of_field;
@@ -316,7 +316,7 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
 
 }  // namespace
 
-std::unique_ptr<reference::Renderer> make_renderer() {
+std::unique_ptr<external::Renderer> make_renderer() {
   return std::make_unique<CyclesRenderer>();
 }
 
@@ -328,7 +328,7 @@ bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string
 int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
         std::vector<ShotTiming>* timings) {
   CyclesRenderer renderer;
-  return reference::run_reference(scene, options, renderer, log, timings);
+  return external::run_reference(scene, options, renderer, log, timings);
 }
 
 }  // namespace rigc::cycles

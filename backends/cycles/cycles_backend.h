@@ -3,7 +3,7 @@
 // geometry (geometry.bin) and textures, rendered by Cycles and developed by the shared DSLR model.
 //
 // Everything the script needs is one JSON document inside it, written as an escaped Python string
-// literal (reference::python_string_literal): no user text is ever code. Paths in the script are
+// literal (external::python_string_literal): no user text is ever code. Paths in the script are
 // relative to its own folder. Units: Blender's, 1 m per unit; lights in watts (point, spot, area),
 // suns in W/m² = lux/683, the ambient as a world of radiance E/(683π), the output EXR in
 // W/(m²·sr) = cd/m² / 683.
@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include "backends/reference/reference_backend.h"
-#include "compiler/ir.h"
+#include "backends/external/reference_backend.h"
+#include "ir/ir.h"
 
 namespace rigc::cycles {
 
-using reference::ReferenceOptions;
-using reference::ShotTiming;
+using external::ReferenceOptions;
+using external::ShotTiming;
 
 // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
 // the default Cycles sample count of the script (0: 64). False with a one-line `error`.
@@ -33,6 +33,6 @@ bool emit(const ir::Scene& scene, const std::filesystem::path& dir, double scale
 int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
         std::vector<ShotTiming>* timings = nullptr);
 
-std::unique_ptr<reference::Renderer> make_renderer();
+std::unique_ptr<external::Renderer> make_renderer();
 
 }  // namespace rigc::cycles

@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "backends/cycles/cycles_backend.h"
+#include "backends/external/process.h"
 #include "backends/povray/povray_backend.h"
-#include "backends/reference/process.h"
 #include "compiler/frontend.h"
 #include "tests/test_support.h"
 
@@ -13,8 +13,8 @@ namespace rigc::cycles {
 namespace {
 
 namespace fs = std::filesystem;
-using rigc::testing::read_text;
-using rigc::testing::TempDir;
+using ::rigc::testing::read_text;
+using ::rigc::testing::TempDir;
 
 // A mesh file whose name would break out of any unescaped string in a script: quotes,
 // backslashes, a newline and Python code.
@@ -69,7 +69,7 @@ TEST(CyclesEmit, ScriptCarriesUserTextOnlyAsEscapedData) {
   const std::string script = read_text((dir.path() / "cycles" / "scene.py").string());
   // The hostile text never appears verbatim, and the script is valid Python.
   EXPECT_EQ(script.find("os.system(\"touch"), std::string::npos);
-  const auto python = reference::find_executable("python3");
+  const auto python = external::find_executable("python3");
   if (python) {
     const auto result = rigc::testing::run_process(
         {python->string(), "-c", "import ast, sys; ast.parse(open(sys.argv[1]).read())",
@@ -80,7 +80,7 @@ TEST(CyclesEmit, ScriptCarriesUserTextOnlyAsEscapedData) {
 }
 
 TEST(CyclesRun, HostileMeshPathRendersWithoutRunningAnything) {
-  if (!reference::find_executable("blender")) GTEST_SKIP() << "blender is not installed";
+  if (!external::find_executable("blender")) GTEST_SKIP() << "blender is not installed";
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);
   ASSERT_FALSE(scene.shots.empty());
@@ -96,7 +96,7 @@ TEST(CyclesRun, HostileMeshPathRendersWithoutRunningAnything) {
 }
 
 TEST(PovrayRun, HostileMeshPathRendersWithoutRunningAnything) {
-  if (!reference::find_executable("povray")) GTEST_SKIP() << "povray is not installed";
+  if (!external::find_executable("povray")) GTEST_SKIP() << "povray is not installed";
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);
   ASSERT_FALSE(scene.shots.empty());

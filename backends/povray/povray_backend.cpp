@@ -11,12 +11,12 @@
 #include <regex>
 #include <set>
 
-#include "backends/common/files.h"
-#include "backends/preview/preview_backend.h"
-#include "backends/preview/studio_scene.h"
-#include "backends/reference/process.h"
-#include "backends/reference/script_text.h"
+#include "backends/external/process.h"
+#include "backends/external/script_text.h"
 #include "dslr/lens.h"
+#include "io/files.h"
+#include "scene/motion_blur.h"
+#include "scene/studio_scene.h"
 
 namespace rigc::povray {
 
@@ -28,8 +28,8 @@ const double kApertureMetersPerPupilDiameter = 2.0;
 namespace {
 
 namespace fs = std::filesystem;
-using reference::number_text;
-using reference::RenderedShot;
+using external::number_text;
+using external::RenderedShot;
 
 constexpr double kPi = std::numbers::pi;
 // fade_distance of every local light: POV's 2/(1 + (d/D)²) is 2D²/d² to 1e-6 beyond 1 m·1e-3.
@@ -89,11 +89,11 @@ bool write_baked_texture(const fs::path& path, const ir::Texture& texture,
   return true;
 }
 
-std::string pigment_text(const preview::ShadedMaterial& material, int index, bool is_object) {
+std::string pigment_text(const scene::ShadedMaterial& material, int index, bool is_object) {
   const Eigen::Vector3f base = material.base_color;
   if (material.texture >= 0) {
     return fmt::format("uv_mapping image_map {{ png {} gamma 1.0 interpolate 2 }}",
-                       *reference::pov_string_literal(texture_file_name(index)));
+                       *external::pov_string_literal(texture_file_name(index)));
   }
   const ir::SurfacePattern& pattern = material.pattern;
   if (!is_object || pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
@@ -122,7 +122,7 @@ std::string pigment_text(const preview::ShadedMaterial& material, int index, boo
 // The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) scaled by
 // 1 - F0 as the preview's (1 - Fresnel), and a normalised Blinn-Phong highlight of the same
 // peak as its GGX lobe.
-std::string finish_text(const preview::ShadedMaterial& material) {
+std::string finish_text(const scene::ShadedMaterial& material) {
   const double metallic = material.metallic;
   const double f0 = 0.04 * (1 - metallic) + metallic;
   const double alpha = std::max(static_cast<double>(material.roughness) * material.roughness, 0.05);
@@ -134,7 +134,7 @@ std::string finish_text(const preview::ShadedMaterial& material) {
                      metallic > 0.5 ? " metallic" : "");
 }
 
-void append_mesh2(fmt::memory_buffer& out, const std::string& name, const preview::Geometry& g,
+void append_mesh2(fmt::memory_buffer& out, const std::string& name, const scene::Geometry& g,
                   const std::vector<int>& triangles, int material_offset, int material_count) {
   fmt::format_to(std::back_inserter(out), "#declare {} = mesh2 {{\n  vertex_vectors {{ {}", name,
                  g.positions.size());
@@ -177,7 +177,7 @@ std::string light_text(const ir::Light& light) {
       return fmt::format("light_source {{ {}, rgb {} parallel point_at {} }}\n",
                          vec(Eigen::Vector3d(center - dir * 50)),
                          vec(Eigen::Vector3d(color * light.illuminance_lx /
-                                             reference::kCandelaPerBlenderUnit / kPi)),
+                                             external::kCandelaPerBlenderUnit / kPi)),
                          vec(center));
     }
     case ir::LightType::kPoint:
@@ -217,9 +217,9 @@ int antialias_depth(int samples) {
   return std::clamp(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(samples)))), 1, 9);
 }
 
-int subframes_for(const ir::Scene& scene, const preview::StudioScene& studio, const ir::Shot& shot,
+int subframes_for(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
                   double scale) {
-  return std::clamp(preview::motion_blur_subframes(scene, studio, shot, scale), 1, kMaxSubframes);
+  return std::clamp(scene::motion_blur_subframes(scene, studio, shot, scale), 1, kMaxSubframes);
 }
 
 std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::Intrinsics& canvas,
@@ -238,8 +238,8 @@ std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::I
       "#version 3.7;\n#include \"scene.inc\"\n\n"
       "// Horizontal field of view {:.4f} deg, {} x {} px.\n"
       "camera {{\n  perspective\n  location {}\n  direction {}\n  right {}\n  up {}\n",
-      reference::comment_text(shot.name), reference::comment_text(scene.name),
-      reference::comment_text(shot.name), horizontal_fov_deg, canvas.width, canvas.height, vec(eye),
+      external::comment_text(shot.name), external::comment_text(scene.name),
+      external::comment_text(shot.name), horizontal_fov_deg, canvas.width, canvas.height, vec(eye),
       vec(direction), vec(Eigen::Vector3d(right * (canvas.width / canvas.fx))),
       vec(Eigen::Vector3d(-down * (canvas.height / canvas.fy))));
   if (camera.effects.depth_of_field) {
@@ -298,7 +298,7 @@ std::string shot_ini(const ir::Shot& shot, const dslr::Intrinsics& canvas, int s
 }
 
 bool write_text_file(const fs::path& path, const std::string& text, std::string* error) {
-  return backends::write_file_atomically(path, text, error);
+  return rigc::write_file_atomically(path, text, error);
 }
 
 // The shots whose .pov and .ini files the last emit into a folder wrote, one name a line. An
@@ -314,7 +314,7 @@ void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
   std::string name;
   while (std::getline(listed, name)) {
     // Only names an emit could have written: a plain file stem, not a path.
-    if (current.count(name) || !reference::is_plain_file_stem(name)) continue;
+    if (current.count(name) || !external::is_plain_file_stem(name)) continue;
     for (const char* suffix : {".pov", ".ini", "_mask.ini"}) {
       std::error_code ec;
       if (fs::is_regular_file(dir / (name + suffix), ec)) fs::remove(dir / (name + suffix), ec);
@@ -322,7 +322,7 @@ void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
   }
 }
 
-class PovrayRenderer : public reference::Renderer {
+class PovrayRenderer : public external::Renderer {
  public:
   std::string name() const override { return "povray"; }
   std::string executable() const override { return "povray"; }
@@ -346,8 +346,8 @@ class PovrayRenderer : public reference::Renderer {
 
 bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
                                 int samples, std::vector<int>* subframes, std::string* error) {
-  if (!reference::prepare_emit_folder(scene, dir, scale, error)) return false;
-  const preview::StudioScene studio = preview::prepare_studio_scene(scene);
+  if (!external::prepare_emit_folder(scene, dir, scale, error)) return false;
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());
 
@@ -358,16 +358,16 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
                  "// World frame: +Z up, floor at z = 0, metres. Colours are linear; light is in "
                  "Blender's units (1 = 683 cd/m2).\n"
                  "#version 3.7;\n#ifndef (RIGC_MASK)\n  #declare RIGC_MASK = 0;\n#end\n\n",
-                 reference::comment_text(scene.name), reference::comment_text(scene.source_file),
-                 reference::comment_text(scene.object.source));
-  const double ambient = scene.studio.ambient_lx / reference::kCandelaPerBlenderUnit / kPi;
+                 external::comment_text(scene.name), external::comment_text(scene.source_file),
+                 external::comment_text(scene.object.source));
+  const double ambient = scene.studio.ambient_lx / external::kCandelaPerBlenderUnit / kPi;
   fmt::format_to(out,
                  "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 5\n"
                  "  #if (RIGC_MASK)\n    ambient_light rgb 1\n  #else\n    ambient_light rgb {}\n"
                  "  #end\n}}\n\n",
                  number_text(ambient));
   for (int m = 0; m < total_materials; ++m) {
-    const preview::ShadedMaterial& material = studio.materials[m];
+    const scene::ShadedMaterial& material = studio.materials[m];
     const bool is_object = m < object_materials;
     if (material.texture >= 0) {
       if (material.texture >= static_cast<int>(scene.textures.size()) ||
@@ -420,7 +420,7 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
 
 bool run_povray(const fs::path& dir, const std::string& ini, const fs::path& log_path,
                 std::string* error) {
-  const reference::ProgramResult result = reference::run_program({"povray", ini}, dir, log_path);
+  const external::ProgramResult result = external::run_program({"povray", ini}, dir, log_path);
   if (!result.started) {
     *error = result.error;
     return false;
@@ -478,18 +478,18 @@ bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
   const size_t pixels = static_cast<size_t>(canvas.width) * canvas.height;
   frame.rgb.assign(pixels * 3, 0.0f);
   for (const auto& path : frames) {
-    reference::LinearImage image;
-    if (!reference::read_linear_image(path, &image, error)) return false;
+    external::LinearImage image;
+    if (!external::read_linear_image(path, &image, error)) return false;
     if (image.width != canvas.width || image.height != canvas.height) {
       *error = fmt::format("{} is {} x {}, expected {} x {}", path.filename().string(), image.width,
                            image.height, canvas.width, canvas.height);
       return false;
     }
-    const float weight = static_cast<float>(reference::kCandelaPerBlenderUnit / frames.size());
+    const float weight = static_cast<float>(external::kCandelaPerBlenderUnit / frames.size());
     for (size_t i = 0; i < frame.rgb.size(); ++i) frame.rgb[i] += image.rgb[i] * weight;
   }
-  reference::LinearImage mask;
-  if (!reference::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) return false;
+  external::LinearImage mask;
+  if (!external::read_linear_image(dir / (stem + "_mask.exr"), &mask, error)) return false;
   if (mask.width != canvas.width || mask.height != canvas.height) {
     *error = "the mask render has the wrong size";
     return false;
@@ -504,7 +504,7 @@ bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
 
 }  // namespace
 
-std::unique_ptr<reference::Renderer> make_renderer() {
+std::unique_ptr<external::Renderer> make_renderer() {
   return std::make_unique<PovrayRenderer>();
 }
 
@@ -517,7 +517,7 @@ bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string
 int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
         std::vector<ShotTiming>* timings) {
   PovrayRenderer renderer;
-  return reference::run_reference(scene, options, renderer, log, timings);
+  return external::run_reference(scene, options, renderer, log, timings);
 }
 
 }  // namespace rigc::povray

@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "backends/reference/reference_backend.h"
-#include "compiler/ir.h"
+#include "backends/external/reference_backend.h"
+#include "ir/ir.h"
 
 namespace rigc::povray {
 
-using reference::ReferenceOptions;
-using reference::ShotTiming;
+using external::ReferenceOptions;
+using external::ShotTiming;
 
 // POV-Ray's focal blur `aperture` per metre of pupil diameter f/N (2: checked with a render by
 // ReferenceAgreement.DefocusBlurWidth).
@@ -41,6 +41,6 @@ int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& l
         std::vector<ShotTiming>* timings = nullptr);
 
 // The Renderer run() uses, for tests that need the linear frames.
-std::unique_ptr<reference::Renderer> make_renderer();
+std::unique_ptr<external::Renderer> make_renderer();
 
 }  // namespace rigc::povray

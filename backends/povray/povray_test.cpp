@@ -6,8 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "backends/external/process.h"
 #include "backends/povray/povray_backend.h"
-#include "backends/reference/process.h"
 #include "compiler/frontend.h"
 #include "tests/test_support.h"
 
@@ -15,8 +15,8 @@ namespace rigc::povray {
 namespace {
 
 namespace fs = std::filesystem;
-using rigc::testing::read_text;
-using rigc::testing::TempDir;
+using ::rigc::testing::read_text;
+using ::rigc::testing::TempDir;
 
 ir::Scene paper_scene() {
   DiagnosticEngine diag;
@@ -131,7 +131,7 @@ TEST(PovrayRun, MissingExecutableNamesThePackage) {
 // A povray that fails for shot_001 (a wrapper in front of the real one): the run names the shot
 // and its log, finishes the others and exits 2; the rerun renders only the failed shot.
 TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
-  const auto real = reference::find_executable("povray");
+  const auto real = external::find_executable("povray");
   if (!real) GTEST_SKIP() << "povray is not installed";
   ir::Scene scene = paper_scene();
   scene.camera.effects.depth_of_field = false;

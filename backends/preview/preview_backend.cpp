@@ -13,15 +13,16 @@
 #include <optional>
 #include <ostream>
 
-#include "backends/common/colmap_text.h"
-#include "backends/common/manifest.h"
-#include "backends/common/run_folder.h"
-#include "backends/common/transforms_json.h"
 #include "dslr/buffer_pool.h"
 #include "dslr/exposure.h"
 #include "dslr/image_io.h"
 #include "dslr/lens.h"
 #include "dslr/pipeline.h"
+#include "run/colmap_text.h"
+#include "run/manifest.h"
+#include "run/run_folder.h"
+#include "run/transforms_json.h"
+#include "scene/motion_blur.h"
 
 namespace rigc::preview {
 namespace {
@@ -35,39 +36,22 @@ double ms_since(Clock::time_point start) {
 
 }  // namespace
 
-int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
-                          double scale) {
-  const ir::Camera& camera = scene.camera;
-  if (!camera.effects.motion_blur || shot.turntable_velocity_rad_s == 0) return 1;
-  // The fastest object point: the far rim of its bounding sphere, at its nearest depth.
-  const double radius = studio.object_center.head<2>().norm() + studio.object_radius;
-  const ir::Vec3 center_world =
-      (ir::world_from_object(scene, shot.turntable_angle_rad) * studio.object_center.homogeneous())
-          .head<3>();
-  const ir::Vec3 eye = shot.world_from_camera.block<3, 1>(0, 3);
-  const double depth = std::max(0.05, (center_world - eye).norm() - studio.object_radius);
-  const double blur_px =
-      dslr::motion_blur_length_px(camera, scale, shot.turntable_velocity_rad_s, radius, depth);
-  // About one sub-frame per pixel of travel keeps the streak continuous.
-  return std::clamp(static_cast<int>(std::ceil(blur_px)) + 1, 1, 48);
-}
-
-dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
+dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale, std::uint64_t seed,
                                 ShotTiming* timing, dslr::LinearFrame* linear_out,
                                 bool keep_linear) {
   const auto start = Clock::now();
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
-  FrameRequest request;
+  raster::FrameRequest request;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
   request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);
-  const int subframes = motion_blur_subframes(scene, studio, shot, scale);
-  RasterTimings raster;
+  const int subframes = scene::motion_blur_subframes(scene, studio, shot, scale);
+  raster::RasterTimings raster;
   dslr::LinearFrame frame;
   if (subframes == 1) {
     request.turntable_angle_rad = shot.turntable_angle_rad;
-    frame = render_frame(scene, studio, request, &raster);
+    frame = raster::render_frame(scene, studio, request, &raster);
   } else {
     // Sub-frames spread evenly over the open shutter, centred on the shot's angle. Depth and
     // mask come from the middle one.
@@ -76,7 +60,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studi
     for (int k = 0; k < subframes; ++k) {
       request.turntable_angle_rad =
           shot.turntable_angle_rad + sweep * ((k + 0.5) / subframes - 0.5);
-      dslr::LinearFrame sub = render_frame(scene, studio, request, &raster);
+      dslr::LinearFrame sub = raster::render_frame(scene, studio, request, &raster);
       if (sum.empty()) sum.assign(sub.rgb.size(), 0.0);
       for (size_t i = 0; i < sub.rgb.size(); ++i) sum[i] += sub.rgb[i];
       if (k == subframes / 2) frame = std::move(sub);
@@ -120,12 +104,12 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   // The check the run's cameras.txt makes at the end (a positive, finite scale), made before
   // anything is written: a NaN scale used to render and record a shot first.
   std::string camera_error;
-  if (!backends::output_camera(scene.camera, options.scale, &camera_error)) {
+  if (!run::output_camera(scene.camera, options.scale, &camera_error)) {
     log << fmt::format("rigc: error: {}\n", camera_error);
     return 1;
   }
-  if (!backends::prepare_run_folder(run_dir, {}, log)) return 1;
-  backends::RunFolderLock lock;
+  if (!run::prepare_run_folder(run_dir, {}, log)) return 1;
+  run::RunFolderLock lock;
   if (!lock.acquire(run_dir, log)) return 1;
   std::vector<int> shots = options.shots;
   if (shots.empty()) {
@@ -133,17 +117,17 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   }
 
   const fs::path manifest_path = run_dir / "manifest.json";
-  backends::Manifest manifest = backends::Manifest::load(manifest_path);
-  if (!backends::prune_stale_outputs(manifest, scene, run_dir, manifest_path, log)) return 2;
-  const std::string content_hash = backends::scene_content_hash(scene);
+  run::Manifest manifest = run::Manifest::load(manifest_path);
+  if (!run::prune_stale_outputs(manifest, scene, run_dir, manifest_path, log)) return 2;
+  const std::string content_hash = run::scene_content_hash(scene);
   manifest.set_backend("preview");
   manifest.set_inputs({{"scene", scene.name},
                        {"source_file", scene.source_file},
                        {"content_sha256", content_hash},
-                       {"object_sha256", backends::object_geometry_hash(scene)},
+                       {"object_sha256", run::object_geometry_hash(scene)},
                        {"scale", options.scale},
                        {"seed", options.seed}});
-  const StudioScene studio = prepare_studio_scene(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   int failures = 0, done = 0;
 
   // A shot's files are encoded and written while the next shot renders: JPEG encoding is
@@ -203,7 +187,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
       ++failures;
       return;
     }
-    backends::ShotRecord record;
+    run::ShotRecord record;
     record.name = shot.name;
     record.key = write.key;
     record.render_ms = timing.total_ms;
@@ -215,8 +199,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     ++done;
     if (timings) timings->push_back(timing);
     if (options.progress_bar) {
-      log << backends::progress_line(done, static_cast<int>(shots.size()), shot.name,
-                                     timing.total_ms / 1000)
+      log << run::progress_line(done, static_cast<int>(shots.size()), shot.name,
+                                timing.total_ms / 1000)
           << std::flush;
     } else {
       log << fmt::format("{}: rendered in {:.2f} s ({} sub-frame{})\n", shot.name,
@@ -228,7 +212,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   for (int index : shots) {
     const ir::Shot& shot = scene.shots[index];
     const std::string key =
-        backends::shot_key(scene, content_hash, shot, "preview", options.scale, options.seed);
+        run::shot_key(scene, content_hash, shot, "preview", options.scale, options.seed);
     if (manifest.is_done(shot.name, key, run_dir)) {
       ShotTiming timing;
       timing.skipped = true;
@@ -246,8 +230,8 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
     PendingWrite write;
     write.shot = &shot;
     write.key = key;
-    write.image = backends::image_relative_path(scene.camera, shot);
-    write.mask = backends::mask_relative_path(shot);
+    write.image = run::image_relative_path(scene.camera, shot);
+    write.mask = run::mask_relative_path(shot);
     write.timing = timing;
     auto task = std::make_shared<std::packaged_task<WriteOutcome()>>(
         [&scene, &run_dir, image = write.image, mask = write.mask,
@@ -274,7 +258,7 @@ int run_preview(const ir::Scene& scene, const RenderOptions& options, std::ostre
   if (manifest_failed || !save_manifest(true)) return 2;
   if (options.progress_bar) log << '\n';
 
-  return backends::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);
+  return run::finish_run(scene, manifest, run_dir, options.scale, failures, shots.size(), log);
 }
 
 }  // namespace rigc::preview

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "backends/preview/rasterizer.h"
-#include "compiler/ir.h"
 #include "dslr/frame.h"
+#include "ir/ir.h"
+#include "raster/rasterizer.h"
 
 namespace rigc::preview {
 
@@ -23,7 +23,7 @@ struct RenderOptions {
 };
 
 struct ShotTiming {
-  RasterTimings raster;
+  raster::RasterTimings raster;
   dslr::StageTimings develop;
   double write_ms = 0;
   double total_ms = 0;
@@ -36,14 +36,10 @@ std::map<std::string, double> stage_ms(const ShotTiming& timing);
 
 // Renders one shot to developed pixels (no files). For tests and benchmarks. Without
 // `keep_linear` the result's linear image is left empty (what a run that writes files does).
-dslr::DevelopResult render_shot(const ir::Scene& scene, const StudioScene& studio,
+dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale, std::uint64_t seed,
                                 ShotTiming* timing = nullptr,
                                 dslr::LinearFrame* linear_out = nullptr, bool keep_linear = true);
-
-// The number of sub-frames motion blur needs for a shot (1 when there is no motion).
-int motion_blur_subframes(const ir::Scene& scene, const StudioScene& studio, const ir::Shot& shot,
-                          double scale);
 
 // Runs the whole backend; returns the process exit code (0, 1 user error, 2 failure) and
 // writes progress and errors to `log`.

@@ -8,17 +8,17 @@
 #include <set>
 #include <sstream>
 
-#include "backends/common/colmap_text.h"
-#include "backends/common/manifest.h"
-#include "backends/common/run_folder.h"
+#include "assets/primitives.h"
 #include "backends/preview/preview_backend.h"
-#include "backends/preview/studio_scene.h"
 #include "compiler/frontend.h"
-#include "compiler/primitives.h"
 #include "dslr/buffer_pool.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/optics.h"
+#include "run/colmap_text.h"
+#include "run/manifest.h"
+#include "run/run_folder.h"
+#include "scene/studio_scene.h"
 #include "tests/test_support.h"
 
 namespace rigc::preview {
@@ -123,9 +123,9 @@ TEST(Preview, ObjectLandsWhereColmapProjectsIt) {
 )"));
   ASSERT_EQ(scene.shots.size(), 3u);
   const double scale = 0.25;
-  StudioScene studio = prepare_studio_scene(scene);
+  scene::StudioScene studio = scene::prepare_studio_scene(scene);
   std::string error;
-  auto camera = backends::output_camera(scene.camera, scale, &error);
+  auto camera = run::output_camera(scene.camera, scale, &error);
   ASSERT_TRUE(camera) << error;
   // The ball's centre in the object frame: COLMAP's world.
   const ir::Vec3 center = (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
@@ -135,7 +135,7 @@ TEST(Preview, ObjectLandsWhereColmapProjectsIt) {
     const Blob blob = mask_blob(result);
     ASSERT_GT(blob.mass, 100) << shot.name;
     const ir::Vec2 expected =
-        backends::project_opencv(camera->params(), backends::camera_from_object(shot), center);
+        run::project_opencv(camera->params(), run::camera_from_object(shot), center);
     EXPECT_NEAR(blob.x, expected.x(), 0.5) << shot.name;
     EXPECT_NEAR(blob.y, expected.y(), 0.5) << shot.name;
   }
@@ -158,7 +158,7 @@ TEST(Preview, ExposureFollowsShutterApertureAndIso) {
         ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
     text.replace(text.find("{aperture: f/8, shutter: 1/125, iso: 200}"), 41, exposure);
     ir::Scene scene = compile(text);
-    StudioScene studio = prepare_studio_scene(scene);
+    scene::StudioScene studio = scene::prepare_studio_scene(scene);
     return mean_green(render_shot(scene, studio, scene.shots[0], 0.1, 1));
   };
   const double base = render_mean("{aperture: f/8, shutter: 1/250, iso: 200}");
@@ -174,7 +174,7 @@ TEST(Preview, ExposureFollowsShutterApertureAndIso) {
 TEST(Preview, AbsoluteSignalMatchesTheExposureEquation) {
   ir::Scene scene =
       compile(ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n"));
-  StudioScene studio = prepare_studio_scene(scene);
+  scene::StudioScene studio = scene::prepare_studio_scene(scene);
   dslr::DevelopResult result = render_shot(scene, studio, scene.shots[0], 0.1, 1);
   const double luminance = 0.9 * 2000 / std::numbers::pi;  // ambient only, albedo 0.9
   const double expected = luminance * dslr::exposure_scale(scene.camera);
@@ -189,7 +189,7 @@ TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
                                          "  - turntable: {steps: 1, step: 0deg, speed: " + speed +
                                              ", camera: {distance: 40cm, height: 0.5cm}}\n",
                                          "  translate: [0, -6cm, 0]\n"));
-    StudioScene studio = prepare_studio_scene(scene);
+    scene::StudioScene studio = scene::prepare_studio_scene(scene);
     const ir::Shot& shot = scene.shots[0];
     Blob blob = bright_extent(render_shot(scene, studio, shot, 0.25, 1), 0.02);
     return std::pair{blob.max_x - blob.min_x + 1.0, scene};
@@ -210,8 +210,8 @@ ir::Scene paper_scene() {
 }
 
 // The frame of one of the scene's shots at `scale` of the sensor, with 1024-texel shadow maps.
-FrameRequest shot_request(const ir::Scene& scene, int shot, double scale) {
-  FrameRequest request;
+raster::FrameRequest shot_request(const ir::Scene& scene, int shot, double scale) {
+  raster::FrameRequest request;
   request.world_from_camera = scene.shots[shot].world_from_camera;
   request.turntable_angle_rad = scene.shots[shot].turntable_angle_rad;
   request.canvas = dslr::render_geometry_for(scene.camera, scale);
@@ -254,12 +254,12 @@ LightingDifference lighting_difference(const dslr::LinearFrame& shaded,
 TEST(Preview, QuadLightingMatchesPerPixelLighting) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   for (double scale : {0.15, 0.4}) {
-    FrameRequest request = shot_request(scene, 3, scale);
-    const dslr::LinearFrame quad = render_frame(scene, studio, request);
+    raster::FrameRequest request = shot_request(scene, 3, scale);
+    const dslr::LinearFrame quad = raster::render_frame(scene, studio, request);
     request.per_pixel_lighting = true;
-    const dslr::LinearFrame pixel = render_frame(scene, studio, request);
+    const dslr::LinearFrame pixel = raster::render_frame(scene, studio, request);
     ASSERT_EQ(quad.rgb.size(), pixel.rgb.size());
     ASSERT_EQ(quad.mask, pixel.mask);
     const LightingDifference d = lighting_difference(quad, pixel, true);
@@ -272,19 +272,19 @@ TEST(Preview, QuadLightingMatchesPerPixelLighting) {
 }
 
 // A 4 x 4 block of the statue that fails its light check hands its 16 albedos to the quads
-// that shade its pixels instead (see FrameRequest::reuse_block_albedos). They must be the
+// that shade its pixels instead (see raster::FrameRequest::reuse_block_albedos). They must be the
 // albedos the quads would evaluate: the same pixel, the same bytes. At 0.7 scale the speckle is
 // fully resolved over much of the statue, so thousands of quads take them.
 TEST(Preview, QuadsTakingABlocksAlbedosShadeAsTheirOwn) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request = shot_request(scene, 3, 0.7);
-  RasterTimings reused;
-  const dslr::LinearFrame with = render_frame(scene, studio, request, &reused);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  raster::FrameRequest request = shot_request(scene, 3, 0.7);
+  raster::RasterTimings reused;
+  const dslr::LinearFrame with = raster::render_frame(scene, studio, request, &reused);
   request.reuse_block_albedos = false;
-  RasterTimings own;
-  const dslr::LinearFrame without = render_frame(scene, studio, request, &own);
+  raster::RasterTimings own;
+  const dslr::LinearFrame without = raster::render_frame(scene, studio, request, &own);
   EXPECT_GT(reused.quads_with_block_albedos, 1000);
   EXPECT_EQ(own.quads_with_block_albedos, 0);
   ASSERT_EQ(with.rgb.size(), without.rgb.size());
@@ -299,9 +299,9 @@ TEST(Preview, QuadsTakingABlocksAlbedosShadeAsTheirOwn) {
 TEST(Preview, TileRangesAreTheFramesOwnAndTheDepthOfFieldAlike) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request = shot_request(scene, 3, 0.3);
-  const dslr::LinearFrame frame = render_frame(scene, studio, request);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  raster::FrameRequest request = shot_request(scene, 3, 0.3);
+  const dslr::LinearFrame frame = raster::render_frame(scene, studio, request);
   const dslr::TileRanges& ranges = frame.tile_ranges;
   ASSERT_TRUE(ranges.fits(frame.width, frame.height));
   constexpr int kTile = dslr::TileRanges::kTile;
@@ -360,11 +360,11 @@ TEST(Preview, TileRangesAreTheFramesOwnAndTheDepthOfFieldAlike) {
 TEST(Preview, DepthOfFieldInPlaceIsTheCopyingOnesResult) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const dslr::Intrinsics full = dslr::render_geometry_for(scene.camera, 1.0);
-  std::vector<FrameRequest> requests;
+  std::vector<raster::FrameRequest> requests;
   for (const auto& [x, y] : {std::pair{0.5, 0.5}, {0.5, 0.83}, {0.35, 0.3}}) {
-    FrameRequest request = shot_request(scene, 3, 1.0);
+    raster::FrameRequest request = shot_request(scene, 3, 1.0);
     request.canvas = full;
     request.canvas.width = 1600;
     request.canvas.height = 1000;
@@ -374,10 +374,10 @@ TEST(Preview, DepthOfFieldInPlaceIsTheCopyingOnesResult) {
   }
   requests.push_back(shot_request(scene, 3, 0.3));
   const double focus = scene.shots[3].focus_distance_m;
-  for (const FrameRequest& request : requests) {
+  for (const raster::FrameRequest& request : requests) {
     SCOPED_TRACE(::testing::Message() << request.canvas.width << " x " << request.canvas.height
                                       << ", cx " << request.canvas.cx);
-    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    const dslr::LinearFrame frame = raster::render_frame(scene, studio, request);
     dslr::DepthOfFieldOptions options;
     options.tile_ranges = &frame.tile_ranges;
     std::vector<float> copied;
@@ -403,13 +403,13 @@ TEST(Preview, DepthOfFieldInPlaceIsTheCopyingOnesResult) {
 TEST(Preview, SparseStudioLightingMatchesPerPixelLighting) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const dslr::Intrinsics full = dslr::render_geometry_for(scene.camera, 1.0);
   struct Window {
     double x, y;  // centre, as a fraction of the frame
   };
   for (const Window window : {Window{0.5, 0.83}, Window{0.1, 0.65}}) {
-    FrameRequest request;
+    raster::FrameRequest request;
     request.world_from_camera = scene.shots[3].world_from_camera;
     request.turntable_angle_rad = scene.shots[3].turntable_angle_rad;
     request.canvas = full;
@@ -418,9 +418,9 @@ TEST(Preview, SparseStudioLightingMatchesPerPixelLighting) {
     request.canvas.cx = full.cx - (window.x * full.width - 800);
     request.canvas.cy = full.cy - (window.y * full.height - 500);
     request.shadow_map_size = 2048;
-    const dslr::LinearFrame sparse = render_frame(scene, studio, request);
+    const dslr::LinearFrame sparse = raster::render_frame(scene, studio, request);
     request.per_pixel_lighting = true;
-    const dslr::LinearFrame pixel = render_frame(scene, studio, request);
+    const dslr::LinearFrame pixel = raster::render_frame(scene, studio, request);
     ASSERT_EQ(sparse.mask, pixel.mask);
     // Per-pixel lighting also turns the plain tiles off (every tile is rasterized per sample):
     // the same surface must be in front in every pixel.
@@ -473,10 +473,10 @@ camera:
 shots:
   - turntable: {steps: 1, step: 20deg, camera: {distance: 40cm, height: 80cm}}
 )");
-    const StudioScene studio = prepare_studio_scene(scene);
-    FrameRequest request = shot_request(scene, 0, 0.1);
+    const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+    raster::FrameRequest request = shot_request(scene, 0, 0.1);
     request.shadow_map_size = 2048;
-    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    const dslr::LinearFrame frame = raster::render_frame(scene, studio, request);
     // The middle of the frame, which the top fills, less the ball and its short shadow.
     const int width = frame.width, height = frame.height;
     double sum = 0;
@@ -520,10 +520,10 @@ camera:
 shots:
   - turntable: {steps: 1, step: 20deg, camera: {distance: 70cm, height: 15cm}}
 )");
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request = shot_request(scene, 0, scale);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  raster::FrameRequest request = shot_request(scene, 0, scale);
   request.shadow_map_size = map_size;
-  return render_frame(scene, studio, request);
+  return raster::render_frame(scene, studio, request);
 }
 
 std::string area_light_front_right(const std::string& size) {
@@ -723,10 +723,10 @@ camera:
 shots:
   - pose: {position: [0, -0.9m, 0.55m], look_at: [0, 0, 0.55m]}
 )");
-    const StudioScene studio = prepare_studio_scene(scene);
-    FrameRequest request = shot_request(scene, 0, 0.15);
+    const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+    raster::FrameRequest request = shot_request(scene, 0, 0.15);
     request.shadow_map_size = 1024;
-    return render_frame(scene, studio, request);
+    return raster::render_frame(scene, studio, request);
   };
   // The fraction of the light's square (facing the ball) that the ball hides from backdrop point
   // p, on a 200 x 200 grid of the light; its largest value near where the ball's centre projects.
@@ -787,9 +787,9 @@ shots:
 TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   for (bool per_pixel : {false, true}) {
-    FrameRequest request;
+    raster::FrameRequest request;
     request.world_from_camera = scene.shots[0].world_from_camera;
     request.turntable_angle_rad = scene.shots[0].turntable_angle_rad;
     request.canvas = dslr::sensor_intrinsics(scene.camera, 0.05);
@@ -799,7 +799,7 @@ TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
     request.canvas.cy = request.canvas.height / 2.0;
     request.shadow_map_size = 512;
     request.per_pixel_lighting = per_pixel;
-    const dslr::LinearFrame frame = render_frame(scene, studio, request);
+    const dslr::LinearFrame frame = raster::render_frame(scene, studio, request);
     int unwritten = 0;
     for (float z : frame.depth_m) unwritten += !std::isfinite(z);
     EXPECT_EQ(unwritten, 0) << (per_pixel ? "per-pixel lighting" : "quad lighting");
@@ -810,8 +810,8 @@ TEST(Preview, OddSizedCanvasHasEveryPixelShaded) {
 // poisoned ones must come back fully overwritten (no NaN radiance, masks 0 or 255, depth set).
 TEST(Preview, ReusedBuffersAreFullyOverwritten) {
   const ir::Scene scene = paper_scene();
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request;
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  raster::FrameRequest request;
   request.world_from_camera = scene.shots[0].world_from_camera;
   request.turntable_angle_rad = scene.shots[0].turntable_angle_rad;
   request.canvas = dslr::sensor_intrinsics(scene.camera, 0.05);
@@ -829,7 +829,7 @@ TEST(Preview, ReusedBuffersAreFullyOverwritten) {
   dslr::recycle(std::move(rgb));
   dslr::recycle(std::move(depth));
   dslr::recycle(std::move(mask));
-  const dslr::LinearFrame frame = render_frame(scene, studio, request);
+  const dslr::LinearFrame frame = raster::render_frame(scene, studio, request);
   EXPECT_EQ(frame.rgb.data(), poisoned[0]) << "the frame should have taken the poisoned buffers";
   EXPECT_EQ(frame.depth_m.data(), poisoned[1]);
   EXPECT_EQ(frame.mask.data(), poisoned[2]);
@@ -863,10 +863,10 @@ TEST(Preview, BatchedPatternsMatchThePointPattern) {
           y[i] = -0.0041f * start + 0.0007f * i;
           z[i] = 0.0029f * start - 0.0011f * i;
         }
-        preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint_m,
-                                 batched.data());
+        scene::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint_m,
+                               batched.data());
         for (int i = 0; i < kPoints; ++i) {
-          const float one = preview::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint_m);
+          const float one = scene::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint_m);
           ASSERT_NEAR(batched[i], one, 1e-5f)
               << "kind " << static_cast<int>(kind) << " point " << i << " start " << start;
         }
@@ -893,11 +893,11 @@ TEST(Preview, PatternFactorsWithAFootprintPerPointMatchEachPointAlone) {
     z[i] = 0.0023f * i * i;
     footprint[i] = 0.0002f * i;
   }
-  preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint.data(),
-                           factor.data());
+  scene::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, footprint.data(),
+                         factor.data());
   std::set<float> distinct;
   for (int i = 0; i < kPoints; ++i) {
-    EXPECT_EQ(factor[i], preview::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint[i]))
+    EXPECT_EQ(factor[i], scene::pattern_factor(pattern, {x[i], y[i], z[i]}, footprint[i]))
         << "point " << i;
     distinct.insert(factor[i]);
   }
@@ -923,12 +923,11 @@ TEST(Preview, ResolvedPatternsAverageToTheirFadedValue) {
         y[i] = coordinate(random);
         z[i] = coordinate(random);
       }
-      preview::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, 1e-6f,
-                               factor.data());
+      scene::pattern_factors(pattern, x.data(), y.data(), z.data(), kPoints, 1e-6f, factor.data());
       double mean = 0;
       for (float f : factor) mean += f;
       mean /= kPoints;
-      const float faded = preview::pattern_factor(pattern, {0.1f, 0.2f, 0.3f}, 1.0f);
+      const float faded = scene::pattern_factor(pattern, {0.1f, 0.2f, 0.3f}, 1.0f);
       EXPECT_NEAR(mean, faded, 0.02) << "kind " << static_cast<int>(kind);
       // And the resolved pattern has contrast: it is not the faded value everywhere.
       const auto [lo, hi] = std::minmax_element(factor.begin(), factor.end());
@@ -942,8 +941,8 @@ TEST(Preview, ResolvedPatternsAverageToTheirFadedValue) {
 TEST(Preview, FaceColourPicturesShadePlanesEvenly) {
   const ir::Scene scene = paper_scene();
   ASSERT_FALSE(scene.shots.empty());
-  const StudioScene studio = prepare_studio_scene(scene);
-  FrameRequest request;
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  raster::FrameRequest request;
   // From above, so that the turntable's top fills much of the picture.
   const ir::Vec3 eye(0.3, -0.45, 1.3), target(0, 0, 0.75);
   const ir::Vec3 forward = (target - eye).normalized();
@@ -954,8 +953,8 @@ TEST(Preview, FaceColourPicturesShadePlanesEvenly) {
   request.world_from_camera.block<3, 1>(0, 2) = forward;
   request.world_from_camera.block<3, 1>(0, 3) = eye;
   request.canvas = dslr::sensor_intrinsics(scene.camera, 0.12);
-  const std::vector<float> rgb = render_face_colors(scene, studio, request, {});
-  const VisibilityBuffer visibility = render_visibility(scene, studio, request);
+  const std::vector<float> rgb = raster::render_face_colors(scene, studio, request, {});
+  const raster::VisibilityBuffer visibility = raster::render_visibility(scene, studio, request);
   const int w = visibility.width, h = visibility.height;
   // Inside one plane: no object, and depth affine along the row (a second difference of ~0).
   auto on_plane = [&](int x, int y) {
@@ -987,8 +986,8 @@ TEST(Preview, FaceColourPicturesShadePlanesEvenly) {
 // corner in none of them, or an edge crossing it, is rasterized per sample): each face must be
 // flat, and its triangles must tile a convex polygon, their areas summing to its hull's.
 TEST(Preview, StudioConvexFacesAreFlatAndConvex) {
-  const StudioScene studio = prepare_studio_scene(paper_scene());
-  const Geometry& room = studio.studio;
+  const scene::StudioScene studio = scene::prepare_studio_scene(paper_scene());
+  const scene::Geometry& room = studio.studio;
   ASSERT_EQ(room.convex_face.size(), room.triangles.size());
   // Two cylinders (96 side rectangles and two caps each), the floor and the green screen.
   ASSERT_EQ(room.convex_faces, 2 * (96 + 2) + 2);
@@ -1047,16 +1046,16 @@ TEST(Preview, ClosedOutwardMeshesAreRecognised) {
   const ir::Mesh statue = make_primitive(PrimitiveKind::kStatue, 4, 7);
   for (const ir::Mesh* mesh : {&box, &statue}) {
     auto triangles = mesh->triangles;
-    EXPECT_TRUE(is_closed_outward(mesh->positions, triangles));
+    EXPECT_TRUE(scene::is_closed_outward(mesh->positions, triangles));
     auto open = triangles;
     open.pop_back();
-    EXPECT_FALSE(is_closed_outward(mesh->positions, open));  // a hole
+    EXPECT_FALSE(scene::is_closed_outward(mesh->positions, open));  // a hole
     auto inside_out = triangles;
     for (auto& t : inside_out) std::swap(t[1], t[2]);
-    EXPECT_FALSE(is_closed_outward(mesh->positions, inside_out));
+    EXPECT_FALSE(scene::is_closed_outward(mesh->positions, inside_out));
     auto mixed = triangles;
     std::swap(mixed[0][1], mixed[0][2]);  // one face wound the other way
-    EXPECT_FALSE(is_closed_outward(mesh->positions, mixed));
+    EXPECT_FALSE(scene::is_closed_outward(mesh->positions, mixed));
   }
 }
 
@@ -1064,7 +1063,7 @@ TEST(Preview, SameSeedGivesIdenticalImagesOtherSeedDiffers) {
   std::string text = ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n");
   text.replace(text.find("noise: false"), 12, "noise: true");
   ir::Scene scene = compile(text);
-  StudioScene studio = prepare_studio_scene(scene);
+  scene::StudioScene studio = scene::prepare_studio_scene(scene);
   auto a = render_shot(scene, studio, scene.shots[0], 0.1, 7);
   auto b = render_shot(scene, studio, scene.shots[0], 0.1, 7);
   auto c = render_shot(scene, studio, scene.shots[0], 0.1, 8);
@@ -1118,7 +1117,7 @@ TEST(Preview, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
   EXPECT_FALSE(fs::exists(dir.path() / "masks/shot_003.png"));
   EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
   EXPECT_TRUE(fs::exists(dir.path() / "images/mine.jpg")) << "only the manifest's files go";
-  const auto manifest = backends::Manifest::load(dir.path() / "manifest.json");
+  const auto manifest = run::Manifest::load(dir.path() / "manifest.json");
   EXPECT_EQ(manifest.shots().size(), 2u);
 
   ASSERT_EQ(run_preview(scene_with(2, "png16"), options, log), 0) << log.str();
@@ -1133,7 +1132,7 @@ TEST(Preview, ASecondRenderIntoABusyRunFolderIsRefused) {
   RenderOptions options = small_run(dir.path());
   std::ostringstream log;
   {
-    backends::RunFolderLock other;  // as another rigc process would hold it
+    run::RunFolderLock other;  // as another rigc process would hold it
     ASSERT_TRUE(other.acquire(dir.path(), log)) << log.str();
     EXPECT_EQ(run_preview(scene, options, log), 1);
     EXPECT_NE(log.str().find("another rigc is writing to the run folder"), std::string::npos)

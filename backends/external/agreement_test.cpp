@@ -1,0 +1,295 @@
+// Preview vs POV-Ray vs Cycles on the same IR (issue #4): real renders at about 192 x 128.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <optional>
+
+#include "backends/cycles/cycles_backend.h"
+#include "backends/external/process.h"
+#include "backends/povray/povray_backend.h"
+#include "backends/preview/preview_backend.h"
+#include "compiler/color.h"
+#include "compiler/frontend.h"
+#include "dslr/pipeline.h"
+#include "tests/test_support.h"
+
+namespace rigc::external {
+namespace {
+
+namespace fs = std::filesystem;
+
+ir::Scene compile(const std::string& text, const std::string& base_dir = ".") {
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  auto scene = compile_scene_text(text, "test.yaml", base_dir, diag);
+  EXPECT_TRUE(scene) << messages;
+  return scene ? *scene : ir::Scene{};
+}
+
+ir::Scene compile_file(const std::string& relative) {
+  DiagnosticEngine diag;
+  auto scene = compile_scene_file(rigc::testing::source_path(relative), diag);
+  EXPECT_TRUE(scene);
+  return scene ? *scene : ir::Scene{};
+}
+
+bool renderers_installed() {
+  return find_executable("povray").has_value() && find_executable("blender").has_value();
+}
+
+struct Rendered {
+  std::string backend;
+  dslr::LinearFrame frame;
+  bool depth_of_field_rendered = false;
+};
+
+Rendered render_preview(const ir::Scene& scene, const ir::Shot& shot, double scale) {
+  Rendered out{"preview", {}, false};
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  preview::render_shot(scene, studio, shot, scale, 1, nullptr, &out.frame);
+  return out;
+}
+
+std::optional<Rendered> render_with(Renderer& renderer, const ir::Scene& scene,
+                                    const ir::Shot& shot, double scale, int samples,
+                                    const fs::path& dir) {
+  std::string error;
+  EXPECT_TRUE(renderer.emit(scene, dir, scale, samples, &error)) << error;
+  RenderedShot rendered;
+  const fs::path log = dir / (shot.name + ".log");
+  if (!renderer.render(scene, dir, shot, scale, samples, log, &rendered, &error)) {
+    ADD_FAILURE() << renderer.name() << ": " << error << "\n" << tail_of_file(log, 20);
+    return std::nullopt;
+  }
+  return Rendered{renderer.name(), std::move(rendered.frame), rendered.depth_of_field_rendered};
+}
+
+struct MaskStats {
+  double count = 0, x = 0, y = 0;
+};
+
+MaskStats mask_stats(const dslr::LinearFrame& frame) {
+  MaskStats s;
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      if (!frame.mask[static_cast<size_t>(y) * frame.width + x]) continue;
+      s.count += 1;
+      s.x += x + 0.5;
+      s.y += y + 0.5;
+    }
+  }
+  s.x /= std::max(1.0, s.count);
+  s.y /= std::max(1.0, s.count);
+  return s;
+}
+
+double mask_iou(const dslr::LinearFrame& a, const dslr::LinearFrame& b) {
+  double both = 0, either = 0;
+  for (size_t i = 0; i < a.mask.size(); ++i) {
+    both += a.mask[i] && b.mask[i];
+    either += a.mask[i] || b.mask[i];
+  }
+  return both / std::max(1.0, either);
+}
+
+// Mean luminance (cd/m²) of the pixels every backend calls object, away from the silhouette.
+double mean_object_luminance(const dslr::LinearFrame& frame,
+                             const std::vector<std::uint8_t>& mask) {
+  double sum = 0, count = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    sum += luminance(ir::Vec3(frame.rgb[i * 3], frame.rgb[i * 3 + 1], frame.rgb[i * 3 + 2]));
+    count += 1;
+  }
+  return sum / std::max(1.0, count);
+}
+
+std::vector<std::uint8_t> eroded_common_mask(const std::vector<Rendered>& all) {
+  const int w = all[0].frame.width, h = all[0].frame.height;
+  std::vector<std::uint8_t> mask(static_cast<size_t>(w) * h, 0);
+  for (int y = 2; y < h - 2; ++y) {
+    for (int x = 2; x < w - 2; ++x) {
+      bool inside = true;
+      for (const auto& r : all) {
+        for (int dy = -2; dy <= 2 && inside; ++dy) {
+          for (int dx = -2; dx <= 2 && inside; ++dx) {
+            inside = r.frame.mask[static_cast<size_t>(y + dy) * w + x + dx] != 0;
+          }
+        }
+      }
+      mask[static_cast<size_t>(y) * w + x] = inside ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
+// The normalised sensor signal of the object for a camera, through the DSLR model.
+double mean_signal(const ir::Camera& camera, const Rendered& r, const ir::Shot& shot,
+                   double scale) {
+  ir::Camera developed = camera;
+  if (r.depth_of_field_rendered) developed.effects.depth_of_field = false;
+  dslr::ShotParams params;
+  params.focus_distance_m = shot.focus_distance_m;
+  const dslr::DevelopResult result = dslr::develop_frame(developed, r.frame, params, scale);
+  double sum = 0, count = 0;
+  for (size_t i = 0; i < result.mask.size(); ++i) {
+    if (!result.mask[i]) continue;
+    sum += result.linear[i * 3 + 1];
+    count += 1;
+  }
+  return sum / std::max(1.0, count);
+}
+
+void expect_agreement(ir::Scene scene, int shot_index, double scale) {
+  if (!renderers_installed()) GTEST_SKIP() << "povray or blender is not installed";
+  // Sharp images (DOF has its own test) and no sensor noise: this compares the renderers.
+  scene.camera.effects.depth_of_field = false;
+  scene.camera.effects.noise = false;
+  const ir::Shot& shot = scene.shots[shot_index];
+  rigc::testing::TempDir dir;
+  std::vector<Rendered> all;
+  all.push_back(render_preview(scene, shot, scale));
+  auto pov = povray::make_renderer();
+  auto cyc = cycles::make_renderer();
+  auto pov_frame = render_with(*pov, scene, shot, scale, 4, dir.path() / "povray");
+  auto cyc_frame = render_with(*cyc, scene, shot, scale, 16, dir.path() / "cycles");
+  ASSERT_TRUE(pov_frame && cyc_frame);
+  all.push_back(std::move(*pov_frame));
+  all.push_back(std::move(*cyc_frame));
+
+  const MaskStats reference = mask_stats(all[0].frame);
+  ASSERT_GT(reference.count, 200);
+  const std::vector<std::uint8_t> common = eroded_common_mask(all);
+  const double preview_mean = mean_object_luminance(all[0].frame, common);
+  ASSERT_GT(preview_mean, 0);
+  for (size_t i = 1; i < all.size(); ++i) {
+    const MaskStats stats = mask_stats(all[i].frame);
+    const double iou = mask_iou(all[0].frame, all[i].frame);
+    const double mean = mean_object_luminance(all[i].frame, common);
+    const double stops = std::log2(mean / preview_mean);
+    std::printf(
+        "%s vs preview: IoU %.4f, centroid (%+.3f, %+.3f) px, object %.1f vs %.1f cd/m2 "
+        "(%+.3f stop)\n",
+        all[i].backend.c_str(), iou, stats.x - reference.x, stats.y - reference.y, mean,
+        preview_mean, stops);
+    EXPECT_GE(iou, 0.97) << all[i].backend;
+    EXPECT_NEAR(stats.x, reference.x, 1.0) << all[i].backend;
+    EXPECT_NEAR(stats.y, reference.y, 1.0) << all[i].backend;
+    EXPECT_LT(std::abs(stops), 1.0 / 3) << all[i].backend;
+  }
+  // +1 stop of shutter is +1 stop of signal for every backend (nothing clips here).
+  for (const auto& r : all) {
+    ir::Camera camera = scene.camera;
+    camera.effects.motion_blur = false;
+    camera.iso = 100;
+    const double base = mean_signal(camera, r, shot, scale);
+    camera.shutter_s *= 2;
+    const double doubled = mean_signal(camera, r, shot, scale);
+    std::printf("%s: +1 stop of shutter gives %+.3f stop\n", r.backend.c_str(),
+                std::log2(doubled / base));
+    EXPECT_NEAR(std::log2(doubled / base), 1.0, 0.05) << r.backend;
+  }
+}
+
+TEST(ReferenceAgreement, PaperSceneMasksAndExposure) {
+  const ir::Scene scene = compile_file("scenes/paper-turntable.yaml");
+  // 5472 px wide: 192 px.
+  expect_agreement(scene, 2, 192.0 / scene.camera.width_px);
+}
+
+TEST(ReferenceAgreement, TexturedSceneMasksAndExposure) {
+  if (!fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf")) {
+    GTEST_SKIP() << "assimp-testmodels is not installed";
+  }
+  const ir::Scene scene = compile_file("scenes/orbit-textured.yaml");
+  expect_agreement(scene, 3, 192.0 / scene.camera.width_px);
+}
+
+// 10 %-90 % width in pixels of the left silhouette edge of a bright box on black, averaged over
+// the middle rows of the box, on the developed linear signal.
+double edge_width_px(const dslr::DevelopResult& result) {
+  const int w = result.width, h = result.height;
+  std::vector<double> profile(w, 0.0);
+  for (int y = h / 2 - 4; y <= h / 2 + 4; ++y) {
+    for (int x = 0; x < w; ++x)
+      profile[x] += result.linear[(static_cast<size_t>(y) * w + x) * 3 + 1];
+  }
+  // The plateau: the box's middle column; the left edge: search from the middle leftwards.
+  const int middle = w / 2;
+  const double top = profile[middle];
+  double low = top;
+  for (int x = 0; x < middle; ++x) low = std::min(low, profile[x]);
+  auto crossing = [&](double fraction) {
+    const double level = low + fraction * (top - low);
+    for (int x = middle; x > 0; --x) {
+      if (profile[x - 1] < level && profile[x] >= level) {
+        return x - 1 + (level - profile[x - 1]) / (profile[x] - profile[x - 1]);
+      }
+    }
+    return 0.0;
+  };
+  return crossing(0.9) - crossing(0.1);
+}
+
+TEST(ReferenceAgreement, DefocusBlurWidth) {
+  if (!renderers_installed()) GTEST_SKIP() << "povray or blender is not installed";
+  // A bright 16 cm box 0.9 m away, focused at 0.55 m, at f/1.4: a blur disc of about 9 px.
+  ir::Scene scene = compile(R"(rigc: 1
+object:
+  primitive: box
+  fit: {size: 16cm}
+  surface: {pattern: none, color: [0.9, 0.9, 0.9], roughness: 1}
+studio:
+  turntable: {diameter: 2cm, height: 50cm, color: [0, 0, 0]}
+  backdrop: {green_screen: false}
+  floor: {color: [0, 0, 0]}
+  ambient: 2000lx
+camera:
+  body: canon-6d
+  lens: {focal_length: 50mm}
+  exposure: {aperture: f/1.4, shutter: 1/2000, iso: 100}
+  focus: 0.55m
+  effects: {noise: false, diffraction: false, distortion: false, vignetting: false}
+shots:
+  - pose: {position: [0, -0.9m, 0.58m], look_at: [0, 0, 0.58m]}
+)");
+  const double scale = 192.0 / scene.camera.width_px;
+  const ir::Shot& shot = scene.shots[0];
+  rigc::testing::TempDir dir;
+  std::vector<Rendered> all;
+  all.push_back(render_preview(scene, shot, scale));
+  auto pov = povray::make_renderer();
+  auto cyc = cycles::make_renderer();
+  auto pov_frame = render_with(*pov, scene, shot, scale, 16, dir.path() / "povray");
+  auto cyc_frame = render_with(*cyc, scene, shot, scale, 64, dir.path() / "cycles");
+  ASSERT_TRUE(pov_frame && cyc_frame);
+  all.push_back(std::move(*pov_frame));
+  all.push_back(std::move(*cyc_frame));
+  // The thin-lens circle of confusion, in pixels.
+  const ir::Camera& camera = scene.camera;
+  const double f = camera.focal_length_m, s1 = shot.focus_distance_m;
+  const double s2 = 0.9 - 0.08;
+  const double coc_px = f / camera.aperture_f_number * f * std::abs(s2 - s1) / (s2 * (s1 - f)) *
+                        camera.fx * scale / f;
+  std::vector<double> widths;
+  for (const auto& r : all) {
+    ir::Camera developed = camera;
+    if (r.depth_of_field_rendered) developed.effects.depth_of_field = false;
+    dslr::ShotParams params;
+    params.focus_distance_m = s1;
+    widths.push_back(edge_width_px(dslr::develop_frame(developed, r.frame, params, scale)));
+    std::printf("%s: defocused edge 10-90 %% width %.2f px (circle of confusion %.2f px)\n",
+                r.backend.c_str(), widths.back(), coc_px);
+  }
+  EXPECT_GT(widths[0], 0.3 * coc_px);
+  for (size_t i = 1; i < widths.size(); ++i) {
+    EXPECT_NEAR(widths[i] / widths[0], 1.0, 0.25) << all[i].backend;
+  }
+  // Both ray tracers model the thin lens exactly: POV-Ray's aperture mapping must match Cycles'.
+  EXPECT_NEAR(widths[1] / widths[2], 1.0, 0.1);
+}
+
+}  // namespace
+}  // namespace rigc::external

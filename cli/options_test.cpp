@@ -1,0 +1,51 @@
+#include "cli/options.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+namespace rigc::cli {
+namespace {
+
+// Parses `--value TEXT` through positive_number(); returns the error text ("" when accepted).
+std::string parse_value(const std::string& text, double* value) {
+  CLI::App app;
+  app.add_option("--value", *value)->check(positive_number());
+  std::ostringstream ignored;
+  std::streambuf* old = std::cerr.rdbuf(ignored.rdbuf());
+  const std::optional<int> code = parse_options(app, {"rigc", "--value", text});
+  std::cerr.rdbuf(old);
+  return code ? ignored.str() : std::string();
+}
+
+TEST(CommandLine, DecimalNumbersInEveryUsualFormAreTaken) {
+  const std::vector<std::pair<std::string, double>> valid = {
+      {"1e-3", 1e-3}, {".5", 0.5}, {"5.", 5}, {"+2", 2}, {"1E3", 1000}, {"0.25", 0.25}};
+  for (const auto& [text, expected] : valid) {
+    double value = 0;
+    EXPECT_EQ(parse_value(text, &value), "") << text;
+    EXPECT_DOUBLE_EQ(value, expected) << text;
+  }
+}
+
+TEST(CommandLine, AnythingElseIsNamed) {
+  const std::vector<std::pair<std::string, std::string>> invalid = {
+      {"0x1", "'0x1' is not a number"},
+      {"+-2", "'+-2' is not a number"},
+      {"2cm", "'2cm' is not a number"},
+      {"", "is not a number"},
+      {"nan", "'nan' is not a finite number"},
+      {"inf", "'inf' is not a finite number"},
+      {"1e400", "'1e400' is out of range"},
+      {"-1", "'-1' is not above 0"},
+      {"0", "'0' is not above 0"}};
+  for (const auto& [text, message] : invalid) {
+    double value = 0;
+    const std::string error = parse_value(text, &value);
+    EXPECT_NE(error.find("rigc: error: "), std::string::npos) << text << ": " << error;
+    EXPECT_NE(error.find(message), std::string::npos) << text << ": " << error;
+  }
+}
+
+}  // namespace
+}  // namespace rigc::cli

@@ -1,0 +1,60 @@
+// The front end's entry points: read a scene file, parse and check it, lower it to the IR.
+#include "compiler/frontend.h"
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <tuple>
+
+#include "compiler/check.h"
+
+namespace rigc {
+
+namespace fs = std::filesystem;
+
+std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::string& file,
+                                            const std::string& base_dir, DiagnosticEngine& diag) {
+  diag.add_source(file, text);
+  // Checking walks the tree section by section; its diagnostics are reported in file order.
+  DiagnosticEngine checking;
+  checking.set_handler([](const Diagnostic&, const std::string&) {});
+  std::optional<spec::SceneSpec> checked;
+  if (auto root = parse_yaml(text, file, checking)) {
+    checked = check_scene(*root, file, base_dir, checking);
+  }
+  std::vector<Diagnostic> found = checking.diagnostics();
+  std::stable_sort(found.begin(), found.end(), [](const Diagnostic& a, const Diagnostic& b) {
+    return std::tie(a.loc.line, a.loc.col) < std::tie(b.loc.line, b.loc.col);
+  });
+  for (auto& d : found) diag.report(std::move(d));
+  if (!checked || checking.has_errors()) return std::nullopt;
+  return lower_scene(*checked, diag);
+}
+
+std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  if (!in || fs::is_directory(path, ec)) {
+    diag.error({path, 0, 0}, "cannot read the scene file");
+    return std::nullopt;
+  }
+  // A scene is a few kilobytes; /dev/zero as the scene file grew memory without end.
+  constexpr std::size_t kMostBytes = 16 << 20;
+  std::string text;
+  std::array<char, 1 << 16> chunk;
+  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMostBytes) {
+      diag.error({path, 0, 0},
+                 "the scene file is larger than 16 MB (a scene is text; meshes and "
+                 "textures are files of their own)");
+      return std::nullopt;
+    }
+  }
+  std::string base_dir = fs::path(path).parent_path().string();
+  if (base_dir.empty()) base_dir.push_back('.');  // (GCC 12 warns, falsely, on = ".")
+  return compile_scene_text(text, path, base_dir, diag);
+}
+
+}  // namespace rigc

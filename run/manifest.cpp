@@ -1,0 +1,194 @@
+#include "run/manifest.h"
+
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "io/files.h"
+#include "ir/ir_json.h"
+
+#ifndef RIGC_VERSION
+#define RIGC_VERSION "unknown"
+#endif
+
+namespace rigc::run {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::optional<ShotRecord> record_from_json(const std::string& name, const json& j) {
+  if (!j.is_object() || !j.contains("key") || !j["key"].is_string()) return std::nullopt;
+  ShotRecord record;
+  record.name = name;
+  record.key = j["key"].get<std::string>();
+  if (auto it = j.find("render_ms"); it != j.end() && it->is_number()) {
+    record.render_ms = it->get<double>();
+  }
+  if (auto it = j.find("stage_ms"); it != j.end() && it->is_object()) {
+    for (const auto& [stage, ms] : it->items()) {
+      if (ms.is_number()) record.stage_ms[stage] = ms.get<double>();
+    }
+  }
+  const auto files = j.find("files");
+  if (files == j.end() || !files->is_array()) return std::nullopt;
+  for (const auto& file : *files) {
+    if (!file.is_string()) return std::nullopt;
+    record.files.push_back(file.get<std::string>());
+  }
+  return record;
+}
+
+}  // namespace
+
+Manifest Manifest::load(const fs::path& path) {
+  Manifest manifest;
+  try {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return manifest;
+    const json j = json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object()) return manifest;
+    if (auto it = j.find("rigc_version"); it != j.end() && it->is_string()) {
+      manifest.rigc_version_ = it->get<std::string>();
+    }
+    if (auto it = j.find("backend"); it != j.end() && it->is_string()) {
+      manifest.backend_ = it->get<std::string>();
+    }
+    if (auto it = j.find("inputs"); it != j.end() && it->is_object()) manifest.inputs_ = *it;
+    if (auto it = j.find("shots"); it != j.end() && it->is_object()) {
+      for (const auto& [name, entry] : it->items()) {
+        if (auto record = record_from_json(name, entry)) manifest.shots_[name] = std::move(*record);
+      }
+    }
+  } catch (...) {
+    return Manifest{};
+  }
+  return manifest;
+}
+
+const ShotRecord* Manifest::find(const std::string& name) const {
+  const auto it = shots_.find(name);
+  return it == shots_.end() ? nullptr : &it->second;
+}
+
+bool Manifest::is_done(const std::string& name, const std::string& key,
+                       const fs::path& run_dir) const {
+  const ShotRecord* record = find(name);
+  if (record == nullptr || record->key != key || key.empty()) return false;
+  for (const auto& file : record->files) {
+    // An empty file is no image (a disk that filled up, a file truncated by hand).
+    std::error_code ec;
+    if (!fs::is_regular_file(run_dir / file, ec)) return false;
+    const auto bytes = fs::file_size(run_dir / file, ec);
+    if (ec || bytes == 0) return false;
+  }
+  return true;
+}
+
+void Manifest::record(ShotRecord record) {
+  std::string name = record.name;
+  shots_[name] = std::move(record);
+}
+
+json Manifest::to_json() const {
+  json shots = json::object();
+  for (const auto& [name, record] : shots_) {
+    shots[name] = {{"key", record.key},
+                   {"render_ms", record.render_ms},
+                   {"stage_ms", record.stage_ms},
+                   {"files", record.files}};
+  }
+  return {
+      {"rigc_version", RIGC_VERSION}, {"backend", backend_}, {"inputs", inputs_}, {"shots", shots}};
+}
+
+bool Manifest::save(const fs::path& path, std::string* error) const {
+  std::string text;
+  try {
+    text = to_json().dump(2) + "\n";
+  } catch (const std::exception& e) {  // e.g. invalid UTF-8 in a string
+    if (error != nullptr) *error = std::string("cannot write ") + path.string() + ": " + e.what();
+    return false;
+  }
+  return write_file_atomically(path, text, error);
+}
+
+std::string scene_content_hash(const ir::Scene& scene) {
+  static_assert(sizeof(Eigen::Vector3f) == 12 && sizeof(Eigen::Vector2f) == 8);
+  static_assert(sizeof(std::array<std::uint32_t, 3>) == 12);
+  Sha256 hash;
+  // Each array is preceded by its byte count, so bytes cannot move between arrays unnoticed.
+  auto add = [&](const void* data, std::uint64_t bytes) {
+    hash.update(&bytes, sizeof bytes);
+    if (bytes > 0) hash.update(data, bytes);
+  };
+  const ir::Mesh& mesh = scene.object.mesh;
+  add(mesh.positions.data(), mesh.positions.size() * sizeof(Eigen::Vector3f));
+  add(mesh.normals.data(), mesh.normals.size() * sizeof(Eigen::Vector3f));
+  add(mesh.uvs.data(), mesh.uvs.size() * sizeof(Eigen::Vector2f));
+  add(mesh.triangles.data(), mesh.triangles.size() * sizeof(mesh.triangles[0]));
+  add(mesh.triangle_material.data(), mesh.triangle_material.size() * sizeof(std::int32_t));
+  const std::uint64_t texture_count = scene.textures.size();
+  hash.update(&texture_count, sizeof texture_count);
+  for (const auto& texture : scene.textures) {
+    const std::int32_t shape[3] = {texture.width, texture.height, texture.channels};
+    hash.update(shape, sizeof shape);
+    add(texture.pixels.data(), texture.pixels.size());
+  }
+  return hash.hex_digest();
+}
+
+std::string object_geometry_hash(const ir::Scene& scene) {
+  Sha256 hash;
+  const std::vector<Eigen::Vector3f> positions = ir::object_frame_positions(scene.object);
+  const std::uint64_t counts[2] = {positions.size(), scene.object.mesh.triangles.size()};
+  hash.update(counts, sizeof counts);
+  if (!positions.empty()) hash.update(positions.data(), positions.size() * sizeof(positions[0]));
+  const auto& triangles = scene.object.mesh.triangles;
+  if (!triangles.empty()) hash.update(triangles.data(), triangles.size() * sizeof(triangles[0]));
+  return hash.hex_digest();
+}
+
+namespace {
+
+void strip_locations(json& j) {
+  if (j.is_object()) {
+    j.erase("loc");
+    for (auto& [key, value] : j.items()) strip_locations(value);
+  } else if (j.is_array()) {
+    for (auto& value : j) strip_locations(value);
+  }
+}
+
+}  // namespace
+
+std::string shot_key(const ir::Scene& scene, const std::string& content_hash, const ir::Shot& shot,
+                     const std::string& backend, double scale, std::uint64_t seed,
+                     const std::string& extra) {
+  // A copy without the bulk data and the other shots, so that the JSON is small and a shot's key
+  // does not depend on its neighbours.
+  ir::Scene light;
+  light.language_version = scene.language_version;
+  light.object.source = scene.object.source;
+  light.object.object_from_mesh = scene.object.object_from_mesh;
+  light.object.bounds_min_object = scene.object.bounds_min_object;
+  light.object.bounds_max_object = scene.object.bounds_max_object;
+  light.materials = scene.materials;
+  for (const auto& texture : scene.textures) {
+    light.textures.push_back({texture.source, texture.width, texture.height, texture.channels, {}});
+  }
+  light.studio = scene.studio;
+  light.camera = scene.camera;
+  light.shots = {shot};
+  json ir = ir_to_json(light, /*include_geometry=*/false);
+  ir.erase("name");
+  ir.erase("source_file");
+  ir["object"].erase("mesh");  // counts are zero here; content_hash covers the mesh
+  strip_locations(ir);
+  const json key = {
+      {"ir", ir},     {"content", content_hash}, {"backend", backend},          {"scale", scale},
+      {"seed", seed}, {"extra", extra},          {"rigc_version", RIGC_VERSION}};
+  return sha256_hex(key.dump(-1, ' ', false, json::error_handler_t::replace));
+}
+
+}  // namespace rigc::run

@@ -1,0 +1,59 @@
+#include "run/shots.h"
+
+#include <gtest/gtest.h>
+
+namespace rigc::run {
+namespace {
+
+std::vector<int> parse_ok(const std::string& text, int count) {
+  std::string error;
+  auto selection = parse_shot_selection(text, count, &error);
+  EXPECT_TRUE(selection.has_value()) << text << ": " << error;
+  return selection.value_or(std::vector<int>{});
+}
+
+std::string parse_error(const std::string& text, int count) {
+  std::string error;
+  auto selection = parse_shot_selection(text, count, &error);
+  EXPECT_FALSE(selection.has_value()) << text;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  return error;
+}
+
+TEST(BackendShots, ParsesIndicesAndRanges) {
+  EXPECT_EQ(parse_ok("0,3,5-7", 10), (std::vector<int>{0, 3, 5, 6, 7}));
+  EXPECT_EQ(parse_ok("7,5-6,0,6", 10), (std::vector<int>{0, 5, 6, 7}));  // sorted, unique
+  EXPECT_EQ(parse_ok(" 2 , 4 - 5 ", 10), (std::vector<int>{2, 4, 5}));
+  EXPECT_EQ(parse_ok("9", 10), (std::vector<int>{9}));
+  EXPECT_EQ(parse_ok("3-3", 10), (std::vector<int>{3}));
+}
+
+TEST(BackendShots, AllSelectsEverythingAndEmptyIsAnError) {
+  EXPECT_EQ(parse_ok("all", 3), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(parse_ok(" all ", 3), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(parse_ok("all", 0), (std::vector<int>{}));
+  for (const char* text : {"", "  "}) {
+    const std::string error = parse_error(text, 3);
+    EXPECT_NE(error.find("empty"), std::string::npos) << error;
+    EXPECT_NE(error.find("0..2"), std::string::npos) << error;
+  }
+}
+
+TEST(BackendShots, ReportsErrorsWithTheValidRange) {
+  for (const char* text : {"10", "5-10", "99999999999999999999999"}) {
+    const std::string error = parse_error(text, 10);
+    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    EXPECT_NE(error.find("0..9"), std::string::npos) << error;
+  }
+  const std::string reversed = parse_error("7-5", 10);
+  EXPECT_NE(reversed.find("reversed"), std::string::npos) << reversed;
+  EXPECT_NE(reversed.find("0..9"), std::string::npos) << reversed;
+  for (const char* text : {"x", "1,,2", "1,", "-3", "3-", "1-2-3", "1.5", "0x3", "shot_001"}) {
+    const std::string error = parse_error(text, 10);
+    EXPECT_NE(error.find("0..9"), std::string::npos) << text << ": " << error;
+  }
+  EXPECT_NE(parse_error("0", 0).find("no shots"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rigc::run
