@@ -24,7 +24,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using rigc::preview::ShotTiming;
+using rigc::run::ShotTiming;
 
 // Seconds of CPU (user + system) the process has used: on a shared VM whose speed swings from
 // run to run, the CPU a run takes moves less than its wall time does.
@@ -56,7 +56,7 @@ struct Row {
   std::map<std::string, double> second_shot_stage_ms;
 };
 
-// The manifest's stages (preview::stage_ms) under this table's shorter column names, which
+// The manifest's stages (ShotTiming::stage_ms) under this table's shorter column names, which
 // bench/preview_full.sh reads. The preview runs the sensor and the sRGB development as one pass
 // (timed as noise): they share a column.
 std::map<std::string, double> stages_of(const ShotTiming& t) {
@@ -72,16 +72,16 @@ std::map<std::string, double> stages_of(const ShotTiming& t) {
       {"develop", "noise+develop"},
       {"write", "encode+write"}};
   std::map<std::string, double> columns;
-  for (const auto& [stage, ms] : rigc::preview::stage_ms(t)) columns[kColumn.at(stage)] += ms;
+  for (const auto& [stage, ms] : t.stage_ms) columns[kColumn.at(stage)] += ms;
   return columns;
 }
 
 Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int shot_count) {
   const fs::path dir = fs::temp_directory_path() / ("rigc_bench_" + std::to_string(getpid()));
   fs::remove_all(dir);
-  rigc::preview::RenderOptions options;
-  options.output_dir = dir.string();
-  options.scale = scale;
+  rigc::run::RunOptions options;
+  options.output_dir = dir;
+  options.settings.scale = scale;
   for (int i = 0; i < shot_count && i < static_cast<int>(scene.shots.size()); ++i) {
     options.shots.push_back(i);
   }
@@ -89,7 +89,8 @@ Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int
   std::ostringstream log;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = cpu_seconds();
-  const int code = rigc::preview::run_preview(scene, options, log, &timings);
+  rigc::preview::PreviewBackend backend;
+  const int code = rigc::run::run_backend(scene, backend, options, log, &timings);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu = cpu_seconds() - cpu_start;
@@ -100,7 +101,7 @@ Row run(const std::string& name, const rigc::ir::Scene& scene, double scale, int
   }
   Row row{name, static_cast<int>(options.shots.size()), seconds, cpu, {}, 0, 0, {}, {}};
   std::vector<double> render_ms;
-  for (const auto& t : timings) render_ms.push_back(t.total_ms - t.write_ms);
+  for (const auto& t : timings) render_ms.push_back(t.total_ms - t.stage_ms.at("write"));
   if (!render_ms.empty()) {
     row.first_shot_ms = render_ms.front();
     std::vector<double> others(render_ms.begin() + 1, render_ms.end());

@@ -237,5 +237,14 @@ TEST(Cli, VersionAndHelp) {
   EXPECT_NE(top.out.find("compile"), std::string::npos);
 }
 
+TEST(Cli, RenderCommandRejectsBadShotSelection) {
+  auto result = ::rigc::testing::run_rigc(
+      {"render", ::rigc::testing::source_path("scenes/paper-turntable.yaml"), "--shots", "3,40",
+       "-o", "/tmp/rigc-never-written"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("--shots"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists("/tmp/rigc-never-written"));
+}
+
 }  // namespace
 }  // namespace rigc

@@ -12,16 +12,16 @@
 #include "analysis/advice.h"
 #include "analysis/coverage.h"
 #include "analysis/coverage_output.h"
-#include "backends/cycles/cycles_backend.h"
-#include "backends/povray/povray_backend.h"
-#include "backends/preview/preview_backend.h"
+#include "backends/registry.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "compiler/units.h"
 #include "io/atomic_file.h"
 #include "ir/ir_json.h"
+#include "run/run_loop.h"
 #include "run/shots.h"
+#include "scene/studio_scene.h"
 
 namespace rigc::cli {
 namespace {
@@ -95,6 +95,23 @@ int run_check(std::vector<std::string> args) {
   return kExitOk;
 }
 
+// `compile --target BACKEND`: the backend's scripts for the whole scene in `output`.
+int emit_scripts(const ir::Scene& scene, const std::string& target, const std::string& output,
+                 double scale, int samples) {
+  const std::unique_ptr<run::Backend> backend = backends::find_backend(target)->make();
+  run::RenderSettings settings;
+  settings.scale = scale;
+  settings.samples = samples;
+  std::string error;
+  if (!settings.check(&error) ||
+      !backend->emit(scene, scene::prepare_studio_scene(scene), output, settings, &error)) {
+    std::cerr << "rigc: error: " << error << '\n';
+    return kExitUserError;
+  }
+  std::cout << fmt::format("{} files for '{}' in {}\n", target, scene.name, output);
+  return kExitOk;
+}
+
 int run_compile(std::vector<std::string> args) {
   CLI::App app{"Compile a scene for a target: the IR as JSON (more targets come with backends)."};
   std::string scene_path, target = "ir", output;
@@ -102,8 +119,10 @@ int run_compile(std::vector<std::string> args) {
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
   int samples = 0;
   double scale = 1.0;
+  std::vector<std::string> targets = backends::backend_names(true);
+  targets.insert(targets.begin(), "ir");
   app.add_option("--target,--emit", target, "what to emit: the IR as JSON, or scripts")
-      ->check(CLI::IsMember({"ir", "povray", "cycles"}))
+      ->check(CLI::IsMember(targets))
       ->capture_default_str();
   app.add_option("-o,--output", output,
                  "output file for ir (default: standard output); folder for povray and cycles "
@@ -120,17 +139,9 @@ int run_compile(std::vector<std::string> args) {
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
-  if (target == "povray" || target == "cycles") {
+  if (target != "ir") {
     if (output.empty()) output = (fs::path("out") / scene->name / target / "render").string();
-    std::string error;
-    const bool ok = target == "povray" ? povray::emit(*scene, output, scale, &error, samples)
-                                       : cycles::emit(*scene, output, scale, &error, samples);
-    if (!ok) {
-      std::cerr << "rigc: error: " << error << '\n';
-      return kExitUserError;
-    }
-    std::cout << fmt::format("{} files for '{}' in {}\n", target, scene->name, output);
-    return kExitOk;
+    return emit_scripts(*scene, target, output, scale, samples);
   }
   const std::string text = ir_to_json(*scene, !no_geometry).dump(1) + "\n";
   if (output.empty()) {
@@ -158,7 +169,7 @@ int run_render(std::vector<std::string> args) {
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
   int samples = 0;
   app.add_option("--backend", backend, "renderer")
-      ->check(CLI::IsMember({"preview", "povray", "cycles"}))
+      ->check(CLI::IsMember(backends::backend_names()))
       ->capture_default_str();
   app.add_option("--samples", samples,
                  "samples per pixel for povray and cycles (0: the backend's default)")
@@ -185,25 +196,15 @@ int run_render(std::vector<std::string> args) {
     std::cerr << "rigc: error: --shots: " << error << '\n';
     return kExitUserError;
   }
-  if (output.empty()) output = (fs::path("out") / scene->name / backend).string();
-  if (backend != "preview") {
-    external::ReferenceOptions options;
-    options.output_dir = output;
-    options.shots = *shots;
-    options.scale = scale;
-    options.seed = seed;
-    options.samples = samples;
-    options.progress_bar = isatty(STDERR_FILENO);
-    return backend == "povray" ? povray::run(*scene, options, std::cerr)
-                               : cycles::run(*scene, options, std::cerr);
-  }
-  preview::RenderOptions options;
-  options.output_dir = output;
+  run::RunOptions options;
+  options.output_dir = output.empty() ? fs::path("out") / scene->name / backend : fs::path(output);
   options.shots = *shots;
-  options.scale = scale;
-  options.seed = seed;
+  options.settings.scale = scale;
+  options.settings.seed = seed;
+  options.settings.samples = samples;
   options.progress_bar = isatty(STDERR_FILENO);
-  return preview::run_preview(*scene, options, std::cerr);
+  const std::unique_ptr<run::Backend> renderer = backends::find_backend(backend)->make();
+  return run::run_backend(*scene, *renderer, options, std::cerr);
 }
 
 int run_coverage(std::vector<std::string> args) {
@@ -255,8 +256,8 @@ int run_version(std::vector<std::string> args) {
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"check", "check a scene and report errors and capture warnings", run_check},
-      {"compile", "compile a scene to a target (ir, povray, cycles)", run_compile},
-      {"render", "render every shot with a backend (preview, povray, cycles)", run_render},
+      {"compile", "compile a scene to the IR or to a backend's scripts", run_compile},
+      {"render", "render every shot with a backend (rigc render --help lists them)", run_render},
       {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
       {"eval", "reconstruct a run with COLMAP and measure it against the ground truth",
        run_eval_command},

@@ -2,12 +2,18 @@
 // code: 0 ok, 1 user error, 2 internal or external-tool failure.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
+
+#include "eval/eval.h"
 
 namespace rigc::cli {
 
 int run_eval_command(std::vector<std::string> args);
 int run_compare_command(std::vector<std::string> args);
+
+// The reconstruction options `eval` and `compare` share.
+void add_eval_options(CLI::App& app, eval::EvalOptions& options);
 
 }  // namespace rigc::cli

@@ -534,11 +534,12 @@ RenderedRun render(const rigc::testing::TempDir& dir, const std::string& text, d
   auto scene = compile_scene_file(r.scene_file.string(), diag);
   EXPECT_TRUE(scene.has_value());
   if (!scene) return r;
-  preview::RenderOptions options;
-  options.output_dir = r.run_dir.string();
-  options.scale = scale;
+  run::RunOptions options;
+  options.output_dir = r.run_dir;
+  options.settings.scale = scale;
   std::ostringstream log;
-  EXPECT_EQ(preview::run_preview(*scene, options, log), 0) << log.str();
+  preview::PreviewBackend backend;
+  EXPECT_EQ(run::run_backend(*scene, backend, options, log), 0) << log.str();
   return r;
 }
 

@@ -19,7 +19,6 @@ namespace rigc::cycles {
 namespace {
 
 namespace fs = std::filesystem;
-using external::RenderedShot;
 using nlohmann::json;
 
 constexpr double kPi = std::numbers::pi;
@@ -164,27 +163,14 @@ std::string script_text(const json& data) {
   return header + script;
 }
 
-class CyclesRenderer : public external::Renderer {
- public:
-  std::string name() const override { return "cycles"; }
-  std::string executable() const override { return "blender"; }
-  std::string package() const override { return "blender"; }
-  bool emit(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
-            std::string* error) override {
-    return emit_files(scene, dir, scale, samples, error);
-  }
-  bool render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot, double scale,
-              int samples, const fs::path& log_path, RenderedShot* out,
-              std::string* error) override;
+}  // namespace
 
-  static bool emit_files(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
-                         std::string* error);
-};
-
-bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
-                                int samples, std::string* error) {
+bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studio,
+                         const fs::path& dir, const run::RenderSettings& settings,
+                         std::string* error) {
+  const double scale = settings.scale;
+  const int samples = settings.samples;
   if (!external::prepare_emit_folder(scene, dir, scale, error)) return false;
-  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());
   const ir::Camera& camera = scene.camera;
@@ -253,9 +239,13 @@ bool CyclesRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   return rigc::write_file_atomically(dir / "scene.py", script_text(data), error);
 }
 
-bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
-                            double scale, int samples, const fs::path& log_path, RenderedShot* out,
-                            std::string* error) {
+bool CyclesBackend::render(const ir::Scene& scene, const scene::StudioScene& /*studio*/,
+                           const ir::Shot& shot, const run::RenderSettings& settings,
+                           const run::ShotFiles& files, run::RenderedShot* out,
+                           std::string* error) {
+  const fs::path& dir = files.work_dir;
+  const double scale = settings.scale;
+  const int samples = settings.samples;
   const std::string stem = shot.name;
   std::error_code ec;
   fs::remove(dir / (stem + ".exr"), ec);
@@ -277,7 +267,7 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
     argv.push_back("--samples");
     argv.push_back(std::to_string(samples));
   }
-  const external::ProgramResult result = external::run_program(argv, dir, log_path);
+  const external::ProgramResult result = external::run_program(argv, dir, files.log);
   if (!result.started) {
     *error = result.error;
     return false;
@@ -312,23 +302,6 @@ bool CyclesRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
   out->depth_of_field_rendered = scene.camera.effects.depth_of_field;
   out->subframes = 1;
   return true;
-}
-
-}  // namespace
-
-std::unique_ptr<external::Renderer> make_renderer() {
-  return std::make_unique<CyclesRenderer>();
-}
-
-bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
-          int samples) {
-  return CyclesRenderer::emit_files(scene, dir, scale, samples, error);
-}
-
-int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
-        std::vector<ShotTiming>* timings) {
-  CyclesRenderer renderer;
-  return external::run_reference(scene, options, renderer, log, timings);
 }
 
 }  // namespace rigc::cycles

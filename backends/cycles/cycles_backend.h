@@ -10,29 +10,28 @@
 #pragma once
 
 #include <filesystem>
-#include <iosfwd>
-#include <memory>
 #include <string>
 #include <vector>
 
-#include "backends/external/reference_backend.h"
+#include "backends/external/external_backend.h"
 #include "ir/ir.h"
 
 namespace rigc::cycles {
 
-using external::ReferenceOptions;
-using external::ShotTiming;
-
-// Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
-// the default Cycles sample count of the script (0: 64). False with a one-line `error`.
-bool emit(const ir::Scene& scene, const std::filesystem::path& dir, double scale,
-          std::string* error, int samples = 0);
-
-// Emits into <output_dir>/render, runs Blender once per shot, develops and writes the common
-// layout. Exit code 0, 1 user error, 2 Blender failure.
-int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
-        std::vector<ShotTiming>* timings = nullptr);
-
-std::unique_ptr<external::Renderer> make_renderer();
+class CyclesBackend : public external::ExternalBackend {
+ public:
+  std::string name() const override { return "cycles"; }
+  std::string executable() const override { return "blender"; }
+  std::string package() const override { return "blender"; }
+  // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
+  // the script's default Cycles sample count (0: 64).
+  bool emit(const ir::Scene& scene, const scene::StudioScene& studio,
+            const std::filesystem::path& dir, const run::RenderSettings& settings,
+            std::string* error) override;
+  // Runs Blender once for the shot's image and mask.
+  bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
+              const run::RenderSettings& settings, const run::ShotFiles& files,
+              run::RenderedShot* out, std::string* error) override;
+};
 
 }  // namespace rigc::cycles

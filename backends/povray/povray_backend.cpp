@@ -29,7 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using external::number_text;
-using external::RenderedShot;
 
 constexpr double kPi = std::numbers::pi;
 // fade_distance of every local light: POV's 2/(1 + (d/D)²) is 2D²/d² to 1e-6 beyond 1 m·1e-3.
@@ -322,32 +321,14 @@ void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
   }
 }
 
-class PovrayRenderer : public external::Renderer {
- public:
-  std::string name() const override { return "povray"; }
-  std::string executable() const override { return "povray"; }
-  std::string package() const override { return "povray"; }
+}  // namespace
 
-  bool emit(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
-            std::string* error) override {
-    return emit_files(scene, dir, scale, samples, &subframes_, error);
-  }
-
-  bool render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot, double scale,
-              int samples, const fs::path& log_path, RenderedShot* out,
-              std::string* error) override;
-
-  static bool emit_files(const ir::Scene& scene, const fs::path& dir, double scale, int samples,
-                         std::vector<int>* subframes, std::string* error);
-
- private:
-  std::vector<int> subframes_;  // per shot index, from the last emit
-};
-
-bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, double scale,
-                                int samples, std::vector<int>* subframes, std::string* error) {
+bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studio,
+                         const fs::path& dir, const run::RenderSettings& settings,
+                         std::string* error) {
+  const double scale = settings.scale;
+  const int samples = settings.samples;
   if (!external::prepare_emit_folder(scene, dir, scale, error)) return false;
-  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());
 
@@ -398,12 +379,12 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   if (!write_text_file(dir / "scene.inc", fmt::to_string(inc), error)) return false;
 
   const dslr::Intrinsics canvas = dslr::render_geometry_for(scene.camera, scale);
-  subframes->assign(scene.shots.size(), 1);
+  subframes_.assign(scene.shots.size(), 1);
   const bool focal_blur = scene.camera.effects.depth_of_field;
   remove_stale_shot_files(scene, dir);
   for (const auto& shot : scene.shots) {
     const int count = subframes_for(scene, studio, shot, scale);
-    (*subframes)[shot.index] = count;
+    subframes_[shot.index] = count;
     if (!write_text_file(dir / (shot.name + ".pov"), shot_pov(scene, shot, canvas, count, samples),
                          error) ||
         !write_text_file(dir / (shot.name + ".ini"),
@@ -417,6 +398,8 @@ bool PovrayRenderer::emit_files(const ir::Scene& scene, const fs::path& dir, dou
   for (const auto& shot : scene.shots) shot_list += shot.name + '\n';
   return write_text_file(dir / kShotListFile, shot_list, error);
 }
+
+namespace {
 
 bool run_povray(const fs::path& dir, const std::string& ini, const fs::path& log_path,
                 std::string* error) {
@@ -432,9 +415,15 @@ bool run_povray(const fs::path& dir, const std::string& ini, const fs::path& log
   return true;
 }
 
-bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const ir::Shot& shot,
-                            double scale, int /*samples*/, const fs::path& log_path,
-                            RenderedShot* out, std::string* error) {
+}  // namespace
+
+bool PovrayBackend::render(const ir::Scene& scene, const scene::StudioScene& /*studio*/,
+                           const ir::Shot& shot, const run::RenderSettings& settings,
+                           const run::ShotFiles& files, run::RenderedShot* out,
+                           std::string* error) {
+  const fs::path& dir = files.work_dir;
+  const fs::path& log_path = files.log;
+  const double scale = settings.scale;
   const std::string stem = shot.name;
   const int subframes =
       shot.index < static_cast<int>(subframes_.size()) ? subframes_[shot.index] : 1;
@@ -500,24 +489,6 @@ bool PovrayRenderer::render(const ir::Scene& scene, const fs::path& dir, const i
   out->depth_of_field_rendered = scene.camera.effects.depth_of_field;
   out->subframes = subframes;
   return true;
-}
-
-}  // namespace
-
-std::unique_ptr<external::Renderer> make_renderer() {
-  return std::make_unique<PovrayRenderer>();
-}
-
-bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error,
-          int samples) {
-  std::vector<int> subframes;
-  return PovrayRenderer::emit_files(scene, dir, scale, samples, &subframes, error);
-}
-
-int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
-        std::vector<ShotTiming>* timings) {
-  PovrayRenderer renderer;
-  return external::run_reference(scene, options, renderer, log, timings);
 }
 
 }  // namespace rigc::povray

@@ -12,35 +12,36 @@
 #pragma once
 
 #include <filesystem>
-#include <iosfwd>
-#include <memory>
 #include <string>
 #include <vector>
 
-#include "backends/external/reference_backend.h"
+#include "backends/external/external_backend.h"
 #include "ir/ir.h"
 
 namespace rigc::povray {
-
-using external::ReferenceOptions;
-using external::ShotTiming;
 
 // POV-Ray's focal blur `aperture` per metre of pupil diameter f/N (2: checked with a render by
 // ReferenceAgreement.DefocusBlurWidth).
 extern const double kApertureMetersPerPupilDiameter;
 
-// Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
-// missing). `scale` multiplies the sensor resolution; `samples` sets antialiasing and focal blur
-// samples (0: defaults). Textures are written beside them as PNG. False with one-line `error`.
-bool emit(const ir::Scene& scene, const std::filesystem::path& dir, double scale,
-          std::string* error, int samples = 0);
+class PovrayBackend : public external::ExternalBackend {
+ public:
+  std::string name() const override { return "povray"; }
+  std::string executable() const override { return "povray"; }
+  std::string package() const override { return "povray"; }
+  // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
+  // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
+  // samples (0: defaults).
+  bool emit(const ir::Scene& scene, const scene::StudioScene& studio,
+            const std::filesystem::path& dir, const run::RenderSettings& settings,
+            std::string* error) override;
+  // Runs povray for the shot's image (per motion-blur sub-frame, which it averages) and mask.
+  bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
+              const run::RenderSettings& settings, const run::ShotFiles& files,
+              run::RenderedShot* out, std::string* error) override;
 
-// Emits into <output_dir>/render, runs povray per shot (and per motion-blur sub-frame, which it
-// averages), develops and writes the common layout. Exit code 0, 1 user error, 2 POV-Ray failure.
-int run(const ir::Scene& scene, const ReferenceOptions& options, std::ostream& log,
-        std::vector<ShotTiming>* timings = nullptr);
-
-// The Renderer run() uses, for tests that need the linear frames.
-std::unique_ptr<external::Renderer> make_renderer();
+ private:
+  std::vector<int> subframes_;  // per shot index, from the last emit
+};
 
 }  // namespace rigc::povray

@@ -9,12 +9,31 @@
 #include "backends/external/process.h"
 #include "backends/povray/povray_backend.h"
 #include "compiler/frontend.h"
+#include "run/run_loop.h"
+#include "scene/studio_scene.h"
+#include "tests/hostile_scene.h"
 #include "tests/test_support.h"
 
 namespace rigc::povray {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The run loop with this backend, as `rigc render` runs it.
+int render_run(const ir::Scene& scene, const run::RunOptions& options, std::ostream& log,
+               std::vector<run::ShotTiming>* timings = nullptr) {
+  PovrayBackend backend;
+  return run::run_backend(scene, backend, options, log, timings);
+}
+
+// The backend's scripts for the scene, as `rigc compile --target` writes them.
+bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string* error) {
+  run::RenderSettings settings;
+  settings.scale = scale;
+  return PovrayBackend().emit(scene, scene::prepare_studio_scene(scene), dir, settings, error);
+}
+using ::rigc::testing::hostile_scene;
+using ::rigc::testing::pwned_anywhere;
 using ::rigc::testing::read_text;
 using ::rigc::testing::TempDir;
 
@@ -120,11 +139,11 @@ TEST(PovrayRun, MissingExecutableNamesThePackage) {
   const ir::Scene scene = paper_scene();
   TempDir dir;
   ScopedEnv path("PATH", (dir.path() / "empty").string());
-  ReferenceOptions options;
+  run::RunOptions options;
   options.output_dir = (dir.path() / "out").string();
-  options.scale = 0.01;
+  options.settings.scale = 0.01;
   std::ostringstream log;
-  EXPECT_EQ(run(scene, options, log), 2);
+  EXPECT_EQ(render_run(scene, options, log), 2);
   EXPECT_NE(log.str().find("apt-get install povray"), std::string::npos) << log.str();
 }
 
@@ -143,15 +162,15 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
                             "exec " +
                                 real->string() + " \"$@\"\n");
   fs::permissions(wrapper, fs::perms::owner_all);
-  ReferenceOptions options;
+  run::RunOptions options;
   options.output_dir = (dir.path() / "out").string();
-  options.scale = 0.012;
-  options.samples = 1;
+  options.settings.scale = 0.012;
+  options.settings.samples = 1;
   options.shots = {0, 1};
   {
     ScopedEnv path("PATH", (dir.path() / "bin").string() + ":" + std::getenv("PATH"));
     std::ostringstream log;
-    EXPECT_EQ(run(scene, options, log), 2);
+    EXPECT_EQ(render_run(scene, options, log), 2);
     EXPECT_NE(log.str().find("shot_001: povray shot_001.ini failed with exit code 7"),
               std::string::npos)
         << log.str();
@@ -160,8 +179,8 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
     EXPECT_FALSE(fs::exists(dir.path() / "out" / "images" / "shot_001.jpg"));
   }
   std::ostringstream log;
-  std::vector<ShotTiming> timings;
-  EXPECT_EQ(run(scene, options, log, &timings), 0) << log.str();
+  std::vector<run::ShotTiming> timings;
+  EXPECT_EQ(render_run(scene, options, log, &timings), 0) << log.str();
   ASSERT_EQ(timings.size(), 2u);
   EXPECT_TRUE(timings[0].skipped);
   EXPECT_FALSE(timings[1].skipped);
@@ -169,6 +188,21 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
                            "transforms.json", "manifest.json"}) {
     EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
   }
+}
+
+TEST(PovrayRun, HostileMeshPathRendersWithoutRunningAnything) {
+  if (!external::find_executable("povray")) GTEST_SKIP() << "povray is not installed";
+  TempDir dir;
+  const ir::Scene scene = hostile_scene(dir);
+  ASSERT_FALSE(scene.shots.empty());
+  run::RunOptions options;
+  options.output_dir = (dir.path() / "out \"'; touch PWNED #").string();
+  options.settings.scale = 0.02;
+  options.settings.samples = 1;
+  std::ostringstream log;
+  EXPECT_EQ(render_run(scene, options, log), 0) << log.str();
+  EXPECT_TRUE(fs::exists(options.output_dir / "masks" / "shot_000.png"));
+  EXPECT_FALSE(pwned_anywhere(dir.path()));
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 #include "dslr/pipeline.h"
 #include "tests/test_support.h"
 
-namespace rigc::external {
+namespace rigc::backends {
 namespace {
 
 namespace fs = std::filesystem;
@@ -52,15 +52,20 @@ Rendered render_preview(const ir::Scene& scene, const ir::Shot& shot, double sca
   return out;
 }
 
-std::optional<Rendered> render_with(Renderer& renderer, const ir::Scene& scene,
+std::optional<Rendered> render_with(run::Backend& renderer, const ir::Scene& scene,
                                     const ir::Shot& shot, double scale, int samples,
                                     const fs::path& dir) {
   std::string error;
-  EXPECT_TRUE(renderer.emit(scene, dir, scale, samples, &error)) << error;
-  RenderedShot rendered;
+  run::RenderSettings settings;
+  settings.scale = scale;
+  settings.samples = samples;
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  EXPECT_TRUE(renderer.emit(scene, studio, dir, settings, &error)) << error;
+  run::RenderedShot rendered;
   const fs::path log = dir / (shot.name + ".log");
-  if (!renderer.render(scene, dir, shot, scale, samples, log, &rendered, &error)) {
-    ADD_FAILURE() << renderer.name() << ": " << error << "\n" << tail_of_file(log, 20);
+  if (!renderer.render(scene, studio, shot, settings, run::ShotFiles{dir, log}, &rendered,
+                       &error)) {
+    ADD_FAILURE() << renderer.name() << ": " << error << "\n" << external::tail_of_file(log, 20);
     return std::nullopt;
   }
   return Rendered{renderer.name(), std::move(rendered.frame), rendered.depth_of_field_rendered};
@@ -151,8 +156,8 @@ void expect_agreement(ir::Scene scene, int shot_index, double scale) {
   rigc::testing::TempDir dir;
   std::vector<Rendered> all;
   all.push_back(render_preview(scene, shot, scale));
-  auto pov = povray::make_renderer();
-  auto cyc = cycles::make_renderer();
+  auto pov = std::make_unique<povray::PovrayBackend>();
+  auto cyc = std::make_unique<cycles::CyclesBackend>();
   auto pov_frame = render_with(*pov, scene, shot, scale, 4, dir.path() / "povray");
   auto cyc_frame = render_with(*cyc, scene, shot, scale, 16, dir.path() / "cycles");
   ASSERT_TRUE(pov_frame && cyc_frame);
@@ -260,8 +265,8 @@ shots:
   rigc::testing::TempDir dir;
   std::vector<Rendered> all;
   all.push_back(render_preview(scene, shot, scale));
-  auto pov = povray::make_renderer();
-  auto cyc = cycles::make_renderer();
+  auto pov = std::make_unique<povray::PovrayBackend>();
+  auto cyc = std::make_unique<cycles::CyclesBackend>();
   auto pov_frame = render_with(*pov, scene, shot, scale, 16, dir.path() / "povray");
   auto cyc_frame = render_with(*cyc, scene, shot, scale, 64, dir.path() / "cycles");
   ASSERT_TRUE(pov_frame && cyc_frame);
@@ -292,4 +297,4 @@ shots:
 }
 
 }  // namespace
-}  // namespace rigc::external
+}  // namespace rigc::backends

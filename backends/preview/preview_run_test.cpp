@@ -1,0 +1,159 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "assets/primitives.h"
+#include "backends/preview/preview_backend.h"
+#include "compiler/frontend.h"
+#include "dslr/buffer_pool.h"
+#include "dslr/exposure.h"
+#include "dslr/lens.h"
+#include "dslr/optics.h"
+#include "run/colmap_text.h"
+#include "run/manifest.h"
+#include "run/run_folder.h"
+#include "scene/studio_scene.h"
+#include "tests/scene_fixtures.h"
+#include "tests/test_support.h"
+
+namespace rigc::preview {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::turntable_ball;
+
+// A run into `dir` at 5 % of the sensor: a few kilobytes a shot.
+run::RunOptions small_run(const fs::path& dir) {
+  run::RunOptions options;
+  options.output_dir = dir;
+  options.settings.scale = 0.05;
+  return options;
+}
+
+// The run loop with the preview backend, as `rigc render --backend preview` runs it.
+int run_preview(const ir::Scene& scene, const run::RunOptions& options, std::ostream& log,
+                std::vector<run::ShotTiming>* timings = nullptr) {
+  PreviewBackend backend;
+  return run::run_backend(scene, backend, options, log, timings);
+}
+
+TEST(PreviewRun, RunWritesTheLayoutAndResumes) {
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(3, "120deg");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
+  for (const char* file :
+       {"images/shot_000.jpg", "images/shot_002.jpg", "masks/shot_001.png", "sparse/cameras.txt",
+        "sparse/images.txt", "sparse/points3D.txt", "transforms.json", "manifest.json"}) {
+    EXPECT_TRUE(fs::exists(dir.path() / file)) << file;
+  }
+  // A rerun renders nothing; a deleted image is rendered again, alone.
+  std::vector<run::ShotTiming> timings;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0);
+  ASSERT_EQ(timings.size(), 3u);
+  for (const auto& t : timings) EXPECT_TRUE(t.skipped);
+  fs::remove(dir.path() / "images/shot_001.jpg");
+  timings.clear();
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0);
+  EXPECT_TRUE(timings[0].skipped);
+  EXPECT_FALSE(timings[1].skipped);
+  EXPECT_TRUE(timings[2].skipped);
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
+}
+
+// A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
+// rerun after the scene lost shots, or changed its image format, removes what it no longer makes.
+TEST(PreviewRun, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
+  testing::TempDir dir;
+  auto scene_with = [](int steps, const char* format) {
+    return turntable_ball(steps, "90deg", std::string("}\n  output: {format: ") + format + "}");
+  };
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene_with(4, "jpeg"), options, log), 0) << log.str();
+  ASSERT_TRUE(fs::exists(dir.path() / "images/shot_003.jpg"));
+  testing::write_text((dir.path() / "images/mine.jpg").string(), "not the run's");
+
+  ASSERT_EQ(run_preview(scene_with(2, "jpeg"), options, log), 0) << log.str();
+  EXPECT_NE(log.str().find("2 shots of an earlier run (shot_002 to shot_003) are no longer"),
+            std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_002.jpg"));
+  EXPECT_FALSE(fs::exists(dir.path() / "masks/shot_003.png"));
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
+  EXPECT_TRUE(fs::exists(dir.path() / "images/mine.jpg")) << "only the manifest's files go";
+  const auto manifest = run::Manifest::load(dir.path() / "manifest.json");
+  EXPECT_EQ(manifest.shots().size(), 2u);
+
+  ASSERT_EQ(run_preview(scene_with(2, "png16"), options, log), 0) << log.str();
+  EXPECT_TRUE(fs::exists(dir.path() / "images/shot_000.png"));
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg")) << "the JPEG beside the new PNG";
+}
+
+// Two renders into one folder at once each saved their own manifest over the other's.
+TEST(PreviewRun, ASecondRenderIntoABusyRunFolderIsRefused) {
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(1, "0deg");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  {
+    run::RunFolderLock other;  // as another rigc process would hold it
+    ASSERT_TRUE(other.acquire(dir.path(), log)) << log.str();
+    EXPECT_EQ(run_preview(scene, options, log), 1);
+    EXPECT_NE(log.str().find("another rigc is writing to the run folder"), std::string::npos)
+        << log.str();
+    EXPECT_FALSE(fs::exists(dir.path() / "manifest.json"));
+  }
+  EXPECT_EQ(run_preview(scene, options, log), 0) << log.str();
+}
+
+// A folder named manifest.json let every shot render, and then the run failed (exit 2).
+TEST(PreviewRun, AManifestThatIsNoFileStopsTheRunBeforeItRenders) {
+  testing::TempDir dir;
+  fs::create_directories(dir.path() / "manifest.json");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  EXPECT_EQ(run_preview(turntable_ball(1, "0deg"), options, log), 1);
+  EXPECT_NE(log.str().find("manifest.json: it is not a regular file"), std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg"));
+}
+
+TEST(PreviewRun, UnwritableOutputIsAUserError) {
+  testing::TempDir dir;
+  fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
+  if (access(dir.path().c_str(), W_OK) == 0) {
+    // Running as root: permissions do not stop us, so use a path under a regular file instead.
+    testing::write_text(dir.file("file"), "x");
+  }
+  ir::Scene scene = turntable_ball(1, "0deg");
+  run::RunOptions options = small_run(dir.path() / "file" / "run");
+  std::ostringstream log;
+  EXPECT_EQ(run_preview(scene, options, log), 1);
+  EXPECT_NE(log.str().find("cannot create the output folder"), std::string::npos) << log.str();
+}
+
+TEST(PreviewRun, ANonFiniteScaleIsRejectedBeforeAnythingIsWritten) {
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(1, "0deg");
+  for (double scale : {std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::infinity(), 0.0, -0.5}) {
+    run::RunOptions options = small_run(dir.path() / "run");
+    options.settings.scale = scale;
+    std::ostringstream log;
+    EXPECT_EQ(run_preview(scene, options, log), 1) << scale;
+    EXPECT_NE(log.str().find("render scale"), std::string::npos) << log.str();
+    // The run folder is not even made: a NaN scale used to render and record a shot first.
+    EXPECT_FALSE(fs::exists(dir.path() / "run")) << scale;
+  }
+}
+
+}  // namespace
+}  // namespace rigc::preview

@@ -1,0 +1,71 @@
+// The one interface every renderer implements. A backend turns one shot of an instantiated scene
+// into a linear frame (cd/m² and an object mask, on the canvas of dslr::render_geometry_for);
+// the run loop (run/run_loop.h) owns everything else: the run folder, its lock, the manifest,
+// skipping and resuming, progress, the DSLR model's development and the asynchronous writes.
+// How to add one: docs/architecture.md, "Adding a backend".
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "dslr/frame.h"
+#include "ir/ir.h"
+#include "scene/studio_scene.h"
+
+namespace rigc::run {
+
+// What a run asks of every backend.
+struct RenderSettings {
+  double scale = 1.0;      // multiplies the sensor resolution
+  std::uint64_t seed = 1;  // sensor noise (and an external renderer's sampling seed)
+  int samples = 0;         // renderer samples per pixel; 0 = the backend's default
+
+  // False with a one-line `error` when a field is out of its domain.
+  bool check(std::string* error) const;
+};
+
+// One shot in linear light, as a backend rendered it.
+struct RenderedShot {
+  dslr::LinearFrame frame;               // rgb in cd/m², mask of the object
+  bool depth_of_field_rendered = false;  // the renderer's lens blurred it: the DSLR model must not
+  int subframes = 1;                     // motion-blur sub-frames averaged (1: none, or native)
+  std::map<std::string, double> stage_ms;  // the backend's own stages, by name
+};
+
+// Where a backend may keep files of its own during a run, and where a shot's log goes.
+struct ShotFiles {
+  std::filesystem::path work_dir;  // <run>/render for backends with scripts; else empty
+  std::filesystem::path log;       // the external program's log for this shot; else empty
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  // The name `render --backend`, the manifest and the shot keys use.
+  virtual std::string name() const = 0;
+
+  // Whether the backend writes scripts a user can render by hand (`compile --target NAME`);
+  // such a backend keeps them in the run's render/ folder and logs each shot there.
+  virtual bool emits_scripts() const { return false; }
+  // Whether RenderSettings::samples changes its output (then it is part of the shot key).
+  virtual bool takes_samples() const { return false; }
+
+  // Checked before anything is written: e.g. that the external program is installed. False with
+  // a one-line `error` naming what to install.
+  virtual bool available(std::string* error) const;
+  // Writes the scripts into `dir` (which may not exist yet). False with a one-line `error`.
+  virtual bool emit(const ir::Scene& scene, const scene::StudioScene& studio,
+                    const std::filesystem::path& dir, const RenderSettings& settings,
+                    std::string* error);
+  // Called once per run, before the first shot that must render.
+  virtual bool prepare(const ir::Scene& scene, const scene::StudioScene& studio,
+                       const RenderSettings& settings, const ShotFiles& files, std::string* error);
+  // Renders one shot. False with a one-line `error`.
+  virtual bool render(const ir::Scene& scene, const scene::StudioScene& studio,
+                      const ir::Shot& shot, const RenderSettings& settings, const ShotFiles& files,
+                      RenderedShot* out, std::string* error) = 0;
+};
+
+}  // namespace rigc::run
