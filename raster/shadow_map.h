@@ -44,7 +44,7 @@ struct ShadowMap {
     std::vector<float> depth;
     // The fraction of those texels that hold a caster: a penumbra filter weighs a coarse texel's
     // block by it, or a blocker would grow by up to a coarse texel all round (a ball hiding a
-    // sixth of a softbox hid a quarter).
+    // sixth of a softbox would hide a quarter).
     std::vector<float> coverage;
     int blocks_per_row = 0;
     std::vector<float> reach_nearest;

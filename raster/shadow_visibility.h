@@ -54,8 +54,8 @@ inline const std::array<TapGroup, 8>& filter() {
 }
 
 // The search beyond the map's own texels: its disc is wider than the filters it leads to, and
-// 16 taps missed a blocker that filled a sixth of it (the penumbra's outer part then ended in
-// a step from a tenth of the light hidden to none).
+// 16 taps can miss a blocker that fills a sixth of it (the penumbra's outer part then ends in a
+// step from a tenth of the light hidden to none), so it takes 32.
 inline const std::array<TapGroup, 4>& wide_search() {
   static const std::array<TapGroup, 4> taps = spiral<4>();
   return taps;
@@ -192,8 +192,8 @@ class ShadowLookup {
   // surface, anywhere in a 24-texel disc, is no blocker; only within a texel or two of the point
   // can it hide the light. Where the cone is narrower than the smallest filter (a small light, or
   // a blocker just above the surface at a contact), that filter's taps must all count: it
-  // smooths the map's texel stairs, and with a 1-texel margin its outer taps came out lit,
-  // opening a lit gap between a box's foot and its shadow. A coarser level's texel may hold a
+  // smooths the map's texel stairs, and with a 1-texel margin its outer taps would come out
+  // lit, opening a lit gap between a box's foot and its shadow. A coarser level's texel may hold a
   // depth from anywhere in its 2^k texels: the margin grows alike.
   Int8 can_hide(const Float8& z, const Float8& d, float margin) const {
     return (d - margin) * z * z_r_ <= cone_ * (z_r_ - z);
