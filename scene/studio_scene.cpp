@@ -141,17 +141,20 @@ void add_quad(Geometry& g, const Vector3f& corner, const Vector3f& edge_u, const
   mark_convex_face(g, g.triangles.size() - 2);
 }
 
-// A closed cylinder about the Z axis from z0 to z1, smooth sides and flat caps.
-void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
-  constexpr int kSegments = 96;
-  auto ring_point = [&](int i, float z) {
-    const float a = 2 * std::numbers::pi_v<float> * i / kSegments;
-    return Vector3f(radius * std::cos(a), radius * std::sin(a), z);
-  };
-  for (int i = 0; i < kSegments; ++i) {
+constexpr int kCylinderSegments = 96;
+
+// Point i of a cylinder's ring of kCylinderSegments at height z.
+Vector3f ring_point(float radius, int i, float z) {
+  const float a = 2 * std::numbers::pi_v<float> * i / kCylinderSegments;
+  return Vector3f(radius * std::cos(a), radius * std::sin(a), z);
+}
+
+// A cylinder's smooth side, one flat rectangle (a convex face) per segment.
+void add_cylinder_side(Geometry& g, float radius, float z0, float z1, int material) {
+  for (int i = 0; i < kCylinderSegments; ++i) {
     const auto base = static_cast<std::uint32_t>(g.positions.size());
-    const Vector3f a0 = ring_point(i, z0), a1 = ring_point(i + 1, z0);
-    const Vector3f b0 = ring_point(i, z1), b1 = ring_point(i + 1, z1);
+    const Vector3f a0 = ring_point(radius, i, z0), a1 = ring_point(radius, i + 1, z0);
+    const Vector3f b0 = ring_point(radius, i, z1), b1 = ring_point(radius, i + 1, z1);
     const Vector3f n0(a0.x() / radius, a0.y() / radius, 0), n1(a1.x() / radius, a1.y() / radius, 0);
     for (const auto& [p, n] : {std::pair{a0, n0}, {a1, n1}, {b1, n1}, {b0, n0}}) {
       g.positions.push_back(p);
@@ -163,41 +166,49 @@ void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
     g.triangle_material.insert(g.triangle_material.end(), 2, material);
     mark_convex_face(g, g.triangles.size() - 2);  // a flat rectangle
   }
-  // Caps as zig-zag strips across the disc rather than fans: compact triangles, so their
-  // screen boxes do not overlap one another (a fan's thin wedges each box half the disc).
-  for (const float z : {z1, z0}) {
-    const auto base = static_cast<std::uint32_t>(g.positions.size());
-    const Vector3f normal(0, 0, z == z1 ? 1.0f : -1.0f);
-    for (int i = 0; i < kSegments; ++i) {
-      g.positions.push_back(ring_point(i, z));
-      g.normals.push_back(normal);
-      g.uvs.push_back({0, 0});
-    }
-    // Walk inwards from both ends of the ring: i runs forwards, j backwards.
-    auto emit = [&](int a, int b, int c) {
-      // Counter-clockwise about the cap's outward normal.
-      if (z == z1) {
-        g.triangles.push_back({base + a, base + b, base + c});
-      } else {
-        g.triangles.push_back({base + a, base + c, base + b});
-      }
-      g.triangle_material.push_back(material);
-    };
-    const std::size_t first_triangle = g.triangles.size();
-    int i = 0, j = kSegments - 1;
-    bool forward = true;
-    while (j - i >= 2) {
-      if (forward) {
-        emit(j, i, i + 1);
-        ++i;
-      } else {
-        emit(j, i, j - 1);
-        --j;
-      }
-      forward = !forward;
-    }
-    mark_convex_face(g, first_triangle);
+}
+
+// A cylinder's flat cap at height z, facing up (`top`) or down. A zig-zag strip across the disc
+// rather than a fan: compact triangles, so their screen boxes do not overlap one another (a fan's
+// thin wedges each box half the disc).
+void add_cylinder_cap(Geometry& g, float radius, float z, bool top, int material) {
+  const auto base = static_cast<std::uint32_t>(g.positions.size());
+  const Vector3f normal(0, 0, top ? 1.0f : -1.0f);
+  for (int i = 0; i < kCylinderSegments; ++i) {
+    g.positions.push_back(ring_point(radius, i, z));
+    g.normals.push_back(normal);
+    g.uvs.push_back({0, 0});
   }
+  // Walk inwards from both ends of the ring: i runs forwards, j backwards.
+  auto emit = [&](int a, int b, int c) {
+    // Counter-clockwise about the cap's outward normal.
+    if (top) {
+      g.triangles.push_back({base + a, base + b, base + c});
+    } else {
+      g.triangles.push_back({base + a, base + c, base + b});
+    }
+    g.triangle_material.push_back(material);
+  };
+  const std::size_t first_triangle = g.triangles.size();
+  int i = 0, j = kCylinderSegments - 1;
+  bool forward = true;
+  while (j - i >= 2) {
+    if (forward) {
+      emit(j, i, i + 1);
+      ++i;
+    } else {
+      emit(j, i, j - 1);
+      --j;
+    }
+    forward = !forward;
+  }
+  mark_convex_face(g, first_triangle);
+}
+
+// A closed cylinder about the Z axis from z0 to z1, smooth sides and flat caps.
+void add_cylinder(Geometry& g, float radius, float z0, float z1, int material) {
+  add_cylinder_side(g, radius, z0, z1, material);
+  for (const float z : {z1, z0}) add_cylinder_cap(g, radius, z, z == z1, material);
 }
 
 }  // namespace
@@ -226,6 +237,54 @@ float pattern_resolve(float scale_m, float footprint_m) {
   return std::clamp(2.0f - 2.0f * footprint_m / scale_m, 0.0f, 1.0f);
 }
 
+// The pattern's darkness (clamped to [0, 1] by the caller) at lanes points, in units of its
+// scale, and its mean over the surface (what a pattern too fine to resolve fades to).
+simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx, simd::F32x8 qy,
+                              simd::F32x8 qz, int lanes, float& mean_darkness) {
+  using simd::F32x8;
+  F32x8 darkness{};
+  switch (pattern.kind) {
+    case ir::PatternKind::kSpeckle: {
+      // Dark blotches at two scales, with soft edges (the darkness ramps over 1/12 of n).
+      const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
+                      0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
+                                           pattern.seed + 1);
+      darkness = (n - 0.47f) * 12.0f;
+      // The clamped darkness averages 0.47 over the surface (see the test
+      // Preview.ResolvedPatternsAverageToTheirFadedValue): fading to it keeps the brightness
+      // when zooming out.
+      mean_darkness = 0.47f;
+      break;
+    }
+    case ir::PatternKind::kNoise: {
+      F32x8 n{};
+      float amplitude = 0.5f, frequency = 1;
+      for (int octave = 0; octave < 3; ++octave) {
+        n += amplitude *
+             value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
+        amplitude *= 0.5f;
+        frequency *= 2.1f;
+      }
+      darkness = n / 0.875f;
+      mean_darkness = 0.5f;
+      break;
+    }
+    case ir::PatternKind::kChecker: {
+      for (int k = 0; k < lanes; ++k) {
+        darkness[k] = static_cast<float>((static_cast<int>(std::floor(qx[k])) +
+                                          static_cast<int>(std::floor(qy[k])) +
+                                          static_cast<int>(std::floor(qz[k]))) &
+                                         1);
+      }
+      mean_darkness = 0.5f;
+      break;
+    }
+    case ir::PatternKind::kNone:
+      break;
+  }
+  return darkness;
+}
+
 // pattern_factors with point i's footprint footprint_of(i).
 template <typename FootprintOf>
 void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, const float* y,
@@ -245,47 +304,8 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
       qy[k] = y[first + k] / scale;
       qz[k] = z[first + k] / scale;
     }
-    F32x8 darkness{};  // clamped to [0, 1] below
     float mean_darkness = 0;
-    switch (pattern.kind) {
-      case ir::PatternKind::kSpeckle: {
-        // Dark blotches at two scales, with soft edges (the darkness ramps over 1/12 of n).
-        const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
-                        0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
-                                             pattern.seed + 1);
-        darkness = (n - 0.47f) * 12.0f;
-        // The clamped darkness averages 0.47 over the surface (measured on 200k points, two
-        // seeds; Preview.ResolvedPatternsAverageToTheirFadedValue): fading to it keeps the
-        // brightness when zooming out (0.4 had made the faded statue 7 % brighter).
-        mean_darkness = 0.47f;
-        break;
-      }
-      case ir::PatternKind::kNoise: {
-        F32x8 n{};
-        float amplitude = 0.5f, frequency = 1;
-        for (int octave = 0; octave < 3; ++octave) {
-          n += amplitude *
-               value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
-          amplitude *= 0.5f;
-          frequency *= 2.1f;
-        }
-        darkness = n / 0.875f;
-        mean_darkness = 0.5f;
-        break;
-      }
-      case ir::PatternKind::kChecker: {
-        for (int k = 0; k < lanes; ++k) {
-          darkness[k] = static_cast<float>((static_cast<int>(std::floor(qx[k])) +
-                                            static_cast<int>(std::floor(qy[k])) +
-                                            static_cast<int>(std::floor(qz[k]))) &
-                                           1);
-        }
-        mean_darkness = 0.5f;
-        break;
-      }
-      case ir::PatternKind::kNone:
-        break;
-    }
+    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes, mean_darkness);
     for (int k = 0; k < lanes; ++k) {
       const float resolve = pattern_resolve(scale, footprint_of(first + k));
       const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
@@ -370,8 +390,10 @@ bool is_closed_outward(const std::vector<Vector3f>& positions,
   return true;
 }
 
-StudioScene prepare_studio_scene(const ir::Scene& scene) {
-  StudioScene out;
+namespace {
+
+// The scene's materials for shading, then the object moved into its own frame once.
+void add_object(const ir::Scene& scene, StudioScene& out) {
   for (const auto& texture : scene.textures) out.textures.push_back(build_mips(texture));
   for (const auto& material : scene.materials) {
     ShadedMaterial shaded;
@@ -383,8 +405,6 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
     shaded.casts_shadow = true;
     out.materials.push_back(shaded);
   }
-
-  // The object, moved into its own frame once.
   const ir::Mesh& mesh = scene.object.mesh;
   const Eigen::Matrix4f object_from_mesh = scene.object.object_from_mesh.cast<float>();
   const Eigen::Matrix3f linear = object_from_mesh.block<3, 3>(0, 0);
@@ -408,9 +428,11 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   for (const auto& p : object.positions) {
     out.object_radius = std::max(out.object_radius, (p.cast<double>() - out.object_center).norm());
   }
+}
 
-  // The studio, in the world frame.
-  const ir::Studio& studio = scene.studio;
+// The studio in the world frame: the turntable on its stand (closed solids, first), the floor
+// and the green screen, with their materials.
+void add_studio(const ir::Studio& studio, StudioScene& out) {
   auto add_material = [&](const ir::Vec3& color, float roughness) {
     ShadedMaterial m;
     m.base_color = color.cast<float>();
@@ -440,10 +462,12 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
     add_quad(out.studio, center + across * half_width, -across * (2 * half_width),
              Vector3f(0, 0, static_cast<float>(studio.backdrop.height_m)), backdrop_material);
   }
-  out.object.compute_face_normals();
-  out.studio.compute_face_normals();
+}
+
+// The triangles that cast shadows (object first, then studio, indexed into both meshes'
+// positions one after the other), and the turntable's reach as a caster.
+void collect_shadow_casters(const ir::Studio& studio, StudioScene& out) {
   const auto studio_base = static_cast<std::uint32_t>(out.object.positions.size());
-  out.object_closed = is_closed_outward(out.object.positions, out.object.triangles);
   for (size_t t = 0; t < out.object.triangles.size(); ++t) {
     if (out.materials[out.object.triangle_material[t]].casts_shadow) {
       out.shadow_casters.push_back(out.object.triangles[t]);
@@ -460,6 +484,18 @@ StudioScene prepare_studio_scene(const ir::Scene& scene) {
   out.turntable_caster_radius =
       std::max(out.object_center.head<2>().norm() + out.object_radius, table_radius) +
       out.object_center.z() + out.object_radius + studio.turntable.thickness_m;
+}
+
+}  // namespace
+
+StudioScene prepare_studio_scene(const ir::Scene& scene) {
+  StudioScene out;
+  add_object(scene, out);
+  add_studio(scene.studio, out);
+  out.object.compute_face_normals();
+  out.studio.compute_face_normals();
+  out.object_closed = is_closed_outward(out.object.positions, out.object.triangles);
+  collect_shadow_casters(scene.studio, out);
   return out;
 }
 
