@@ -54,14 +54,11 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
 // only write them a second time.
 //
 // The pages are asked to stay 4 KB ones (MADV_NOHUGEPAGE, which also holds where THP is
-// "always"; Debian's mode is "madvise"). On the KVM guest this project is measured on, a 2 MB
-// page costs 2.2-2.5 s per GB of CPU to fault in once the memory has been free for a few seconds
-// (0.16 s per GB after 1 s), and a 4 KB page 0.3-0.4 s per GB even then (800 MB populated 10 s
-// after the last run, alternated). Most likely the guest's free 2 MB blocks go back to the host
-// (virtio-balloon free page reporting, order 9 here) while its scattered 4 KB pages stay backed.
-// Later shots reuse the pool's buffers, and were no slower on 4 KB pages in the full-size benchmark
-// (median 460-464 against 463-466 ms a shot), while a cold `rigc render` of the paper scene
-// took 8.95-9.16 s against 9.62-9.99 s, its system CPU 0.41-0.46 s against 1.92-2.17 s.
+// "always"; Debian's mode is "madvise"). On a virtual machine a fresh 2 MB page can cost several
+// times as much CPU to fault in as the same memory in 4 KB pages, once the memory has been free
+// for a few seconds: most likely the guest's free 2 MB blocks go back to the host (virtio-balloon
+// free page reporting) while its scattered 4 KB pages stay backed. Later shots reuse the pool's
+// buffers, so small pages cost them nothing.
 void first_touch(void* data, std::size_t bytes) {
   constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20, kPage = 4096;
   const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(data);

@@ -7,7 +7,7 @@
 
 namespace rigc::dslr {
 
-// Lens transmission, vignetting and angle factor in H = q·L·t/N² (CAMERA.md).
+// Lens transmission, vignetting and angle factor in H = q·L·t/N² (docs/camera-model.md).
 inline constexpr double kExposureQ = 0.65;
 
 // EV100 = log2(N²/t) - log2(ISO/100).

@@ -27,8 +27,8 @@ struct RenderGeometry : Intrinsics {
 // row and column of tiles may be cut by the frame's edges): the nearest and furthest depth (a
 // depth that is not > 0 counts as +inf, background) and each channel's smallest and largest
 // radiance. A renderer that has its tiles in cache hands them over with the frame
-// (record_tile_ranges, in optics.h); otherwise the depth of field reads the whole frame once more
-// for them.
+// (record_tile_ranges, in depth_of_field.h); otherwise the depth of field reads the whole frame
+// once more for them.
 struct TileRanges {
   static constexpr int kTile = 16;
   int tiles_x = 0, tiles_y = 0;
@@ -78,8 +78,8 @@ struct ShotParams {
   double focus_distance_m = 1;  // ir::Shot::focus_distance_m
   int shot_index = 0;           // varies the temporal noise between shots
   std::uint64_t seed = 1;       // camera seed: fixes the sensor's fixed-pattern noise
-  // Whether DevelopResult::depth_m is wanted (a writer of images only does not need it: at full
-  // resolution it is 80 MB and a tenth of the distortion stage).
+  // Whether DevelopResult::depth_m is wanted (a writer of images only does not need it, and
+  // the warp to the sensor then skips a frame-sized output).
   bool sensor_depth = true;
   // Whether DevelopResult::linear is wanted. Without it, and with a fixed white balance, the
   // sensor and the encoding run as one pass (the full-size linear image is never written).

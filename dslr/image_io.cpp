@@ -127,7 +127,7 @@ bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int
     return false;
   }
   if (lowercase_extension(path) == ".png") {
-    // Encoded by runs: about a tenth of zlib's time on a mask (see mask_png.h).
+    // Encoded by runs: much faster than zlib on a mask (see mask_png.h).
     return write_file_atomically(path, encode_mask_png(mask.data(), width, height), error);
   }
   // Any other format OpenImageIO writes (the backends name masks .png).

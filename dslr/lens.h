@@ -15,7 +15,7 @@ namespace rigc::dslr {
 // no pixel intrinsics.
 Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale);
 
-// Undistorted -> distorted normalised coordinates (CAMERA.md, OpenCV).
+// Undistorted -> distorted normalised coordinates (docs/camera-model.md, OpenCV).
 ir::Vec2 distort_normalized(const ir::Distortion& d, double x, double y);
 
 // Distorted -> undistorted, by Newton's method (converges to ~1e-14). Returns false when the

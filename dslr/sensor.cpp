@@ -260,6 +260,19 @@ void for_each_group(std::size_t values, const Fn& fn) {
       });
 }
 
+// sensor_pass with the noise off: the signal only clipped to [0, 1].
+template <typename Store>
+void clipping_pass(std::size_t values, const float* signal, const Store& store) {
+  for_each_group(values, [=](std::size_t first, std::size_t count) {
+    F32x8 x = {};
+    std::memcpy(&x, signal + first, count * sizeof(float));
+    const F32x8 zero = {}, one = zero + 1;
+    x = x < zero ? zero : x;
+    x = x > one ? one : x;
+    store(first, count, x);
+  });
+}
+
 // The sensor over `signal` (3 values per pixel), eight values per step: store(first, count, out)
 // receives values [first, first + count) as the ADC leaves them, normalised (first is a multiple
 // of eight). The store may write over the signal it came from.
@@ -269,14 +282,7 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   const std::size_t values = 3 * pixels;
   if (!camera.effects.noise) {
-    for_each_group(values, [=](std::size_t first, std::size_t count) {
-      F32x8 x = {};
-      std::memcpy(&x, signal + first, count * sizeof(float));
-      const F32x8 zero = {}, one = zero + 1;
-      x = x < zero ? zero : x;
-      x = x > one ? one : x;
-      store(first, count, x);
-    });
+    clipping_pass(values, signal, store);
     return;
   }
   const ir::SensorNoise& model = camera.noise;

@@ -1,5 +1,5 @@
 // The sensor: photon shot noise, dark current, read noise, fixed-pattern noise, clipping and the
-// ADC, in the order ISETCam simulates them (CAMERA.md).
+// ADC, in the order ISETCam simulates them (docs/camera-model.md).
 #pragma once
 
 #include <cstdint>
