@@ -148,7 +148,7 @@ double mean_signal(const ir::Camera& camera, const Rendered& r, const ir::Shot& 
 }
 
 void expect_agreement(ir::Scene scene, int shot_index, double scale) {
-  if (!renderers_installed()) GTEST_SKIP() << "povray or blender is not installed";
+  RIGC_REQUIRE_TOOL(renderers_installed(), "povray or blender");
   // Sharp images (DOF has its own test) and no sensor noise: this compares the renderers.
   scene.camera.effects.depth_of_field = false;
   scene.camera.effects.noise = false;
@@ -205,9 +205,9 @@ TEST(ReferenceAgreement, PaperSceneMasksAndExposure) {
 }
 
 TEST(ReferenceAgreement, TexturedSceneMasksAndExposure) {
-  if (!fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf")) {
-    GTEST_SKIP() << "assimp-testmodels is not installed";
-  }
+  RIGC_REQUIRE_TOOL(
+      fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf"),
+      "assimp-testmodels");
   const ir::Scene scene = compile_file("scenes/orbit-textured.yaml");
   expect_agreement(scene, 3, 192.0 / scene.camera.width_px);
 }
@@ -239,7 +239,7 @@ double edge_width_px(const dslr::DevelopResult& result) {
 }
 
 TEST(ReferenceAgreement, DefocusBlurWidth) {
-  if (!renderers_installed()) GTEST_SKIP() << "povray or blender is not installed";
+  RIGC_REQUIRE_TOOL(renderers_installed(), "povray or blender");
   // A bright 16 cm box 0.9 m away, focused at 0.55 m, at f/1.4: a blur disc of about 9 px.
   ir::Scene scene = compile(R"(rigc: 1
 object:

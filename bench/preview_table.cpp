@@ -188,8 +188,7 @@ int main(int argc, char** argv) {
     }
     std::cout << '\n';
   }
-  // The first shot's extra time is mostly fresh memory: on this VM the host backs each page
-  // anew (memory a process frees is handed back to the host after about 2 s).
+  // The first shot's extra time is mostly fresh memory (bench/results.md).
   for (const auto& row : rows) {
     std::cout << fmt::format("{:<24} first shot {:.0f} ms, other shots median {:.0f} ms\n",
                              row.name, row.first_shot_ms, row.other_shots_median_ms);

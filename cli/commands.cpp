@@ -219,7 +219,7 @@ int run_coverage(std::vector<std::string> args) {
       ->capture_default_str();
   app.add_option("--visibility-scale", visibility_scale,
                  "resolution of the visibility buffers relative to the sensor (0: ~1400 px)")
-      // 1e-9 made a buffer of a pixel or two: fill 100 %, two thirds unseen, and no warning.
+      // Below 0.01 the buffers are a pixel or two across, and their coverage means nothing.
       ->check(cli::finite_number_where(
           [](double value) { return value == 0 || (value >= 0.01 && value <= 1); },
           "is neither 0 (automatic) nor within 0.01..1", ""));

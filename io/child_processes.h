@@ -29,9 +29,8 @@ struct ChildResult {
 };
 
 // Runs the program and waits for it. While it runs, a SIGINT, SIGTERM or SIGHUP that stops rigc
-// sends it a SIGTERM first: a signal sent to rigc alone (`kill`, `timeout`, a closed ssh
-// session) had left POV-Ray rendering on its own, into the folder a rerun then rendered into as
-// well. A signal that comes while the child is being started stops it too. (A SIGKILL cannot be
+// sends it a SIGTERM first, so that a signal sent to rigc alone (`kill`, `timeout`, a closed ssh
+// session) does not leave a renderer writing into a folder a rerun renders into. A signal that comes while the child is being started stops it too. (A SIGKILL cannot be
 // caught: the child then runs on.)
 ChildResult run_child(const ChildRun& run);
 

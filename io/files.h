@@ -15,9 +15,6 @@ struct evp_md_ctx_st;  // OpenSSL's EVP_MD_CTX
 
 namespace rigc {
 
-// write_file_atomically, where the backends have always called it.
-using rigc::write_file_atomically;
-
 // Incremental SHA-256 (FIPS 180-4), for hashing large arrays without copying them. OpenSSL's
 // implementation: it uses the CPU's SHA instructions where there are any, and the scene hash of
 // a textured mesh runs on one core before the first shot can start.

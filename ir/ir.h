@@ -23,6 +23,10 @@ using Vec2 = Eigen::Vector2d;
 using Vec3 = Eigen::Vector3d;
 using Mat4 = Eigen::Matrix4d;
 
+// Lumens per watt of radiant power: the photometric convention that light powers in watts follow
+// here (as Blender's do), so 1 W/(m²·sr) of linear luminance is 683 cd/m².
+inline constexpr double kLumensPerWatt = 683.0;
+
 // An 8-bit image (sRGB-encoded colour, as stored in files), row-major, top row first.
 struct Texture {
   std::string source;  // file it came from (or "file.glb#image3" for embedded images)

@@ -11,8 +11,7 @@
 
 namespace rigc::raster {
 
-// Blender's photometric convention: 1 W of light is 683 lm at 555 nm.
-inline constexpr float kLumensPerWatt = 683.0f;
+inline constexpr float kLumensPerWatt = static_cast<float>(ir::kLumensPerWatt);
 
 // A light with its constants in float, worked out once per frame rather than per pixel.
 struct FrameLight {

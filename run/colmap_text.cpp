@@ -262,9 +262,9 @@ std::optional<std::vector<ColmapImage>> read_colmap_images(const fs::path& path,
 namespace {
 
 // What COLMAP could not use in a camera line (empty if nothing): its model with the parameter
-// count COLMAP expects, a size of real images, finite parameters and positive focal lengths. A
-// wrong height reached OpenImageIO as an assertion, and a huge one took 24 GB before the kernel
-// stopped it; a NaN focal length made COLMAP's matcher abort.
+// count COLMAP expects, a size of real images, finite parameters and positive focal lengths (a
+// wrong height trips an assertion in OpenImageIO, a huge one exhausts memory, and a NaN focal
+// length aborts COLMAP's matcher).
 std::string camera_problem(const ColmapCamera& camera) {
   // COLMAP's camera models and their parameter counts (colmap/sensor/models.h); the focal
   // lengths come first in every one of them (one for the SIMPLE_ models, fx and fy otherwise).

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -15,6 +16,11 @@ extern char** environ;
 namespace rigc::testing {
 
 namespace fs = std::filesystem;
+
+bool tools_required() {
+  const char* value = std::getenv("RIGC_REQUIRE_TOOLS");
+  return value && std::string(value) == "1";
+}
 
 ProcessResult run_process(const std::vector<std::string>& argv) {
   TempDir capture;

@@ -33,8 +33,22 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// True when RIGC_REQUIRE_TOOLS=1 (scripts/test.sh sets it, and CI installs every tool): a test
+// whose external tool is missing then fails instead of skipping.
+bool tools_required();
+
 std::string source_path(const std::string& relative);  // inside the repository
 std::string read_text(const std::string& path);
 void write_text(const std::string& path, const std::string& text);
 
 }  // namespace rigc::testing
+
+// Skips the test when `available` is false, naming `what` is missing; fails it instead where
+// tools are required (see tools_required()).
+#define RIGC_REQUIRE_TOOL(available, what)                                                  \
+  do {                                                                                      \
+    if (!(available)) {                                                                     \
+      if (::rigc::testing::tools_required()) FAIL() << what << " is not installed";          \
+      GTEST_SKIP() << what << " is not installed";                                          \
+    }                                                                                       \
+  } while (0)

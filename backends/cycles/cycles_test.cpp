@@ -54,7 +54,7 @@ TEST(CyclesEmit, ScriptCarriesUserTextOnlyAsEscapedData) {
 }
 
 TEST(CyclesRun, HostileMeshPathRendersWithoutRunningAnything) {
-  if (!external::find_executable("blender")) GTEST_SKIP() << "blender is not installed";
+  RIGC_REQUIRE_TOOL(external::find_executable("blender"), "blender");
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);
   ASSERT_FALSE(scene.shots.empty());

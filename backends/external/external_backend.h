@@ -53,7 +53,7 @@ bool write_texture_png(const std::filesystem::path& path, const ir::Texture& tex
                        std::string* error);
 
 // The light a renderer's file holds per unit: both POV-Ray and Cycles write Blender's
-// radiometric units, and 1 W/(m²·sr) of linear Y is 683 cd/m² (docs/camera-model.md).
-inline constexpr double kCandelaPerBlenderUnit = 683.0;
+// radiometric units, in which 1 W/(m²·sr) of linear Y is ir::kLumensPerWatt cd/m².
+inline constexpr double kCandelaPerBlenderUnit = ir::kLumensPerWatt;
 
 }  // namespace rigc::external

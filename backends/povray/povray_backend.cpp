@@ -20,9 +20,9 @@
 
 namespace rigc::povray {
 
-// CAMERA.md's reading of the 3.7 source (pupil radius = aperture/4, so aperture = 2·f/N),
-// confirmed by a render: ReferenceAgreement.DefocusBlurWidth gives a defocused edge 3.88 px wide
-// in POV-Ray against 3.81 px in Cycles (whose pupil is f/N by definition), for a 6.3 px disc.
+// POV-Ray 3.7's focal blur takes a pupil radius of aperture/4, so aperture = 2·f/N
+// (docs/camera-model.md); ReferenceAgreement.DefocusBlurWidth checks it against Cycles, whose
+// pupil is f/N by definition.
 const double kApertureMetersPerPupilDiameter = 2.0;
 
 namespace {
@@ -291,7 +291,7 @@ std::string shot_ini(const ir::Shot& shot, const dslr::Intrinsics& canvas, int s
       "Jitter=off\nDisplay=off\nPause_When_Done=off\nVerbose=off\n",
       canvas.width, canvas.height,
       // Focal blur already spreads its samples over the pixel; antialiasing on top of it would
-      // multiply the rays (a 198 px shot took 46 s instead of 11 s).
+      // multiply the rays.
       focal_blur && !mask ? "off" : "on", mask ? 3 : antialias_depth(samples));
   return text;
 }

@@ -151,7 +151,7 @@ TEST(PovrayRun, MissingExecutableNamesThePackage) {
 // and its log, finishes the others and exits 2; the rerun renders only the failed shot.
 TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
   const auto real = external::find_executable("povray");
-  if (!real) GTEST_SKIP() << "povray is not installed";
+  RIGC_REQUIRE_TOOL(real, "povray");
   ir::Scene scene = paper_scene();
   scene.camera.effects.depth_of_field = false;
   TempDir dir;
@@ -191,7 +191,7 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
 }
 
 TEST(PovrayRun, HostileMeshPathRendersWithoutRunningAnything) {
-  if (!external::find_executable("povray")) GTEST_SKIP() << "povray is not installed";
+  RIGC_REQUIRE_TOOL(external::find_executable("povray"), "povray");
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);
   ASSERT_FALSE(scene.shots.empty());

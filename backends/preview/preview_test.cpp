@@ -124,7 +124,7 @@ TEST(Preview, ExposureFollowsShutterApertureAndIso) {
 }
 
 // A white Lambertian ball under a known illuminance has luminance L = ρE/π; its signal must be
-// the CAMERA.md exposure equation of that L.
+// the exposure equation of that L (docs/camera-model.md).
 TEST(Preview, AbsoluteSignalMatchesTheExposureEquation) {
   ir::Scene scene =
       compile(ball_scene("}", "  - pose: {position: [0, -0.3m, 0.505m], look_at: object}\n"));
