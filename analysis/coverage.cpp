@@ -1,5 +1,6 @@
 #include "analysis/coverage.h"
 
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 
 #include "compiler/color.h"
 #include "dslr/exposure.h"
@@ -16,6 +18,15 @@
 #include "raster/rasterizer.h"
 
 namespace rigc::analysis {
+
+bool CoverageOptions::check(std::string* error) const {
+  if (visibility_scale == 0 || (visibility_scale >= 0.01 && visibility_scale <= 1)) return true;
+  if (error) {
+    *error = fmt::format("visibility_scale {} is neither 0 (automatic) nor within 0.01..1",
+                         visibility_scale);
+  }
+  return false;
+}
 
 namespace {
 
@@ -458,6 +469,8 @@ ShotCoverage CoverageAnalysis::summarise_shot(const ShotView& view, const ShotAr
 
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options) {
+  std::string error;
+  if (!options.check(&error)) throw std::invalid_argument(error);
   return CoverageAnalysis(scene, studio, options).run();
 }
 

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <string>
 
 #include "analysis/coverage.h"
 #include "compiler/frontend.h"
@@ -15,9 +16,16 @@
 
 int main(int argc, char** argv) {
   rigc::keep_freed_memory();  // as the rigc command does
-  double visibility_scale = 0;
+  rigc::analysis::CoverageOptions options;
   for (int i = 1; i + 1 < argc; ++i) {
-    if (!std::strcmp(argv[i], "--visibility-scale")) visibility_scale = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--visibility-scale")) {
+      options.visibility_scale = std::atof(argv[i + 1]);
+    }
+  }
+  std::string error;
+  if (!options.check(&error)) {
+    std::cerr << "coverage_table: " << error << '\n';
+    return 2;
   }
   std::cout << fmt::format("{:<10} {:>10} {:>8} {:>10} {:>10} {:>8}\n", "detail", "triangles",
                            "shots", "prepare s", "analyse s", ">=2 %");
@@ -41,8 +49,6 @@ shots:
     const auto t0 = std::chrono::steady_clock::now();
     const rigc::scene::StudioScene studio = rigc::scene::prepare_studio_scene(*scene);
     const auto t1 = std::chrono::steady_clock::now();
-    rigc::analysis::CoverageOptions options;
-    options.visibility_scale = visibility_scale;
     const auto coverage = rigc::analysis::analyse_coverage(*scene, studio, options);
     const auto t2 = std::chrono::steady_clock::now();
     std::cout << fmt::format("{:<10} {:>10} {:>8} {:>10.2f} {:>10.2f} {:>8.1f}\n", detail,
