@@ -192,8 +192,8 @@ TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
   EXPECT_EQ(usual.warnings.find(expected), std::string::npos) << usual.warnings;
 }
 
-// The over-exposure advice names a shutter; taking it, the warning goes (it said "one stop" at
-// any setting, at 30 s too, where nine were needed).
+// The over-exposure advice names a shutter; taking it, the warning goes, however many stops over
+// the exposure is (about nine at 30 s).
 TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {
   for (const char* shutter : {"30", "1/2", "1/15"}) {
     Analysed a = analyse(scene_text(
