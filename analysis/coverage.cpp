@@ -1,5 +1,6 @@
 #include "analysis/coverage.h"
 
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -7,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
 
 #include "compiler/color.h"
 #include "dslr/exposure.h"
@@ -15,6 +18,16 @@
 #include "raster/rasterizer.h"
 
 namespace rigc::analysis {
+
+bool CoverageOptions::check(std::string* error) const {
+  if (visibility_scale == 0 || (visibility_scale >= 0.01 && visibility_scale <= 1)) return true;
+  if (error) {
+    *error = fmt::format("visibility_scale {} is neither 0 (automatic) nor within 0.01..1",
+                         visibility_scale);
+  }
+  return false;
+}
+
 namespace {
 
 using Eigen::Vector3d;
@@ -23,14 +36,65 @@ using Eigen::Vector3f;
 constexpr int kBlurBins = 1000;  // histogram of blur / max_blur, 0..10
 constexpr double kBlurBinWidth = 0.01;
 
-struct ShotSums {
-  double visible = 0, fresh = 0, overlap = 0, out_of_focus = 0, clipped = 0, dark = 0, oblique = 0,
-         coarse = 0;
-  double seen_gain[4] = {0, 0, 0, 0};  // area whose view count reached 1, 2, 3 in this shot
-  double reconstructable_gain = 0;
-  double nearest = 1e30;
-  std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
+// Areas (m²) of one shot's visible surface, summed per thread and then over the threads.
+struct ShotAreas {
+  double visible = 0, fresh = 0, overlap = 0;
+  double out_of_focus = 0, clipped = 0, dark = 0, oblique = 0, coarse = 0;
+  double nearest_depth_m = 1e30;
   std::vector<double> signal_histogram = std::vector<double>(ShotCoverage::kSignalBins, 0.0);
+
+  void add(const ShotAreas& part) {
+    visible += part.visible;
+    fresh += part.fresh;
+    overlap += part.overlap;
+    out_of_focus += part.out_of_focus;
+    clipped += part.clipped;
+    dark += part.dark;
+    oblique += part.oblique;
+    coarse += part.coarse;
+    nearest_depth_m = std::min(nearest_depth_m, part.nearest_depth_m);
+    for (int b = 0; b < ShotCoverage::kSignalBins; ++b) {
+      signal_histogram[b] += part.signal_histogram[b];
+    }
+  }
+};
+
+// What one shot adds to the totals over all shots so far (m²).
+struct CumulativeGain {
+  double seen[4] = {0, 0, 0, 0};  // area whose view count reached 1, 2, 3 in this shot
+  double reconstructable = 0;
+  std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
+};
+
+// One thread's sums over the faces it visited in a shot.
+struct ShotSums {
+  ShotAreas areas;
+  CumulativeGain gain;
+};
+
+// Totals over all shots so far.
+struct CumulativeTotals {
+  double seen_area[4] = {0, 0, 0, 0};  // area seen by at least 1, 2, 3 shots (index = views)
+  double reconstructable_area = 0;
+  std::vector<double> blur_histogram = std::vector<double>(kBlurBins + 1, 0.0);
+
+  void add(const CumulativeGain& part) {
+    for (int k = 1; k <= 3; ++k) seen_area[k] += part.seen[k];
+    reconstructable_area += part.reconstructable;
+    for (int b = 0; b <= kBlurBins; ++b) blur_histogram[b] += part.blur_histogram[b];
+  }
+
+  // The blur (a multiple of max_blur_px) that 95 % of the seen surface stays within.
+  double blur_ratio_95() const {
+    double histogram_total = 0;
+    for (double a : blur_histogram) histogram_total += a;
+    double running = 0;
+    for (int b = 0; b <= kBlurBins; ++b) {
+      running += blur_histogram[b];
+      if (running >= 0.95 * histogram_total) return (b + 1) * kBlurBinWidth;
+    }
+    return 0;
+  }
 };
 
 // Mean albedo luminance of each face: material colour, texture average, pattern average.
@@ -56,224 +120,358 @@ std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene&
   return albedo;
 }
 
+// One shot as the analysis needs it: the camera and the turntable in the object frame, and what
+// the camera sees (a visibility buffer at the reduced canvas).
+struct ShotView {
+  int index = 0;
+  const ir::Shot* shot = nullptr;
+  raster::VisibilityBuffer buffer;
+  Eigen::Matrix3d camera_rotation;  // camera_from_object
+  Vector3d camera_translation;
+  Vector3d eye;                    // camera centre, object frame
+  Eigen::Matrix3d world_rotation;  // world_from_object at the shot's turntable angle
+  Vector3d world_translation;
+
+  Vector3d to_camera(const Vector3d& object_point) const {
+    return camera_rotation * object_point + camera_translation;
+  }
+};
+
+// A face as one shot sees it: the quantities the usability tests judge.
+struct FaceView {
+  double pixels_per_mm2 = 0;  // footprint on the sensor at full resolution per mm² of surface
+  double cos_view = 0;        // cosine of the angle between the normal and the line of sight
+  double blur_px = 0;         // circle of confusion in sensor pixels
+  double signal = 0;          // in the units of min_signal and max_signal (clipping)
+};
+
+// Why SfM cannot use a view of a face (all false: it can).
+struct ViewFaults {
+  bool out_of_focus = false, clipped = false, dark = false, oblique = false, coarse = false;
+  bool any() const { return out_of_focus || clipped || dark || oblique || coarse; }
+};
+
+// The whole analysis: per shot, per face visibility, usability and triangulation; the per-face
+// state persists across shots (view counts, usable views by shot).
+class CoverageAnalysis {
+ public:
+  CoverageAnalysis(const ir::Scene& scene, const scene::StudioScene& studio,
+                   const CoverageOptions& options);
+  CoverageResult run();  // once
+
+ private:
+  void measure_faces();
+  ShotView view_shot(int s) const;
+  ShotAreas analyse_faces(const ShotView& view);
+  void analyse_face(const ShotView& view, size_t f, ShotSums& sum);
+  std::optional<double> visible_depth(const ShotView& view, size_t f, const Vector3d& to_eye) const;
+  void count_view(int s, size_t f, double depth_m, ShotAreas& areas, CumulativeGain& gain);
+  FaceView measure_face_view(const ShotView& view, size_t f, const Vector3d& to_eye,
+                             double depth_m) const;
+  double footprint_px(const ShotView& view, size_t f) const;
+  double face_signal(const ShotView& view, size_t f) const;
+  void add_to_histograms(const FaceView& face, double area, ShotSums& sum) const;
+  ViewFaults judge(const FaceView& face) const;
+  bool triangulates_with_earlier_shot(int s, size_t f, const Vector3d& to_eye) const;
+  ShotCoverage summarise_shot(const ShotView& view, const ShotAreas& areas) const;
+
+  const ir::Scene& scene_;
+  const scene::StudioScene& studio_;
+  const ir::Camera& camera_;
+  const ir::CoverageSettings& settings_;
+  const scene::Geometry& mesh_;
+  const size_t face_count_;
+  const int shot_count_;
+  const dslr::Intrinsics canvas_;
+  const double pixel_pitch_m_;
+  const double exposure_;
+  const double cos_max_angle_;
+  const double cos_min_triangulation_;
+
+  CoverageResult result_;
+  std::vector<Vector3d> center_, normal_;  // object frame
+  std::vector<float> albedo_;
+  // usable_by_shot_[s][f]: face f has a usable view in shot s (for triangulation pairs).
+  std::vector<std::vector<std::uint8_t>> usable_by_shot_;
+  std::vector<std::uint8_t> seen_previous_, seen_now_;
+  std::vector<Vector3d> eye_by_shot_;  // camera centres, object frame
+  CumulativeTotals totals_;
+};
+
+double visibility_scale(const CoverageOptions& options, const ir::Camera& camera) {
+  return options.visibility_scale > 0 ? options.visibility_scale
+                                      : std::min(1.0, 1400.0 / camera.width_px);
+}
+
+CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioScene& studio,
+                                   const CoverageOptions& options)
+    : scene_(scene),
+      studio_(studio),
+      camera_(scene.camera),
+      settings_(scene.coverage),
+      mesh_(studio.object),
+      face_count_(mesh_.triangles.size()),
+      shot_count_(static_cast<int>(scene.shots.size())),
+      canvas_(dslr::sensor_intrinsics(camera_, visibility_scale(options, camera_))),
+      pixel_pitch_m_(camera_.sensor_width_m / camera_.width_px),
+      exposure_(dslr::exposure_scale(camera_)),
+      cos_max_angle_(std::cos(settings_.max_view_angle_rad)),
+      cos_min_triangulation_(std::cos(settings_.min_triangulation_angle_rad)),
+      usable_by_shot_(shot_count_),
+      seen_previous_(face_count_, 0),
+      seen_now_(face_count_, 0),
+      eye_by_shot_(shot_count_) {}
+
+CoverageResult CoverageAnalysis::run() {
+  measure_faces();
+  albedo_ = face_albedo(scene_, studio_);
+  for (int s = 0; s < shot_count_; ++s) {
+    const ShotView view = view_shot(s);
+    result_.shots.push_back(summarise_shot(view, analyse_faces(view)));
+    std::swap(seen_previous_, seen_now_);
+  }
+  result_.blur_ratio_95 = totals_.blur_ratio_95();
+  return std::move(result_);
+}
+
+// Every face in one shot, in parallel; returns the shot's areas and adds its gains to the
+// totals.
+ShotAreas CoverageAnalysis::analyse_faces(const ShotView& view) {
+  eye_by_shot_[view.index] = view.eye;
+  usable_by_shot_[view.index].assign(face_count_, 0);
+  tbb::enumerable_thread_specific<ShotSums> sums;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, face_count_, 2048),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      ShotSums& sum = sums.local();
+                      for (size_t f = range.begin(); f != range.end(); ++f) {
+                        analyse_face(view, f, sum);
+                      }
+                    });
+  ShotAreas areas;
+  for (const ShotSums& part : sums) {
+    areas.add(part.areas);
+    totals_.add(part.gain);
+  }
+  return areas;
+}
+
+// Area, centre and normal of every face; the faces resting on the turntable.
+void CoverageAnalysis::measure_faces() {
+  result_.face_area_m2.resize(face_count_);
+  result_.views.assign(face_count_, 0);
+  result_.usable_views.assign(face_count_, 0);
+  result_.reconstructable.assign(face_count_, 0);
+  result_.resting.assign(face_count_, 0);
+  result_.first_seen.assign(face_count_, CoverageResult::kNever);
+  result_.second_seen.assign(face_count_, CoverageResult::kNever);
+  center_.resize(face_count_);
+  normal_.resize(face_count_);
+  for (size_t f = 0; f < face_count_; ++f) {
+    const auto& t = mesh_.triangles[f];
+    const Vector3d a = mesh_.positions[t[0]].cast<double>(),
+                   b = mesh_.positions[t[1]].cast<double>(),
+                   c = mesh_.positions[t[2]].cast<double>();
+    const Vector3d cross = (b - a).cross(c - a);
+    result_.face_area_m2[f] = cross.norm() / 2;
+    normal_[f] = cross.norm() > 0 ? Vector3d(cross.normalized()) : Vector3d::UnitZ();
+    center_[f] = (a + b + c) / 3;
+    // Faces on the table top, facing down: the turntable hides them from every camera.
+    result_.resting[f] = normal_[f].z() < -0.9 && center_[f].z() < 0.002;
+    result_.total_area_m2 += result_.face_area_m2[f];
+  }
+}
+
+ShotView CoverageAnalysis::view_shot(int s) const {
+  const ir::Shot& shot = scene_.shots[s];
+  ShotView view;
+  view.index = s;
+  view.shot = &shot;
+  raster::FrameRequest request;
+  request.world_from_camera = shot.world_from_camera;
+  request.turntable_angle_rad = shot.turntable_angle_rad;
+  request.canvas = canvas_;
+  view.buffer = raster::render_visibility(scene_, studio_, request);
+  const ir::Mat4 camera_from_object = shot.object_from_camera.inverse();
+  view.camera_rotation = camera_from_object.block<3, 3>(0, 0);
+  view.camera_translation = camera_from_object.block<3, 1>(0, 3);
+  view.eye = shot.object_from_camera.block<3, 1>(0, 3);
+  const ir::Mat4 world_from_object = ir::world_from_object(scene_, shot.turntable_angle_rad);
+  view.world_rotation = world_from_object.block<3, 3>(0, 0);
+  view.world_translation = world_from_object.block<3, 1>(0, 3);
+  return view;
+}
+
+void CoverageAnalysis::analyse_face(const ShotView& view, size_t f, ShotSums& sum) {
+  seen_now_[f] = 0;
+  const Vector3d to_eye = view.eye - center_[f];
+  const std::optional<double> depth_m = visible_depth(view, f, to_eye);
+  if (!depth_m) return;
+  seen_now_[f] = 1;
+  count_view(view.index, f, *depth_m, sum.areas, sum.gain);
+
+  const double area = result_.face_area_m2[f];
+  const FaceView face = measure_face_view(view, f, to_eye, *depth_m);
+  add_to_histograms(face, area, sum);
+  const ViewFaults faults = judge(face);
+  if (faults.out_of_focus) sum.areas.out_of_focus += area;
+  if (faults.clipped) sum.areas.clipped += area;
+  if (faults.dark) sum.areas.dark += area;
+  if (faults.oblique) sum.areas.oblique += area;
+  if (faults.coarse) sum.areas.coarse += area;
+  if (faults.any()) return;
+
+  usable_by_shot_[view.index][f] = 1;
+  ++result_.usable_views[f];
+  if (result_.reconstructable[f]) return;
+  if (triangulates_with_earlier_shot(view.index, f, to_eye)) {
+    result_.reconstructable[f] = 1;
+    sum.gain.reconstructable += area;
+  }
+}
+
+// The depth of the face's centre if the camera sees it: facing the camera, in front of it, inside
+// the canvas, and not hidden.
+std::optional<double> CoverageAnalysis::visible_depth(const ShotView& view, size_t f,
+                                                      const Vector3d& to_eye) const {
+  if (normal_[f].dot(to_eye) <= 0) return std::nullopt;
+  const Vector3d p = view.to_camera(center_[f]);
+  if (p.z() <= 0.01) return std::nullopt;
+  const double u = canvas_.fx * p.x() / p.z() + canvas_.cx;
+  const double v = canvas_.fy * p.y() / p.z() + canvas_.cy;
+  if (u < 0 || v < 0 || u >= canvas_.width || v >= canvas_.height) return std::nullopt;
+  const size_t pixel = static_cast<size_t>(v) * canvas_.width + static_cast<size_t>(u);
+  // The face's own triangle at its centre pixel, or a surface at the same depth there (faces
+  // smaller than a pixel of the buffer).
+  const bool visible = view.buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
+                       p.z() <= view.buffer.depth_m[pixel] * 1.004 + 0.0015;
+  if (!visible) return std::nullopt;
+  return p.z();
+}
+
+// Records that shot `s` sees face `f`: view counts, first and second sighting, new and
+// overlapping area.
+void CoverageAnalysis::count_view(int s, size_t f, double depth_m, ShotAreas& areas,
+                                  CumulativeGain& gain) {
+  const double area = result_.face_area_m2[f];
+  areas.visible += area;
+  if (result_.views[f] == 0) areas.fresh += area;
+  if (seen_previous_[f]) areas.overlap += area;
+  if (result_.views[f] == 0) result_.first_seen[f] = static_cast<std::uint16_t>(s);
+  if (result_.views[f] == 1) result_.second_seen[f] = static_cast<std::uint16_t>(s);
+  areas.nearest_depth_m = std::min(areas.nearest_depth_m, depth_m);
+  ++result_.views[f];
+  if (result_.views[f] <= 3) gain.seen[result_.views[f]] += area;
+}
+
+FaceView CoverageAnalysis::measure_face_view(const ShotView& view, size_t f, const Vector3d& to_eye,
+                                             double depth_m) const {
+  FaceView face;
+  face.pixels_per_mm2 = footprint_px(view, f) / std::max(result_.face_area_m2[f] * 1e6, 1e-12);
+  face.cos_view = normal_[f].dot(to_eye.normalized());
+  face.blur_px = dslr::coc_diameter_m(camera_.focal_length_m, camera_.aperture_f_number,
+                                      view.shot->focus_distance_m, depth_m) /
+                 pixel_pitch_m_;
+  face.signal = face_signal(view, f);
+  return face;
+}
+
+// The face's area on the sensor in pixels, at full resolution.
+double CoverageAnalysis::footprint_px(const ShotView& view, size_t f) const {
+  const auto& t = mesh_.triangles[f];
+  std::array<Eigen::Vector2d, 3> corner;
+  for (int k = 0; k < 3; ++k) {
+    const Vector3d q = view.to_camera(mesh_.positions[t[k]].cast<double>());
+    corner[k] = {camera_.fx * q.x() / q.z(), camera_.fy * q.y() / q.z()};
+  }
+  const Eigen::Vector2d e1 = corner[1] - corner[0], e2 = corner[2] - corner[0];
+  return std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 2;
+}
+
+// The sensor signal of a diffuse face: albedo x illuminance / pi x exposure (see
+// docs/camera-model.md).
+double CoverageAnalysis::face_signal(const ShotView& view, size_t f) const {
+  const Vector3f world_center =
+      (view.world_rotation * center_[f] + view.world_translation).cast<float>();
+  const Vector3f world_normal = (view.world_rotation * normal_[f]).cast<float>();
+  double illuminance = scene_.studio.ambient_lx;
+  for (const auto& light : scene_.studio.lights) {
+    illuminance +=
+        luminance(raster::light_illuminance(light, world_center, world_normal).cast<double>());
+  }
+  return albedo_[f] * illuminance / std::numbers::pi * exposure_;
+}
+
+void CoverageAnalysis::add_to_histograms(const FaceView& face, double area, ShotSums& sum) const {
+  const int blur_bin =
+      std::min(kBlurBins, static_cast<int>(face.blur_px / settings_.max_blur_px / kBlurBinWidth));
+  sum.gain.blur_histogram[blur_bin] += area;
+  // A signal that is not a number (no light data) counts as the darkest.
+  const double stops_over = std::isfinite(face.signal)
+                                ? std::log2(std::max(face.signal, 1e-300) / settings_.max_signal)
+                                : ShotCoverage::kSignalLowestStops;
+  const int signal_bin = static_cast<int>(std::clamp(
+      std::floor((stops_over - ShotCoverage::kSignalLowestStops) / ShotCoverage::kSignalBinStops),
+      0.0, ShotCoverage::kSignalBins - 1.0));
+  sum.areas.signal_histogram[signal_bin] += area;
+}
+
+// The usability tests: resolution on the surface, viewing angle, focus, exposure.
+ViewFaults CoverageAnalysis::judge(const FaceView& face) const {
+  ViewFaults faults;
+  faults.out_of_focus = !(face.blur_px <= settings_.max_blur_px);
+  faults.clipped = face.signal > settings_.max_signal;
+  faults.dark = face.signal < settings_.min_signal;
+  faults.oblique = face.cos_view < cos_max_angle_;
+  faults.coarse = face.pixels_per_mm2 < settings_.min_pixels_per_mm2;
+  return faults;
+}
+
+// Whether a usable view of face `f` in an earlier shot sees it from a direction at least the
+// minimum triangulation angle away from shot `s`'s.
+bool CoverageAnalysis::triangulates_with_earlier_shot(int s, size_t f,
+                                                      const Vector3d& to_eye) const {
+  const Vector3d ray = to_eye.normalized();
+  for (int earlier = 0; earlier < s; ++earlier) {
+    if (!usable_by_shot_[earlier][f]) continue;
+    if (ray.dot((eye_by_shot_[earlier] - center_[f]).normalized()) <= cos_min_triangulation_) {
+      return true;
+    }
+  }
+  return false;
+}
+
+ShotCoverage CoverageAnalysis::summarise_shot(const ShotView& view, const ShotAreas& areas) const {
+  ShotCoverage coverage;
+  coverage.signal_histogram = areas.signal_histogram;
+  coverage.shot = view.index;
+  coverage.visible_area_m2 = areas.visible;
+  coverage.new_area_m2 = areas.fresh;
+  const double visible = std::max(areas.visible, 1e-30);
+  coverage.overlap_with_previous = view.index > 0 ? areas.overlap / visible : 0;
+  coverage.out_of_focus = areas.out_of_focus / visible;
+  coverage.clipped = areas.clipped / visible;
+  coverage.too_dark = areas.dark / visible;
+  coverage.too_oblique = areas.oblique / visible;
+  coverage.too_coarse = areas.coarse / visible;
+  coverage.nearest_depth_m = areas.nearest_depth_m;
+  size_t object_pixels = 0;
+  for (const auto id : view.buffer.object_triangle) object_pixels += id >= 0;
+  coverage.frame_fill = static_cast<double>(object_pixels) / view.buffer.object_triangle.size();
+  const double total_area = std::max(result_.total_area_m2, 1e-30);
+  coverage.seen_1 = totals_.seen_area[1] / total_area;
+  coverage.seen_2 = totals_.seen_area[2] / total_area;
+  coverage.seen_3 = totals_.seen_area[3] / total_area;
+  coverage.reconstructable = totals_.reconstructable_area / total_area;
+  return coverage;
+}
+
 }  // namespace
 
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options) {
-  const ir::Camera& camera = scene.camera;
-  const ir::CoverageSettings& settings = scene.coverage;
-  const scene::Geometry& mesh = studio.object;
-  const size_t face_count = mesh.triangles.size();
-  const int shot_count = static_cast<int>(scene.shots.size());
-
-  CoverageResult result;
-  result.face_area_m2.resize(face_count);
-  result.views.assign(face_count, 0);
-  result.usable_views.assign(face_count, 0);
-  result.reconstructable.assign(face_count, 0);
-  result.resting.assign(face_count, 0);
-  result.first_seen.assign(face_count, CoverageResult::kNever);
-  result.second_seen.assign(face_count, CoverageResult::kNever);
-  std::vector<Vector3d> center(face_count), normal(face_count);
-  for (size_t f = 0; f < face_count; ++f) {
-    const auto& t = mesh.triangles[f];
-    const Vector3d a = mesh.positions[t[0]].cast<double>(), b = mesh.positions[t[1]].cast<double>(),
-                   c = mesh.positions[t[2]].cast<double>();
-    const Vector3d cross = (b - a).cross(c - a);
-    result.face_area_m2[f] = cross.norm() / 2;
-    normal[f] = cross.norm() > 0 ? Vector3d(cross.normalized()) : Vector3d::UnitZ();
-    center[f] = (a + b + c) / 3;
-    // Faces on the table top, facing down: the turntable hides them from every camera.
-    result.resting[f] = normal[f].z() < -0.9 && center[f].z() < 0.002;
-    result.total_area_m2 += result.face_area_m2[f];
-  }
-  const std::vector<float> albedo = face_albedo(scene, studio);
-
-  const double visibility_scale = options.visibility_scale > 0
-                                      ? options.visibility_scale
-                                      : std::min(1.0, 1400.0 / camera.width_px);
-  const dslr::Intrinsics canvas = dslr::sensor_intrinsics(camera, visibility_scale);
-  const double pixel_pitch_m = camera.sensor_width_m / camera.width_px;
-  const double exposure = dslr::exposure_scale(camera);
-
-  // usable_by_shot[s][f]: face f has a usable view in shot s (for triangulation pairs).
-  std::vector<std::vector<std::uint8_t>> usable_by_shot(shot_count);
-  std::vector<std::uint8_t> seen_previous(face_count, 0), seen_now(face_count, 0);
-  std::vector<Vector3d> eye_object(shot_count);
-  std::vector<double> blur_histogram(kBlurBins + 1, 0.0);
-  const double cos_max_angle = std::cos(settings.max_view_angle_rad);
-  const double cos_min_triangulation = std::cos(settings.min_triangulation_angle_rad);
-  double seen_area[4] = {0, 0, 0, 0}, reconstructable_area = 0;
-
-  for (int s = 0; s < shot_count; ++s) {
-    const ir::Shot& shot = scene.shots[s];
-    raster::FrameRequest request;
-    request.world_from_camera = shot.world_from_camera;
-    request.turntable_angle_rad = shot.turntable_angle_rad;
-    request.canvas = canvas;
-    const raster::VisibilityBuffer buffer = raster::render_visibility(scene, studio, request);
-    const ir::Mat4 camera_from_object = shot.object_from_camera.inverse();
-    const Eigen::Matrix3d rotation = camera_from_object.block<3, 3>(0, 0);
-    const Vector3d translation = camera_from_object.block<3, 1>(0, 3);
-    eye_object[s] = shot.object_from_camera.block<3, 1>(0, 3);
-    const ir::Mat4 world_from_object = ir::world_from_object(scene, shot.turntable_angle_rad);
-    const Eigen::Matrix3d world_rotation = world_from_object.block<3, 3>(0, 0);
-    const Vector3d world_translation = world_from_object.block<3, 1>(0, 3);
-    usable_by_shot[s].assign(face_count, 0);
-
-    tbb::enumerable_thread_specific<ShotSums> sums;
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, face_count, 2048),
-        [&](const tbb::blocked_range<size_t>& range) {
-          ShotSums& sum = sums.local();
-          for (size_t f = range.begin(); f != range.end(); ++f) {
-            seen_now[f] = 0;
-            const Vector3d to_eye = eye_object[s] - center[f];
-            if (normal[f].dot(to_eye) <= 0) continue;
-            const Vector3d p = rotation * center[f] + translation;
-            if (p.z() <= 0.01) continue;
-            const double u = canvas.fx * p.x() / p.z() + canvas.cx;
-            const double v = canvas.fy * p.y() / p.z() + canvas.cy;
-            if (u < 0 || v < 0 || u >= canvas.width || v >= canvas.height) continue;
-            const size_t pixel = static_cast<size_t>(v) * canvas.width + static_cast<size_t>(u);
-            // The face's own triangle at its centre pixel, or a surface at the same depth there
-            // (faces smaller than a pixel of the buffer).
-            const bool visible = buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
-                                 p.z() <= buffer.depth_m[pixel] * 1.004 + 0.0015;
-            if (!visible) continue;
-            seen_now[f] = 1;
-            const double area = result.face_area_m2[f];
-            sum.visible += area;
-            if (result.views[f] == 0) sum.fresh += area;
-            if (seen_previous[f]) sum.overlap += area;
-            if (result.views[f] == 0) result.first_seen[f] = static_cast<std::uint16_t>(s);
-            if (result.views[f] == 1) result.second_seen[f] = static_cast<std::uint16_t>(s);
-            sum.nearest = std::min(sum.nearest, p.z());
-            ++result.views[f];
-            if (result.views[f] <= 3) sum.seen_gain[result.views[f]] += area;
-
-            // Footprint at full resolution.
-            const auto& t = mesh.triangles[f];
-            std::array<Eigen::Vector2d, 3> corner;
-            for (int k = 0; k < 3; ++k) {
-              const Vector3d q = rotation * mesh.positions[t[k]].cast<double>() + translation;
-              corner[k] = {camera.fx * q.x() / q.z(), camera.fy * q.y() / q.z()};
-            }
-            const Eigen::Vector2d e1 = corner[1] - corner[0], e2 = corner[2] - corner[0];
-            const double footprint_px = std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 2;
-            const double pixels_per_mm2 = footprint_px / std::max(area * 1e6, 1e-12);
-            const double cos_view = normal[f].dot(to_eye.normalized());
-            const double blur_px =
-                dslr::coc_diameter_m(camera.focal_length_m, camera.aperture_f_number,
-                                     shot.focus_distance_m, p.z()) /
-                pixel_pitch_m;
-            const int bin = std::min(
-                kBlurBins, static_cast<int>(blur_px / settings.max_blur_px / kBlurBinWidth));
-            sum.blur_histogram[bin] += area;
-            const Vector3f world_center =
-                (world_rotation * center[f] + world_translation).cast<float>();
-            const Vector3f world_normal = (world_rotation * normal[f]).cast<float>();
-            double illuminance = scene.studio.ambient_lx;
-            for (const auto& light : scene.studio.lights) {
-              illuminance += luminance(
-                  raster::light_illuminance(light, world_center, world_normal).cast<double>());
-            }
-            const double signal = albedo[f] * illuminance / std::numbers::pi * exposure;
-
-            // A signal that is not a number (no light data) counts as the darkest.
-            const double stops_over =
-                std::isfinite(signal) ? std::log2(std::max(signal, 1e-300) / settings.max_signal)
-                                      : ShotCoverage::kSignalLowestStops;
-            const int signal_bin = static_cast<int>(
-                std::clamp(std::floor((stops_over - ShotCoverage::kSignalLowestStops) /
-                                      ShotCoverage::kSignalBinStops),
-                           0.0, ShotCoverage::kSignalBins - 1.0));
-            sum.signal_histogram[signal_bin] += area;
-
-            const bool in_focus = blur_px <= settings.max_blur_px;
-            const bool clipped = signal > settings.max_signal;
-            const bool dark = signal < settings.min_signal;
-            const bool oblique = cos_view < cos_max_angle;
-            const bool coarse = pixels_per_mm2 < settings.min_pixels_per_mm2;
-            if (!in_focus) sum.out_of_focus += area;
-            if (clipped) sum.clipped += area;
-            if (dark) sum.dark += area;
-            if (oblique) sum.oblique += area;
-            if (coarse) sum.coarse += area;
-            if (!in_focus || clipped || dark || oblique || coarse) continue;
-
-            usable_by_shot[s][f] = 1;
-            ++result.usable_views[f];
-            if (result.reconstructable[f]) continue;
-            const Vector3d ray = to_eye.normalized();
-            for (int earlier = 0; earlier < s; ++earlier) {
-              if (!usable_by_shot[earlier][f]) continue;
-              if (ray.dot((eye_object[earlier] - center[f]).normalized()) <=
-                  cos_min_triangulation) {
-                result.reconstructable[f] = 1;
-                sum.reconstructable_gain += area;
-                break;
-              }
-            }
-          }
-        });
-
-    ShotSums total;
-    for (const ShotSums& part : sums) {
-      total.visible += part.visible;
-      total.fresh += part.fresh;
-      total.overlap += part.overlap;
-      total.out_of_focus += part.out_of_focus;
-      total.clipped += part.clipped;
-      total.dark += part.dark;
-      total.oblique += part.oblique;
-      total.coarse += part.coarse;
-      total.nearest = std::min(total.nearest, part.nearest);
-      for (int k = 1; k <= 3; ++k) seen_area[k] += part.seen_gain[k];
-      reconstructable_area += part.reconstructable_gain;
-      for (int b = 0; b <= kBlurBins; ++b) blur_histogram[b] += part.blur_histogram[b];
-      for (int b = 0; b < ShotCoverage::kSignalBins; ++b) {
-        total.signal_histogram[b] += part.signal_histogram[b];
-      }
-    }
-    ShotCoverage coverage;
-    coverage.signal_histogram = total.signal_histogram;
-    coverage.shot = s;
-    coverage.visible_area_m2 = total.visible;
-    coverage.new_area_m2 = total.fresh;
-    const double visible = std::max(total.visible, 1e-30);
-    coverage.overlap_with_previous = s > 0 ? total.overlap / visible : 0;
-    coverage.out_of_focus = total.out_of_focus / visible;
-    coverage.clipped = total.clipped / visible;
-    coverage.too_dark = total.dark / visible;
-    coverage.too_oblique = total.oblique / visible;
-    coverage.too_coarse = total.coarse / visible;
-    coverage.nearest_depth_m = total.nearest;
-    size_t object_pixels = 0;
-    for (const auto id : buffer.object_triangle) object_pixels += id >= 0;
-    coverage.frame_fill = static_cast<double>(object_pixels) / buffer.object_triangle.size();
-    const double total_area = std::max(result.total_area_m2, 1e-30);
-    // Running totals: the faces that gained a view or became reconstructable in this shot.
-    coverage.seen_1 = seen_area[1] / total_area;
-    coverage.seen_2 = seen_area[2] / total_area;
-    coverage.seen_3 = seen_area[3] / total_area;
-    coverage.reconstructable = reconstructable_area / total_area;
-    result.shots.push_back(coverage);
-    std::swap(seen_previous, seen_now);
-  }
-
-  // The blur that 95 % of the seen surface stays within.
-  double histogram_total = 0;
-  for (double a : blur_histogram) histogram_total += a;
-  double running = 0;
-  for (int b = 0; b <= kBlurBins; ++b) {
-    running += blur_histogram[b];
-    if (running >= 0.95 * histogram_total) {
-      result.blur_ratio_95 = (b + 1) * kBlurBinWidth;
-      break;
-    }
-  }
-  return result;
+  std::string error;
+  if (!options.check(&error)) throw std::invalid_argument(error);
+  return CoverageAnalysis(scene, studio, options).run();
 }
 
 }  // namespace rigc::analysis

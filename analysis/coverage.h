@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "ir/ir.h"
@@ -48,8 +49,13 @@ struct CoverageResult {
 
 struct CoverageOptions {
   // Scale of the visibility buffers relative to the sensor; footprints are always computed at
-  // full resolution. 0 picks about 1400 px across.
+  // full resolution. 0 picks about 1400 px across; otherwise 0.01..1 (smaller buffers are too
+  // coarse to tell which faces are hidden).
   double visibility_scale = 0;
+
+  // Whether every field holds a value the analysis takes; if not, says why in `error` (when
+  // given). analyse_coverage throws std::invalid_argument on options that fail it.
+  bool check(std::string* error = nullptr) const;
 };
 
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,

@@ -54,9 +54,14 @@ bool write_face_color_ply(const fs::path& path, const scene::Geometry& mesh,
   return rigc::write_file_atomically(path, data, error);
 }
 
-// GLB with the faces unwelded so each carries its own vertex colour (COLOR_0, linear).
-bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
-                          const std::vector<Vector3f>& colors, std::string* error) {
+// The faces unwelded so that each carries its own colour: three vertices per face, glTF axes.
+struct UnweldedFaces {
+  size_t vertex_count = 0;
+  std::vector<float> positions, normals, colors;                             // 3 floats per vertex
+  Vector3f lo = Vector3f::Constant(1e30f), hi = Vector3f::Constant(-1e30f);  // of the positions
+};
+
+UnweldedFaces unweld_faces(const scene::Geometry& mesh, const std::vector<Vector3f>& colors) {
   const size_t vertex_count = mesh.triangles.size() * 3;
   std::vector<float> positions, normals, vertex_colors;
   positions.reserve(vertex_count * 3);
@@ -80,31 +85,41 @@ bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
       vertex_colors.insert(vertex_colors.end(), {colors[f].x(), colors[f].y(), colors[f].z()});
     }
   }
+  return {vertex_count, std::move(positions), std::move(normals), std::move(vertex_colors), lo, hi};
+}
+
+// Appends `values` (3 floats per vertex) to the model's one buffer as a view and an accessor;
+// returns the accessor's index.
+int add_vec3_accessor(tinygltf::Model& model, tinygltf::Buffer& buffer,
+                      const std::vector<float>& values, size_t vertex_count) {
+  const size_t offset = buffer.data.size();
+  const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+  buffer.data.insert(buffer.data.end(), bytes, bytes + values.size() * sizeof(float));
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = offset;
+  view.byteLength = values.size() * sizeof(float);
+  view.target = TINYGLTF_TARGET_ARRAY_BUFFER;
+  model.bufferViews.push_back(view);
+  tinygltf::Accessor accessor;
+  accessor.bufferView = static_cast<int>(model.bufferViews.size()) - 1;
+  accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  accessor.count = vertex_count;
+  accessor.type = TINYGLTF_TYPE_VEC3;
+  model.accessors.push_back(accessor);
+  return static_cast<int>(model.accessors.size()) - 1;
+}
+
+// A glTF model of one mesh with per-vertex colours (COLOR_0, linear) and a matte material.
+tinygltf::Model face_color_model(const UnweldedFaces& faces) {
   tinygltf::Model model;
   tinygltf::Buffer buffer;
-  auto add_view = [&](const std::vector<float>& values) {
-    const size_t offset = buffer.data.size();
-    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    buffer.data.insert(buffer.data.end(), bytes, bytes + values.size() * sizeof(float));
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = offset;
-    view.byteLength = values.size() * sizeof(float);
-    view.target = TINYGLTF_TARGET_ARRAY_BUFFER;
-    model.bufferViews.push_back(view);
-    tinygltf::Accessor accessor;
-    accessor.bufferView = static_cast<int>(model.bufferViews.size()) - 1;
-    accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-    accessor.count = vertex_count;
-    accessor.type = TINYGLTF_TYPE_VEC3;
-    model.accessors.push_back(accessor);
-    return static_cast<int>(model.accessors.size()) - 1;
-  };
-  const int position_accessor = add_view(positions);
-  model.accessors[position_accessor].minValues = {lo.x(), lo.y(), lo.z()};
-  model.accessors[position_accessor].maxValues = {hi.x(), hi.y(), hi.z()};
-  const int normal_accessor = add_view(normals);
-  const int color_accessor = add_view(vertex_colors);
+  const int position_accessor =
+      add_vec3_accessor(model, buffer, faces.positions, faces.vertex_count);
+  model.accessors[position_accessor].minValues = {faces.lo.x(), faces.lo.y(), faces.lo.z()};
+  model.accessors[position_accessor].maxValues = {faces.hi.x(), faces.hi.y(), faces.hi.z()};
+  const int normal_accessor = add_vec3_accessor(model, buffer, faces.normals, faces.vertex_count);
+  const int color_accessor = add_vec3_accessor(model, buffer, faces.colors, faces.vertex_count);
   model.buffers.push_back(buffer);
   tinygltf::Material material;
   material.name = "coverage";
@@ -131,6 +146,13 @@ bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
   model.defaultScene = 0;
   model.asset.version = "2.0";
   model.asset.generator = "RigC coverage";
+  return model;
+}
+
+// GLB with the faces unwelded so each carries its own vertex colour. Atomic.
+bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
+                          const std::vector<Vector3f>& colors, std::string* error) {
+  tinygltf::Model model = face_color_model(unweld_faces(mesh, colors));
   const fs::path temporary = temporary_path_beside(path);
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToFile(&model, temporary.string(), true, true, false, true)) {
@@ -189,6 +211,152 @@ ir::Mat4 picture_camera(const ir::Scene& scene, const scene::StudioScene& studio
   return m;
 }
 
+// Each face's colour in the two colourings: paper colours and the heat map by view count.
+struct FaceColors {
+  std::vector<Vector3f> paper, heat;
+};
+
+FaceColors face_colors(const CoverageResult& coverage) {
+  const size_t faces = coverage.views.size();
+  int max_views = 1;
+  for (auto v : coverage.views) max_views = std::max<int>(max_views, v);
+  FaceColors colors{std::vector<Vector3f>(faces), std::vector<Vector3f>(faces)};
+  for (size_t f = 0; f < faces; ++f) {
+    colors.paper[f] = paper_color(coverage.views[f]);
+    colors.heat[f] = heat_color(coverage.views[f], max_views);
+  }
+  return colors;
+}
+
+// coverage.ply/.glb in paper colours, views.ply/.glb as the heat map.
+bool write_coverage_meshes(const fs::path& dir, const scene::Geometry& mesh,
+                           const FaceColors& colors, std::string* error) {
+  return write_face_color_ply(dir / "coverage.ply", mesh, colors.paper, error) &&
+         write_face_color_glb(dir / "coverage.glb", mesh, colors.paper, error) &&
+         write_face_color_ply(dir / "views.ply", mesh, colors.heat, error) &&
+         write_face_color_glb(dir / "views.glb", mesh, colors.heat, error);
+}
+
+// The pictures' canvas: 3:2, the camera's horizontal field of view.
+struct PictureFrame {
+  PictureFrame(const ir::Scene& scene, int picture_width)
+      : fov(2 * std::atan(0.5 * scene.camera.sensor_width_m / scene.camera.focal_length_m)),
+        width(picture_width),
+        height(picture_width * 2 / 3) {
+    request.canvas = {
+        width,       height,      width / (2 * std::tan(fov / 2)), width / (2 * std::tan(fov / 2)),
+        width / 2.0, height / 2.0};
+  }
+  double fov;
+  int width, height;
+  raster::FrameRequest request;  // turntable angle 0: the object on its own
+};
+
+// The object in paper colours from four sides, from above and from below.
+bool write_view_pictures(const fs::path& dir, const ir::Scene& scene,
+                         const scene::StudioScene& studio, const PictureFrame& frame,
+                         const std::vector<Vector3f>& paper, std::string* error) {
+  struct View {
+    const char* name;
+    double azimuth_deg, elevation_deg;
+  };
+  const View views[] = {{"front", -90, 20}, {"right", 0, 20}, {"back", 90, 20},
+                        {"left", 180, 20},  {"top", -90, 75}, {"below", -90, -30}};
+  raster::FrameRequest request = frame.request;
+  for (const auto& view : views) {
+    request.world_from_camera = picture_camera(scene, studio, view.azimuth_deg * M_PI / 180,
+                                               view.elevation_deg * M_PI / 180, frame.fov);
+    const auto rgb = raster::render_face_colors(scene, studio, request, paper);
+    if (!write_png(dir / fmt::format("view_{}.png", view.name), rgb, frame.width, frame.height,
+                   error)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Coverage growing shot by shot (paper colours of the views so far), from a fixed
+// three-quarter view.
+bool write_progress_pictures(const fs::path& dir, const ir::Scene& scene,
+                             const scene::StudioScene& studio, const CoverageResult& coverage,
+                             const PictureFrame& frame, std::string* error) {
+  raster::FrameRequest request = frame.request;
+  request.world_from_camera =
+      picture_camera(scene, studio, -60 * M_PI / 180, 25 * M_PI / 180, frame.fov);
+  const size_t faces = coverage.views.size();
+  for (size_t s = 0; s < coverage.shots.size(); ++s) {
+    std::vector<Vector3f> colors(faces);
+    for (size_t f = 0; f < faces; ++f) {
+      const int views_so_far = (coverage.first_seen[f] <= s) + (coverage.second_seen[f] <= s);
+      colors[f] = paper_color(views_so_far);
+    }
+    const auto rgb = raster::render_face_colors(scene, studio, request, colors);
+    if (!write_png(dir / fmt::format("after_{}.png", scene.shots[s].name), rgb, frame.width,
+                   frame.height, error)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+nlohmann::json summary_json(const CoverageResult& coverage) {
+  const auto& last = coverage.shots.empty() ? ShotCoverage{} : coverage.shots.back();
+  double reconstructable_area = 0, resting_area = 0;
+  for (size_t f = 0; f < coverage.views.size(); ++f) {
+    if (coverage.reconstructable[f]) reconstructable_area += coverage.face_area_m2[f];
+    if (coverage.resting[f]) resting_area += coverage.face_area_m2[f];
+  }
+  return {{"seen_by_1_or_more", last.seen_1},
+          {"seen_by_2_or_more", last.seen_2},
+          {"seen_by_3_or_more", last.seen_3},
+          {"reconstructable", reconstructable_area / coverage.total_area_m2},
+          {"resting_on_turntable", resting_area / coverage.total_area_m2},
+          {"blur_ratio_95", coverage.blur_ratio_95}};
+}
+
+nlohmann::json thresholds_json(const ir::CoverageSettings& settings) {
+  return {{"min_pixels_per_mm2", settings.min_pixels_per_mm2},
+          {"max_view_angle_deg", settings.max_view_angle_rad * 180 / M_PI},
+          {"max_blur_px", settings.max_blur_px},
+          {"min_triangulation_angle_deg", settings.min_triangulation_angle_rad * 180 / M_PI},
+          {"min_signal", settings.min_signal},
+          {"max_signal", settings.max_signal}};
+}
+
+nlohmann::json shot_json(const ir::Scene& scene, const CoverageResult& coverage,
+                         const ShotCoverage& shot) {
+  return {{"shot", scene.shots[shot.shot].name},
+          {"visible_area_share", shot.visible_area_m2 / coverage.total_area_m2},
+          {"new_area_share", shot.new_area_m2 / coverage.total_area_m2},
+          {"overlap_with_previous", shot.overlap_with_previous},
+          {"cumulative",
+           {{"seen_1", shot.seen_1},
+            {"seen_2", shot.seen_2},
+            {"seen_3", shot.seen_3},
+            {"reconstructable", shot.reconstructable}}},
+          {"unusable_shares",
+           {{"out_of_focus", shot.out_of_focus},
+            {"clipped", shot.clipped},
+            {"too_dark", shot.too_dark},
+            {"too_oblique", shot.too_oblique},
+            {"too_coarse", shot.too_coarse}}},
+          {"frame_fill", shot.frame_fill}};
+}
+
+// coverage.json: the summary, the thresholds the tests used, and per shot its shares.
+nlohmann::json coverage_json(const ir::Scene& scene, const CoverageResult& coverage) {
+  nlohmann::json json;
+  json["scene"] = scene.name;
+  json["total_area_m2"] = coverage.total_area_m2;
+  json["faces"] = coverage.views.size();
+  json["summary"] = summary_json(coverage);
+  json["thresholds"] = thresholds_json(scene.coverage);
+  nlohmann::json shots = nlohmann::json::array();
+  for (const auto& shot : coverage.shots) shots.push_back(shot_json(scene, coverage, shot));
+  json["shots"] = shots;
+  return json;
+}
+
 }  // namespace
 
 Vector3f paper_color(int views) {
@@ -217,103 +385,13 @@ bool write_coverage_outputs(const ir::Scene& scene, const scene::StudioScene& st
     *error = fmt::format("cannot create '{}': {}", (dir / "pictures").string(), ec.message());
     return false;
   }
-  const size_t faces = coverage.views.size();
-  int max_views = 1;
-  for (auto v : coverage.views) max_views = std::max<int>(max_views, v);
-  std::vector<Vector3f> paper(faces), heat(faces);
-  for (size_t f = 0; f < faces; ++f) {
-    paper[f] = paper_color(coverage.views[f]);
-    heat[f] = heat_color(coverage.views[f], max_views);
-  }
-  if (!write_face_color_ply(dir / "coverage.ply", studio.object, paper, error) ||
-      !write_face_color_glb(dir / "coverage.glb", studio.object, paper, error) ||
-      !write_face_color_ply(dir / "views.ply", studio.object, heat, error) ||
-      !write_face_color_glb(dir / "views.glb", studio.object, heat, error)) {
-    return false;
-  }
-
-  // Pictures: the object on its own (turntable angle 0), from four sides and from above.
-  raster::FrameRequest request;
-  const double fov = 2 * std::atan(0.5 * scene.camera.sensor_width_m / scene.camera.focal_length_m);
-  const int width = picture_width;
-  const int height = picture_width * 2 / 3;
-  request.canvas = {
-      width,       height,      width / (2 * std::tan(fov / 2)), width / (2 * std::tan(fov / 2)),
-      width / 2.0, height / 2.0};
-  struct View {
-    const char* name;
-    double azimuth_deg, elevation_deg;
-  };
-  const View views[] = {{"front", -90, 20}, {"right", 0, 20}, {"back", 90, 20},
-                        {"left", 180, 20},  {"top", -90, 75}, {"below", -90, -30}};
-  for (const auto& view : views) {
-    request.world_from_camera = picture_camera(scene, studio, view.azimuth_deg * M_PI / 180,
-                                               view.elevation_deg * M_PI / 180, fov);
-    const auto rgb = raster::render_face_colors(scene, studio, request, paper);
-    if (!write_png(dir / "pictures" / fmt::format("view_{}.png", view.name), rgb, width, height,
-                   error)) {
-      return false;
-    }
-  }
-  // Coverage growing shot by shot, from a fixed three-quarter view.
-  request.world_from_camera = picture_camera(scene, studio, -60 * M_PI / 180, 25 * M_PI / 180, fov);
-  for (size_t s = 0; s < coverage.shots.size(); ++s) {
-    std::vector<Vector3f> colors(faces);
-    for (size_t f = 0; f < faces; ++f) {
-      const int views_so_far = (coverage.first_seen[f] <= s) + (coverage.second_seen[f] <= s);
-      colors[f] = paper_color(views_so_far);
-    }
-    const auto rgb = raster::render_face_colors(scene, studio, request, colors);
-    if (!write_png(dir / "pictures" / fmt::format("after_{}.png", scene.shots[s].name), rgb, width,
-                   height, error)) {
-      return false;
-    }
-  }
-
-  nlohmann::json json;
-  json["scene"] = scene.name;
-  json["total_area_m2"] = coverage.total_area_m2;
-  json["faces"] = faces;
-  const auto& last = coverage.shots.empty() ? ShotCoverage{} : coverage.shots.back();
-  double reconstructable_area = 0, resting_area = 0;
-  for (size_t f = 0; f < faces; ++f) {
-    if (coverage.reconstructable[f]) reconstructable_area += coverage.face_area_m2[f];
-    if (coverage.resting[f]) resting_area += coverage.face_area_m2[f];
-  }
-  json["summary"] = {{"seen_by_1_or_more", last.seen_1},
-                     {"seen_by_2_or_more", last.seen_2},
-                     {"seen_by_3_or_more", last.seen_3},
-                     {"reconstructable", reconstructable_area / coverage.total_area_m2},
-                     {"resting_on_turntable", resting_area / coverage.total_area_m2},
-                     {"blur_ratio_95", coverage.blur_ratio_95}};
-  json["thresholds"] = {
-      {"min_pixels_per_mm2", scene.coverage.min_pixels_per_mm2},
-      {"max_view_angle_deg", scene.coverage.max_view_angle_rad * 180 / M_PI},
-      {"max_blur_px", scene.coverage.max_blur_px},
-      {"min_triangulation_angle_deg", scene.coverage.min_triangulation_angle_rad * 180 / M_PI},
-      {"min_signal", scene.coverage.min_signal},
-      {"max_signal", scene.coverage.max_signal}};
-  nlohmann::json shots = nlohmann::json::array();
-  for (const auto& shot : coverage.shots) {
-    shots.push_back({{"shot", scene.shots[shot.shot].name},
-                     {"visible_area_share", shot.visible_area_m2 / coverage.total_area_m2},
-                     {"new_area_share", shot.new_area_m2 / coverage.total_area_m2},
-                     {"overlap_with_previous", shot.overlap_with_previous},
-                     {"cumulative",
-                      {{"seen_1", shot.seen_1},
-                       {"seen_2", shot.seen_2},
-                       {"seen_3", shot.seen_3},
-                       {"reconstructable", shot.reconstructable}}},
-                     {"unusable_shares",
-                      {{"out_of_focus", shot.out_of_focus},
-                       {"clipped", shot.clipped},
-                       {"too_dark", shot.too_dark},
-                       {"too_oblique", shot.too_oblique},
-                       {"too_coarse", shot.too_coarse}}},
-                     {"frame_fill", shot.frame_fill}});
-  }
-  json["shots"] = shots;
-  return rigc::write_file_atomically(dir / "coverage.json", json.dump(2) + "\n", error);
+  const FaceColors colors = face_colors(coverage);
+  const PictureFrame frame(scene, picture_width);
+  return write_coverage_meshes(dir, studio.object, colors, error) &&
+         write_view_pictures(dir / "pictures", scene, studio, frame, colors.paper, error) &&
+         write_progress_pictures(dir / "pictures", scene, studio, coverage, frame, error) &&
+         rigc::write_file_atomically(dir / "coverage.json",
+                                     coverage_json(scene, coverage).dump(2) + "\n", error);
 }
 
 void print_coverage_table(const ir::Scene& scene, const CoverageResult& coverage,

@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <regex>
+#include <stdexcept>
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
@@ -190,8 +192,8 @@ TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
   EXPECT_EQ(usual.warnings.find(expected), std::string::npos) << usual.warnings;
 }
 
-// The over-exposure advice names a shutter; taking it, the warning goes (it said "one stop" at
-// any setting, at 30 s too, where nine were needed).
+// The over-exposure advice names a shutter; taking it, the warning goes, however many stops over
+// the exposure is (about nine at 30 s).
 TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {
   for (const char* shutter : {"30", "1/2", "1/15"}) {
     Analysed a = analyse(scene_text(
@@ -207,6 +209,26 @@ TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {
         << after.warnings;
     EXPECT_EQ(after.warnings.find("under-exposure"), std::string::npos) << after.warnings;
   }
+}
+
+TEST(Coverage, OptionsCheckTheVisibilityScale) {
+  for (const double scale : {0.0, 0.01, 0.2, 1.0}) {
+    CoverageOptions options;
+    options.visibility_scale = scale;
+    EXPECT_TRUE(options.check()) << scale;
+  }
+  for (const double scale : {-0.5, 1e-9, 0.005, 1.5, std::nan("")}) {
+    CoverageOptions options;
+    options.visibility_scale = scale;
+    std::string error;
+    EXPECT_FALSE(options.check(&error)) << scale;
+    EXPECT_NE(error.find("visibility_scale"), std::string::npos) << error;
+  }
+  CoverageOptions bad;
+  bad.visibility_scale = 2;
+  const ir::Scene scene;
+  const scene::StudioScene studio;
+  EXPECT_THROW(analyse_coverage(scene, studio, bad), std::invalid_argument);
 }
 
 TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
