@@ -219,9 +219,12 @@ int run_coverage(std::vector<std::string> args) {
       ->capture_default_str();
   app.add_option("--visibility-scale", visibility_scale,
                  "resolution of the visibility buffers relative to the sensor (0: ~1400 px)")
-      // Below 0.01 the buffers are a pixel or two across, and their coverage means nothing.
       ->check(cli::finite_number_where(
-          [](double value) { return value == 0 || (value >= 0.01 && value <= 1); },
+          [](double value) {
+            analysis::CoverageOptions options;
+            options.visibility_scale = value;
+            return options.check();
+          },
           "is neither 0 (automatic) nor within 0.01..1", ""));
   if (auto code = parse_options(app, args)) return *code;
 
