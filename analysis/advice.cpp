@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <vector>
 
+#include "compiler/limits.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 
@@ -56,107 +58,128 @@ std::string shutter_text(double seconds) {
   return fmt::format("1/{:.0f} s", 1 / seconds);
 }
 
-}  // namespace
-
-double next_standard_f_number(double f_number) {
-  static const double stops[] = {1.2, 1.4, 1.6, 1.8, 2,  2.2, 2.5, 2.8, 3.2, 3.5, 4,  4.5,
-                                 5,   5.6, 6.3, 7.1, 8,  9,   10,  11,  13,  14,  16, 18,
-                                 20,  22,  25,  29,  32, 36,  40,  45,  51,  57,  64};
-  for (double stop : stops) {
-    if (stop >= f_number * 0.999) return stop;
-  }
-  return 64;
+// A number of stops in thirds, as cameras step: "1/3 stop", "5 2/3 stops".
+std::string stops_text(double stops) {
+  const int thirds = static_cast<int>(std::lround(stops * 3));
+  const int whole = thirds / 3, rest = thirds % 3;
+  const std::string count = whole == 0  ? fmt::format("{}/3", rest)
+                            : rest == 0 ? fmt::format("{}", whole)
+                                        : fmt::format("{} {}/3", whole, rest);
+  return count + (thirds > 3 ? " stops" : " stop");
 }
 
-void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
-                           const CoverageResult& coverage, DiagnosticEngine& diag) {
+// The standard third-stop f-numbers, over the language's apertures.
+constexpr double kFNumberStops[] = {1.2, 1.4, 1.6, 1.8, 2,  2.2, 2.5, 2.8, 3.2, 3.5, 4,  4.5,
+                                    5,   5.6, 6.3, 7.1, 8,  9,   10,  11,  13,  14,  16, 18,
+                                    20,  22,  25,  29,  32, 36,  40,  45,  51,  57,  64};
+static_assert(kFNumberStops[0] == limits::camera::kAperture.min &&
+              kFNumberStops[std::size(kFNumberStops) - 1] == limits::camera::kAperture.max);
+
+// The seen surface over all shots: its area, the area-weighted shares of its problems, and the
+// signal histograms summed.
+struct SeenSurface {
+  double visible = 0;  // m², never 0
+  double out_of_focus = 0, clipped = 0, dark = 0;
+  std::vector<double> signal_histogram = std::vector<double>(ShotCoverage::kSignalBins, 0.0);
+};
+
+SeenSurface seen_surface(const CoverageResult& coverage) {
+  SeenSurface seen;
+  for (const auto& shot : coverage.shots) {
+    for (std::size_t b = 0; b < shot.signal_histogram.size() && b < seen.signal_histogram.size();
+         ++b) {
+      seen.signal_histogram[b] += shot.signal_histogram[b];
+    }
+    seen.visible += shot.visible_area_m2;
+    seen.out_of_focus += shot.out_of_focus * shot.visible_area_m2;
+    seen.clipped += shot.clipped * shot.visible_area_m2;
+    seen.dark += shot.too_dark * shot.visible_area_m2;
+  }
+  seen.visible = std::max(seen.visible, 1e-30);
+  return seen;
+}
+
+// Depth of field, and diffraction where the depth of field does not need the aperture.
+void advise_aperture(const ir::Scene& scene, const CoverageResult& coverage,
+                     const SeenSurface& seen, DiagnosticEngine& diag) {
   const ir::Camera& camera = scene.camera;
-  const ir::CoverageSettings& settings = scene.coverage;
+  const double max_blur_px = scene.coverage.max_blur_px;
   const SourceLoc& aperture_loc = first_known(camera.aperture_loc, camera.loc);
-  const SourceLoc& shutter_loc = first_known(camera.shutter_loc, camera.loc);
   const double pixel_pitch_m = camera.sensor_width_m / camera.width_px;
   const double n = camera.aperture_f_number;
-
-  // Area-weighted means over all views.
-  double visible = 0, out_of_focus = 0, clipped = 0, dark = 0;
-  std::vector<double> signal_histogram(ShotCoverage::kSignalBins, 0.0);
-  for (const auto& shot : coverage.shots) {
-    for (std::size_t b = 0; b < shot.signal_histogram.size() && b < signal_histogram.size(); ++b) {
-      signal_histogram[b] += shot.signal_histogram[b];
-    }
-    visible += shot.visible_area_m2;
-    out_of_focus += shot.out_of_focus * shot.visible_area_m2;
-    clipped += shot.clipped * shot.visible_area_m2;
-    dark += shot.too_dark * shot.visible_area_m2;
-  }
-  visible = std::max(visible, 1e-30);
-
-  // Depth of field: the blur scales as 1/N, so the aperture that keeps 95 % sharp follows.
+  // The blur scales as 1/N, so the aperture that keeps 95 % sharp follows.
   const double needed_n = n * coverage.blur_ratio_95;
-  if (out_of_focus / visible > kWarnShare) {
+  if (seen.out_of_focus / seen.visible > kWarnShare) {
     diag.warning(aperture_loc,
                  fmt::format("depth of field at f/{:g} is shallower than the object: {:.0f}% of "
                              "the seen surface is blurred beyond {:.1f} px; f/{:g} would keep 95% "
                              "sharp (or focus nearer the object's front)",
-                             n, 100 * out_of_focus / visible, settings.max_blur_px,
+                             n, 100 * seen.out_of_focus / seen.visible, max_blur_px,
                              next_standard_f_number(needed_n)));
   }
-  // Diffraction: an Airy disc wider than the blur budget, where depth of field does not need it.
+  // An Airy disc wider than the blur budget.
   const double airy_px = 2.44 * kWavelengthM * n / pixel_pitch_m;
-  if (airy_px > settings.max_blur_px && n > next_standard_f_number(needed_n) * 1.01) {
-    const double limit_n = settings.max_blur_px * pixel_pitch_m / (2.44 * kWavelengthM);
-    diag.warning(aperture_loc,
-                 fmt::format("f/{:g} is diffraction-limited on this sensor ({:.1f} µm pixels): the "
-                             "Airy disc is {:.1f} px; the depth of field only needs f/{:g}, and "
-                             "f/{:.1f} or wider keeps diffraction under {:.1f} px",
-                             n, pixel_pitch_m * 1e6, airy_px,
-                             next_standard_f_number(std::max(needed_n, 1.2)), limit_n,
-                             settings.max_blur_px));
+  if (airy_px > max_blur_px && n > next_standard_f_number(needed_n) * 1.01) {
+    const double limit_n = max_blur_px * pixel_pitch_m / (2.44 * kWavelengthM);
+    diag.warning(
+        aperture_loc,
+        fmt::format("f/{:g} is diffraction-limited on this sensor ({:.1f} µm pixels): the "
+                    "Airy disc is {:.1f} px; the depth of field only needs f/{:g}, and "
+                    "f/{:.1f} or wider keeps diffraction under {:.1f} px",
+                    n, pixel_pitch_m * 1e6, airy_px,
+                    next_standard_f_number(std::max(needed_n, limits::camera::kAperture.min)),
+                    limit_n, max_blur_px));
   }
-  // Exposure.
-  // The advice names how many stops: "one stop" was the advice at 30 s too, where nine were
-  // needed.
-  auto stops_text = [](double stops) {  // in thirds, as cameras step: "1/3 stop", "5 2/3 stops"
-    const int thirds = static_cast<int>(std::lround(stops * 3));
-    const int whole = thirds / 3, rest = thirds % 3;
-    const std::string count = whole == 0  ? fmt::format("{}/3", rest)
-                              : rest == 0 ? fmt::format("{}", whole)
-                                          : fmt::format("{} {}/3", whole, rest);
-    return count + (thirds > 3 ? " stops" : " stop");
-  };
-  if (clipped / visible > kWarnShare) {
-    const double stops = std::max(1.0 / 3, stops_to_unclip(signal_histogram, visible));
+}
+
+// Clipped or too dark surface, with how many stops of light would fix it.
+void advise_exposure(const ir::Scene& scene, const SeenSurface& seen, DiagnosticEngine& diag) {
+  const ir::Camera& camera = scene.camera;
+  const ir::CoverageSettings& settings = scene.coverage;
+  const SourceLoc& shutter_loc = first_known(camera.shutter_loc, camera.loc);
+  if (seen.clipped / seen.visible > kWarnShare) {
+    const double stops = std::max(1.0 / 3, stops_to_unclip(seen.signal_histogram, seen.visible));
     const double shutter = camera.shutter_s * std::exp2(-stops);
     diag.warning(shutter_loc,
                  fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
                              "(EV100 {:.1f}); {} less light: {}",
-                             100 * clipped / visible, dslr::ev100(n, camera.shutter_s, camera.iso),
+                             100 * seen.clipped / seen.visible,
+                             dslr::ev100(camera.aperture_f_number, camera.shutter_s, camera.iso),
                              stops_text(stops),
-                             shutter >= 1.0 / 8000
+                             shutter >= limits::camera::kShutter.min
                                  ? fmt::format("a shutter of {} (or stop down, or a lower ISO)",
                                                shutter_text(shutter))
                                  : "stop down, lower the ISO or dim the lights"));
   }
-  if (dark / visible > kWarnShare) {
+  if (seen.dark / seen.visible > kWarnShare) {
     const double dark_stops = std::log2(settings.min_signal / settings.max_signal);
     const double stops =
-        std::max(1.0 / 3, stops_to_undarken(signal_histogram, visible, dark_stops));
-    diag.warning(shutter_loc,
-                 fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
-                             "full scale, where sensor noise hides texture; {} more light: "
-                             "lengthen the shutter, raise the ISO or add light",
-                             100 * dark / visible, 100 * settings.min_signal, stops_text(stops)));
+        std::max(1.0 / 3, stops_to_undarken(seen.signal_histogram, seen.visible, dark_stops));
+    diag.warning(
+        shutter_loc,
+        fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
+                    "full scale, where sensor noise hides texture; {} more light: "
+                    "lengthen the shutter, raise the ISO or add light",
+                    100 * seen.dark / seen.visible, 100 * settings.min_signal, stops_text(stops)));
   }
-  // A distortion that draws the frame's edge from beyond the canvas the renderers make (at most
-  // twice the sensor's extent): the pixels there repeat the canvas's border, a smear that is not
-  // the scene, and nothing else would tell.
+}
+
+// A distortion that draws the frame's edge from beyond the canvas the renderers make (at most
+// twice the sensor's extent): the pixels there repeat the canvas's border, a smear that is not
+// the scene, and nothing else would tell.
+void advise_distortion(const ir::Camera& camera, DiagnosticEngine& diag) {
   if (camera.effects.distortion && dslr::render_geometry_for(camera, 1.0).clipped) {
     diag.warning(first_known(camera.distortion_loc, camera.loc),
                  "the distortion draws part of the frame from beyond the canvas the renderers "
                  "make (at most twice the sensor's extent): pixels there repeat the canvas's "
                  "border instead of the scene; make the coefficients smaller");
   }
-  // Motion blur from a turning table, per shot group (reported once per source line).
+}
+
+// Motion blur from a turning table, per shot group (reported once per source line).
+void advise_motion_blur(const ir::Scene& scene, const scene::StudioScene& studio,
+                        const CoverageResult& coverage, DiagnosticEngine& diag) {
+  const ir::Camera& camera = scene.camera;
   int last_line = -1;
   for (const auto& shot : scene.shots) {
     if (shot.turntable_velocity_rad_s == 0 || shot.loc.line == last_line) continue;
@@ -164,23 +187,26 @@ void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& stu
     const double depth = std::max(0.05, coverage.shots[shot.index].nearest_depth_m);
     const double blur_px = dslr::motion_blur_length_px(
         camera, 1.0, std::abs(shot.turntable_velocity_rad_s), radius, depth);
-    if (blur_px > 1) {
-      last_line = shot.loc.line;
-      // A shutter that keeps the smear under a pixel, if a camera has one (1/8000 s is the
-      // fastest the language takes).
-      const double fastest_denominator = 8000;
-      const double needed_denominator = std::ceil(blur_px / camera.shutter_s);
-      const std::string remedy =
-          needed_denominator <= fastest_denominator
-              ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
-                            needed_denominator)
-              : std::string("stop the table for each shot (no shutter is fast enough)");
-      diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} "
-                                         "px during the {:g} s exposure; {}",
-                                         blur_px, camera.shutter_s, remedy));
-    }
+    if (!(blur_px > 1)) continue;
+    last_line = shot.loc.line;
+    // A shutter that keeps the smear under a pixel, if the language has one.
+    const double fastest_denominator = 1 / limits::camera::kShutter.min;
+    const double needed_denominator = std::ceil(blur_px / camera.shutter_s);
+    const std::string remedy =
+        needed_denominator <= fastest_denominator
+            ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
+                          needed_denominator)
+            : std::string("stop the table for each shot (no shutter is fast enough)");
+    diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} "
+                                       "px during the {:g} s exposure; {}",
+                                       blur_px, camera.shutter_s, remedy));
   }
-  // Faces never seen (the base resting on the table cannot be, so it does not count).
+}
+
+// Faces never seen (the base resting on the table cannot be, so it does not count), with the
+// shots that would see them.
+void advise_unseen_faces(const ir::Scene& scene, const scene::StudioScene& studio,
+                         const CoverageResult& coverage, DiagnosticEngine& diag) {
   double unseen = 0, resting = 0;
   Eigen::Vector3d unseen_normal = Eigen::Vector3d::Zero();
   const auto& mesh = studio.object;
@@ -198,22 +224,27 @@ void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& stu
         2;
   }
   const double visible_total = std::max(coverage.total_area_m2 - resting, 1e-30);
-  if (!scene.shots.empty() && unseen / visible_total > kWarnShare) {
-    std::string fix = "add shots from the directions the red faces face";
-    if (unseen_normal.norm() > 0.3 * unseen) {
-      const double elevation = std::asin(std::clamp(unseen_normal.normalized().z(), -1.0, 1.0));
-      if (elevation > 0.35)
-        fix = "add a ring at a higher elevation, e.g. 60deg";
-      else if (elevation < -0.35)
-        fix =
-            "add a ring from below (elevation -30deg) or turn the "
-            "object over for a second pass";
-    }
-    diag.warning(scene.shots.front().loc,
-                 fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",
-                             100 * unseen / visible_total, fix));
+  if (scene.shots.empty() || !(unseen / visible_total > kWarnShare)) return;
+  std::string fix = "add shots from the directions the red faces face";
+  if (unseen_normal.norm() > 0.3 * unseen) {
+    const double elevation = std::asin(std::clamp(unseen_normal.normalized().z(), -1.0, 1.0));
+    if (elevation > 0.35)
+      fix = "add a ring at a higher elevation, e.g. 60deg";
+    else if (elevation < -0.35)
+      fix =
+          "add a ring from below (elevation -30deg) or turn the "
+          "object over for a second pass";
   }
-  // Overlap between consecutive shots and the object's size in the frame.
+  diag.warning(scene.shots.front().loc,
+               fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",
+                           100 * unseen / visible_total, fix));
+}
+
+// Overlap between consecutive shots, and the object's size in the frame (the first shot short
+// of each).
+void advise_overlap_and_framing(const ir::Scene& scene, const CoverageResult& coverage,
+                                DiagnosticEngine& diag) {
+  const ir::CoverageSettings& settings = scene.coverage;
   for (size_t i = 1; i < coverage.shots.size(); ++i) {
     const ShotCoverage& shot = coverage.shots[i];
     if (shot.visible_area_m2 > 0 && shot.overlap_with_previous < settings.min_overlap) {
@@ -234,6 +265,26 @@ void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& stu
       break;
     }
   }
+}
+
+}  // namespace
+
+double next_standard_f_number(double f_number) {
+  for (double stop : kFNumberStops) {
+    if (stop >= f_number * 0.999) return stop;
+  }
+  return limits::camera::kAperture.max;
+}
+
+void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
+                           const CoverageResult& coverage, DiagnosticEngine& diag) {
+  const SeenSurface seen = seen_surface(coverage);
+  advise_aperture(scene, coverage, seen, diag);
+  advise_exposure(scene, seen, diag);
+  advise_distortion(scene.camera, diag);
+  advise_motion_blur(scene, studio, coverage, diag);
+  advise_unseen_faces(scene, studio, coverage, diag);
+  advise_overlap_and_framing(scene, coverage, diag);
 }
 
 }  // namespace rigc::analysis

@@ -2,13 +2,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <numbers>
 #include <set>
+#include <tuple>
 
 #include "assets/primitives.h"
+#include "compiler/limits.h"
 #include "compiler/presets.h"
 #include "compiler/units.h"
 
@@ -17,18 +20,15 @@ namespace {
 
 namespace fs = std::filesystem;
 using spec::Target;
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-constexpr std::size_t kMostLights = 32;
-
-// Real cameras' EXIF Make and Model are a few dozen characters.
-constexpr std::size_t kMaxExifText = 255;
 
 // Why `name` cannot be one folder of a path, or empty when it can: the scene's name is the
-// default run folder's parent (out/<name>/<backend>), and "/tmp/x" or "../../x" took runs there.
+// default run folder's parent (out/<name>/<backend>), so "/tmp/x" or "../../x" would put runs
+// elsewhere.
 std::string folder_name_problem(const std::string& name) {
   if (name.empty()) return "it is empty";
-  if (name.size() > 100) return "it is longer than 100 bytes";
+  if (name.size() > limits::kSceneName.max) {
+    return fmt::format("it is longer than {} bytes", limits::kSceneName.max);
+  }
   if (name == "." || name == "..") return "'.' and '..' are not folder names";
   for (const unsigned char c : name) {
     if (c == '/' || c == '\\') return "it holds a slash";
@@ -37,11 +37,18 @@ std::string folder_name_problem(const std::string& name) {
   return {};
 }
 
-struct Range {
-  double min;
-  double max;
-  bool min_exclusive = false;
-};
+std::string comma_list(const std::vector<std::string>& words) {
+  std::string list;
+  for (const auto& word : words) list += (list.empty() ? "" : ", ") + word;
+  return list;
+}
+
+// "; did you mean 'x'?" when one of `known` is close to `word`, else `otherwise`.
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& known,
+                         const std::string& otherwise) {
+  const std::string suggestion = closest_match(word, known);
+  return suggestion.empty() ? otherwise : fmt::format("; did you mean '{}'?", suggestion);
+}
 
 // Walks the YAML tree with the diagnostics engine at hand. Each reader reports its own errors and
 // returns nullopt, so checking goes on and every error of the file is reported in one run.
@@ -70,8 +77,8 @@ class Checker {
   bool check_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
                   const std::string& context) {
     bool ok = true;
-    // yaml-cpp keeps a repeated key's first value and drops the rest without a word: `iso: 200,
-    // iso: 400` gave ISO 200.
+    // yaml-cpp keeps a repeated key's first value and drops the rest without a word (`iso: 200,
+    // iso: 400` would be ISO 200), so repeats are errors.
     std::map<std::string, int> first_line;
     for (auto it = map.begin(); it != map.end(); ++it) {
       if (!it->first.IsScalar()) {
@@ -87,16 +94,10 @@ class Checker {
         continue;
       }
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      std::string suggestion = closest_match(key, allowed);
-      std::string message = fmt::format("unknown key '{}' in {}", key, context);
-      if (!suggestion.empty()) {
-        message += fmt::format("; did you mean '{}'?", suggestion);
-      } else {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        message += fmt::format(" (expected one of: {})", list);
-      }
-      error(it->first, message);
+      error(it->first,
+            fmt::format("unknown key '{}' in {}", key, context) +
+                did_you_mean(key, allowed,
+                             fmt::format(" (expected one of: {})", comma_list(allowed))));
       ok = false;
     }
     return ok;
@@ -117,29 +118,38 @@ class Checker {
     return std::nullopt;
   }
 
-  std::optional<double> quantity(const YAML::Node& node, QuantityKind kind, const std::string& what,
-                                 std::optional<Range> range = std::nullopt) {
+  std::optional<double> quantity(const YAML::Node& node, QuantityKind kind,
+                                 const std::string& what) {
     auto text = scalar(node, what);
     if (!text) return std::nullopt;
     QuantityParse parsed = parse_quantity(*text, kind);
-    if (!parsed.value) {
-      error(node, fmt::format("{}: {}", what, parsed.error));
+    if (!parsed.value) error(node, fmt::format("{}: {}", what, parsed.error));
+    return parsed.value;
+  }
+
+  std::optional<double> quantity(const YAML::Node& node, const std::string& what,
+                                 const limits::Quantity& limit) {
+    const std::optional<double> value = quantity(node, limit.kind, what);
+    if (!value) return std::nullopt;
+    const bool below = limit.min_exclusive ? *value <= limit.min : *value < limit.min;
+    if (below || *value > limit.max) {
+      error(node, fmt::format("{} {} is outside {}..{}", what, format_quantity(*value, limit.kind),
+                              format_quantity(limit.min, limit.kind),
+                              format_quantity(limit.max, limit.kind)));
       return std::nullopt;
-    }
-    double value = *parsed.value;
-    if (range) {
-      bool below = range->min_exclusive ? value <= range->min : value < range->min;
-      if (below || value > range->max) {
-        error(node,
-              fmt::format("{} {} is outside {}..{}", what, format_quantity(value, kind),
-                          format_quantity(range->min, kind), format_quantity(range->max, kind)));
-        return std::nullopt;
-      }
     }
     return value;
   }
 
-  std::optional<int> integer(const YAML::Node& node, const std::string& what, int min, int max) {
+  // Sets `out` from `map[key]` if it is given and within `limit`.
+  void read(const YAML::Node& map, const char* key, const std::string& what,
+            const limits::Quantity& limit, double& out) {
+    if (!map[key]) return;
+    if (auto value = quantity(map[key], what, limit)) out = *value;
+  }
+
+  std::optional<int> integer(const YAML::Node& node, const std::string& what,
+                             const limits::Integer& limit) {
     auto text = scalar(node, what);
     if (!text) return std::nullopt;
     long value = 0;
@@ -151,11 +161,18 @@ class Checker {
       error(node, fmt::format("{} must be a whole number, got '{}'", what, *text));
       return std::nullopt;
     }
-    if (value < min || value > max) {
-      error(node, fmt::format("{} {} is outside {}..{}", what, value, min, max));
+    if (value < limit.min || value > limit.max) {
+      error(node, fmt::format("{} {} is outside {}..{}", what, value, limit.min, limit.max));
       return std::nullopt;
     }
     return static_cast<int>(value);
+  }
+
+  template <typename Int>
+  void read(const YAML::Node& map, const char* key, const std::string& what,
+            const limits::Integer& limit, Int& out) {
+    if (!map[key]) return;
+    if (auto value = integer(map[key], what, limit)) out = static_cast<Int>(*value);
   }
 
   std::optional<bool> boolean(const YAML::Node& node, const std::string& what) {
@@ -167,8 +184,10 @@ class Checker {
     return std::nullopt;
   }
 
-  std::optional<ir::Vec3> vec3(const YAML::Node& node, QuantityKind kind, const std::string& what,
-                               std::optional<Range> range = std::nullopt) {
+  // [x, y, z], each read by `read_one`.
+  template <typename ReadOne>
+  std::optional<ir::Vec3> vec3_of(const YAML::Node& node, const std::string& what,
+                                  ReadOne read_one) {
     if (!node.IsSequence() || node.size() != 3) {
       error(node, fmt::format("{} must be a list of three values [x, y, z]", what));
       return std::nullopt;
@@ -176,7 +195,7 @@ class Checker {
     ir::Vec3 result;
     bool ok = true;
     for (int i = 0; i < 3; ++i) {
-      auto v = quantity(node[i], kind, what, range);
+      auto v = read_one(node[i]);
       if (v)
         result[i] = *v;
       else
@@ -185,13 +204,26 @@ class Checker {
     if (!ok) return std::nullopt;
     return result;
   }
+  std::optional<ir::Vec3> vec3(const YAML::Node& node, QuantityKind kind, const std::string& what) {
+    return vec3_of(node, what, [&](const YAML::Node& n) { return quantity(n, kind, what); });
+  }
+  std::optional<ir::Vec3> vec3(const YAML::Node& node, const std::string& what,
+                               const limits::Quantity& limit) {
+    return vec3_of(node, what, [&](const YAML::Node& n) { return quantity(n, what, limit); });
+  }
 
-  std::optional<ir::Vec3> color(const YAML::Node& node, const std::string& what) {
+  std::optional<ir::Vec3> color(const YAML::Node& node, const std::string& what,
+                                const limits::Quantity& limit) {
     if (!node.IsSequence() || node.size() != 3) {
       error(node, fmt::format("{} must be a list of three linear RGB values in 0..1", what));
       return std::nullopt;
     }
-    return vec3(node, QuantityKind::kNumber, what, Range{0, 1});
+    return vec3(node, what, limit);
+  }
+  void read_color(const YAML::Node& map, const std::string& what, const limits::Quantity& limit,
+                  ir::Vec3& out) {
+    if (!map["color"]) return;
+    if (auto c = color(map["color"], what, limit)) out = *c;
   }
 
   std::optional<Target> target(const YAML::Node& node, const std::string& what) {
@@ -210,23 +242,60 @@ class Checker {
     return result;
   }
 
+  // A non-zero direction, normalised; nullopt (reported) if zero.
+  std::optional<ir::Vec3> direction(const YAML::Node& node, const std::string& what,
+                                    const std::string& zero_message) {
+    auto d = vec3(node, QuantityKind::kNumber, what);
+    if (!d) return std::nullopt;
+    // stableNorm: norm() overflows to inf on [1e200, 0, 0], and normalized() gives zero.
+    if (d->stableNorm() < 1e-9) {
+      error(node, zero_message);
+      return std::nullopt;
+    }
+    return d->stableNormalized();
+  }
+
+  void read_name(const YAML::Node& root, spec::SceneSpec& scene);
   void read_object(const YAML::Node& node, spec::SceneSpec& scene);
+  void read_mesh(const YAML::Node& node, spec::ObjectSpec& object);
+  void read_primitive(const YAML::Node& primitive, spec::ObjectSpec& object);
+  void read_up_axis(const YAML::Node& node, spec::ObjectSpec& object);
+  void read_fit(const YAML::Node& fit, spec::ObjectSpec& object);
+  void read_scale(const YAML::Node& node, spec::ObjectSpec& object);
   void read_surface(const YAML::Node& node, spec::ObjectSpec& object);
   void read_studio(const YAML::Node& node, spec::SceneSpec& scene);
+  void read_turntable(const YAML::Node& table, ir::Turntable& turntable);
+  void read_backdrop(const YAML::Node& backdrop, spec::SceneSpec& scene);
+  void read_lights(const YAML::Node& lights, spec::SceneSpec& scene);
   void read_light(const YAML::Node& node, spec::SceneSpec& scene);
+  std::optional<ir::LightType> light_type(const YAML::Node& node);
+  void read_light_source(const YAML::Node& node, const std::string& type, ir::Light& light);
+  void read_light_aim(const YAML::Node& node, spec::LightSpec& light_spec);
+  void read_light_shape(const YAML::Node& node, ir::Light& light);
   void read_camera(const YAML::Node& node, spec::SceneSpec& scene);
+  void read_body(const YAML::Node& body, ir::Camera& camera);
+  void read_sensor(const YAML::Node& sensor, ir::Camera& camera);
+  void read_exif_text(const YAML::Node& node, ir::Camera& camera);
+  void read_lens(const YAML::Node& lens, ir::Camera& camera);
+  void read_distortion(const YAML::Node& distortion, ir::Camera& camera);
+  void read_exposure(const YAML::Node& exposure, ir::Camera& camera);
+  void read_focus(const YAML::Node& focus, spec::SceneSpec& scene);
+  void read_white_balance(const YAML::Node& wb, ir::Camera& camera);
+  void read_effects(const YAML::Node& effects, ir::Camera& camera);
+  void read_output(const YAML::Node& output, ir::Camera& camera);
+  void finish_camera(ir::Camera& camera);
   void read_shots(const YAML::Node& node, spec::SceneSpec& scene);
   void read_coverage(const YAML::Node& node, spec::SceneSpec& scene);
   void read_turntable_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
+  void read_turntable_camera(const YAML::Node& camera, spec::TurntableCameraSpec& out);
   void read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
+  void read_ring(const YAML::Node& node, spec::OrbitShotsSpec& orbit);
   void read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group);
 
   std::string file_;
   std::string base_dir_;
   DiagnosticEngine& diag_;
 };
-
-const Range kPositiveLength{0, 1000, true};
 
 std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
   spec::SceneSpec scene;
@@ -242,27 +311,11 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
   check_keys(root, {"rigc", "name", "object", "studio", "camera", "shots", "coverage"},
              "the scene");
   if (root["rigc"]) {
-    if (auto version = integer(root["rigc"], "language version 'rigc'", 1, 1)) {
-      scene.version = *version;
-    }
+    read(root, "rigc", "language version 'rigc'", limits::kLanguageVersion, scene.version);
   } else {
     diag_.error({file_, 1, 1}, "missing 'rigc: 1' (the language version) at the top of the scene");
   }
-  if (root["name"]) {
-    if (auto name = scalar(root["name"], "name")) {
-      if (std::string problem = folder_name_problem(*name); !problem.empty()) {
-        error(root["name"], fmt::format("the scene's name cannot name a folder ({}): runs go to "
-                                        "out/<name>/ by default",
-                                        problem));
-      } else {
-        scene.name = *name;
-      }
-    }
-  } else if (std::string problem = folder_name_problem(scene.name); !problem.empty()) {
-    diag_.error({file_, 1, 1}, fmt::format("the file's name cannot name a folder ({}); give the "
-                                           "scene a 'name:'",
-                                           problem));
-  }
+  read_name(root, scene);
   if (root["object"]) {
     read_object(root["object"], scene);
   } else {
@@ -284,7 +337,27 @@ std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
   return scene;
 }
 
+// The scene's name, or the file's if it gives none: either must be able to name a folder.
+void Checker::read_name(const YAML::Node& root, spec::SceneSpec& scene) {
+  if (root["name"]) {
+    if (auto name = scalar(root["name"], "name")) {
+      if (std::string problem = folder_name_problem(*name); !problem.empty()) {
+        error(root["name"], fmt::format("the scene's name cannot name a folder ({}): runs go to "
+                                        "out/<name>/ by default",
+                                        problem));
+      } else {
+        scene.name = *name;
+      }
+    }
+  } else if (std::string problem = folder_name_problem(scene.name); !problem.empty()) {
+    diag_.error({file_, 1, 1}, fmt::format("the file's name cannot name a folder ({}); give the "
+                                           "scene a 'name:'",
+                                           problem));
+  }
+}
+
 void Checker::read_coverage(const YAML::Node& node, spec::SceneSpec& scene) {
+  namespace limit = limits::coverage;
   ir::CoverageSettings& coverage = scene.coverage;
   coverage.loc = loc(node);
   if (!expect_map(node, "coverage")) return;
@@ -292,19 +365,16 @@ void Checker::read_coverage(const YAML::Node& node, spec::SceneSpec& scene) {
              {"min_pixels_per_mm2", "max_view_angle", "max_blur", "min_triangulation_angle",
               "min_signal", "max_signal", "min_overlap", "min_frame_fill"},
              "coverage");
-  auto read = [&](const char* key, QuantityKind kind, Range range, double& out) {
-    if (!node[key]) return;
-    if (auto v = quantity(node[key], kind, key, range)) out = *v;
-  };
-  read("min_pixels_per_mm2", QuantityKind::kNumber, {0, 1e6}, coverage.min_pixels_per_mm2);
-  read("max_view_angle", QuantityKind::kAngle, {1 * kDeg, 90 * kDeg}, coverage.max_view_angle_rad);
-  read("max_blur", QuantityKind::kNumber, {0.1, 1000}, coverage.max_blur_px);
-  read("min_triangulation_angle", QuantityKind::kAngle, {0, 90 * kDeg},
+  read(node, "min_pixels_per_mm2", "min_pixels_per_mm2", limit::kMinPixelsPerMm2,
+       coverage.min_pixels_per_mm2);
+  read(node, "max_view_angle", "max_view_angle", limit::kMaxViewAngle, coverage.max_view_angle_rad);
+  read(node, "max_blur", "max_blur", limit::kMaxBlur, coverage.max_blur_px);
+  read(node, "min_triangulation_angle", "min_triangulation_angle", limit::kMinTriangulationAngle,
        coverage.min_triangulation_angle_rad);
-  read("min_signal", QuantityKind::kNumber, {0, 1}, coverage.min_signal);
-  read("max_signal", QuantityKind::kNumber, {0, 1}, coverage.max_signal);
-  read("min_overlap", QuantityKind::kNumber, {0, 1}, coverage.min_overlap);
-  read("min_frame_fill", QuantityKind::kNumber, {0, 1}, coverage.min_frame_fill);
+  read(node, "min_signal", "min_signal", limit::kMinSignal, coverage.min_signal);
+  read(node, "max_signal", "max_signal", limit::kMaxSignal, coverage.max_signal);
+  read(node, "min_overlap", "min_overlap", limit::kMinOverlap, coverage.min_overlap);
+  read(node, "min_frame_fill", "min_frame_fill", limit::kMinFrameFill, coverage.min_frame_fill);
   if (coverage.min_signal >= coverage.max_signal) {
     error(node, "coverage min_signal must be below max_signal");
   }
@@ -323,100 +393,11 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
           "object needs exactly one of 'mesh' (a model file) or 'primitive' (sphere, box, "
           "cylinder, statue)");
   }
-  if (has_mesh) {
-    if (auto path = scalar(node["mesh"], "mesh")) {
-      object.mesh_path = spec::Located<std::string>{*path, loc(node["mesh"])};
-      fs::path resolved = fs::path(*path);
-      if (resolved.is_relative()) resolved = fs::path(base_dir_) / resolved;
-      object.mesh_path_resolved = resolved.lexically_normal().string();
-      std::error_code ec;
-      if (!fs::exists(resolved, ec)) {
-        error(node["mesh"], fmt::format("mesh file '{}' does not exist", resolved.string()));
-      } else if (fs::is_directory(resolved, ec)) {
-        error(node["mesh"], fmt::format("mesh '{}' is a folder, not a file", resolved.string()));
-      } else {
-        std::string ext = resolved.extension().string();
-        std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-        const std::set<std::string> formats = {".gltf", ".glb", ".obj", ".ply", ".stl"};
-        if (!formats.count(ext)) {
-          error(node["mesh"], fmt::format("mesh '{}' has an unsupported format '{}' (use glTF/GLB, "
-                                          "OBJ, PLY or STL)",
-                                          *path, ext));
-        }
-      }
-    }
-  }
-  if (has_primitive) {
-    const YAML::Node primitive = node["primitive"];
-    // (yaml-cpp's Node::operator= writes through to the node, so pick the shape node once.)
-    const YAML::Node shape = primitive.IsMap() ? primitive["shape"] : primitive;
-    if (primitive.IsMap()) {
-      check_keys(primitive, {"shape", "detail", "seed"}, "primitive");
-      if (!shape) error(primitive, "primitive needs a 'shape' (sphere, box, cylinder, statue)");
-      if (primitive["detail"]) {
-        if (auto d = integer(primitive["detail"], "primitive detail", 1, 9)) {
-          object.primitive_detail = *d;
-        }
-      }
-      if (primitive["seed"]) {
-        if (auto s = integer(primitive["seed"], "primitive seed", 0, 1 << 30)) {
-          object.primitive_seed = static_cast<std::uint32_t>(*s);
-        }
-      }
-    }
-    if (shape) {
-      if (auto name = scalar(shape, "primitive shape")) {
-        if (!primitive_from_name(*name)) {
-          std::string suggestion = closest_match(*name, primitive_names());
-          error(shape,
-                fmt::format("unknown primitive '{}'{}", *name,
-                            suggestion.empty() ? " (expected sphere, box, cylinder or statue)"
-                                               : fmt::format("; did you mean '{}'?", suggestion)));
-        } else {
-          object.primitive = spec::Located<std::string>{*name, loc(shape)};
-        }
-      }
-    }
-  }
-  if (node["up"]) {
-    if (auto up = scalar(node["up"], "up")) {
-      if (*up == "y" || *up == "+y" || *up == "z" || *up == "+z" || *up == "-y" || *up == "-z") {
-        object.up_axis = up->back();
-        object.up_negative = (*up)[0] == '-';
-      } else {
-        error(node["up"], fmt::format("up must be y, z, -y or -z (the model file's up axis), got "
-                                      "'{}'",
-                                      *up));
-      }
-    }
-  }
-  if (node["fit"]) {
-    const YAML::Node fit = node["fit"];
-    if (expect_map(fit, "fit")) {
-      check_keys(fit, {"height", "width", "size"}, "fit");
-      if (fit.size() != 1) error(fit, "fit takes one of height, width or size");
-      auto read = [&](const char* key, std::optional<spec::Located<double>>& out) {
-        if (!fit[key]) return;
-        if (auto v = quantity(fit[key], QuantityKind::kLength, fmt::format("fit {}", key),
-                              Range{0.001, 100})) {
-          out = spec::Located<double>{*v, loc(fit[key])};
-        }
-      };
-      read("height", object.fit_height);
-      read("width", object.fit_width);
-      read("size", object.fit_size);
-    }
-  }
-  if (node["scale"]) {
-    if (node["scale"].IsSequence()) {
-      if (auto s = vec3(node["scale"], QuantityKind::kNumber, "scale", Range{0, 1e6, true})) {
-        object.scale = *s;
-      }
-    } else if (auto s =
-                   quantity(node["scale"], QuantityKind::kNumber, "scale", Range{0, 1e6, true})) {
-      object.scale = ir::Vec3::Constant(*s);
-    }
-  }
+  if (has_mesh) read_mesh(node["mesh"], object);
+  if (has_primitive) read_primitive(node["primitive"], object);
+  if (node["up"]) read_up_axis(node["up"], object);
+  if (node["fit"]) read_fit(node["fit"], object);
+  if (node["scale"]) read_scale(node["scale"], object);
   if (node["rotate"]) {
     if (auto r = vec3(node["rotate"], QuantityKind::kAngle, "rotate")) object.rotate_rad = *r;
   }
@@ -426,7 +407,93 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
   if (node["surface"]) read_surface(node["surface"], object);
 }
 
+void Checker::read_mesh(const YAML::Node& node, spec::ObjectSpec& object) {
+  auto path = scalar(node, "mesh");
+  if (!path) return;
+  object.mesh_path = spec::Located<std::string>{*path, loc(node)};
+  fs::path resolved = fs::path(*path);
+  if (resolved.is_relative()) resolved = fs::path(base_dir_) / resolved;
+  object.mesh_path_resolved = resolved.lexically_normal().string();
+  std::error_code ec;
+  if (!fs::exists(resolved, ec)) {
+    error(node, fmt::format("mesh file '{}' does not exist", resolved.string()));
+  } else if (fs::is_directory(resolved, ec)) {
+    error(node, fmt::format("mesh '{}' is a folder, not a file", resolved.string()));
+  } else {
+    std::string ext = resolved.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::set<std::string> formats = {".gltf", ".glb", ".obj", ".ply", ".stl"};
+    if (!formats.count(ext)) {
+      error(node, fmt::format("mesh '{}' has an unsupported format '{}' (use glTF/GLB, "
+                              "OBJ, PLY or STL)",
+                              *path, ext));
+    }
+  }
+}
+
+void Checker::read_primitive(const YAML::Node& primitive, spec::ObjectSpec& object) {
+  // (yaml-cpp's Node::operator= writes through to the node, so pick the shape node once.)
+  const YAML::Node shape = primitive.IsMap() ? primitive["shape"] : primitive;
+  if (primitive.IsMap()) {
+    check_keys(primitive, {"shape", "detail", "seed"}, "primitive");
+    if (!shape) error(primitive, "primitive needs a 'shape' (sphere, box, cylinder, statue)");
+    read(primitive, "detail", "primitive detail", limits::object::kPrimitiveDetail,
+         object.primitive_detail);
+    read(primitive, "seed", "primitive seed", limits::object::kPrimitiveSeed,
+         object.primitive_seed);
+  }
+  if (!shape) return;
+  auto name = scalar(shape, "primitive shape");
+  if (!name) return;
+  if (!primitive_from_name(*name)) {
+    error(shape, fmt::format("unknown primitive '{}'", *name) +
+                     did_you_mean(*name, primitive_names(),
+                                  " (expected sphere, box, cylinder or statue)"));
+  } else {
+    object.primitive = spec::Located<std::string>{*name, loc(shape)};
+  }
+}
+
+void Checker::read_up_axis(const YAML::Node& node, spec::ObjectSpec& object) {
+  auto up = scalar(node, "up");
+  if (!up) return;
+  if (*up == "y" || *up == "+y" || *up == "z" || *up == "+z" || *up == "-y" || *up == "-z") {
+    object.up_axis = up->back();
+    object.up_negative = (*up)[0] == '-';
+  } else {
+    error(node, fmt::format("up must be y, z, -y or -z (the model file's up axis), got "
+                            "'{}'",
+                            *up));
+  }
+}
+
+void Checker::read_fit(const YAML::Node& fit, spec::ObjectSpec& object) {
+  if (!expect_map(fit, "fit")) return;
+  check_keys(fit, {"height", "width", "size"}, "fit");
+  if (fit.size() != 1) error(fit, "fit takes one of height, width or size");
+  auto read_one = [&](const char* key, const limits::Quantity& limit,
+                      std::optional<spec::Located<double>>& out) {
+    if (!fit[key]) return;
+    if (auto v = quantity(fit[key], fmt::format("fit {}", key), limit)) {
+      out = spec::Located<double>{*v, loc(fit[key])};
+    }
+  };
+  read_one("height", limits::object::kFitHeight, object.fit_height);
+  read_one("width", limits::object::kFitWidth, object.fit_width);
+  read_one("size", limits::object::kFitSize, object.fit_size);
+}
+
+// One factor, or one per axis.
+void Checker::read_scale(const YAML::Node& node, spec::ObjectSpec& object) {
+  if (node.IsSequence()) {
+    if (auto s = vec3(node, "scale", limits::object::kScale)) object.scale = *s;
+  } else if (auto s = quantity(node, "scale", limits::object::kScale)) {
+    object.scale = ir::Vec3::Constant(*s);
+  }
+}
+
 void Checker::read_surface(const YAML::Node& node, spec::ObjectSpec& object) {
+  namespace limit = limits::object;
   if (!expect_map(node, "surface")) return;
   check_keys(node, {"pattern", "scale", "contrast", "seed", "color", "roughness", "metallic"},
              "surface");
@@ -443,36 +510,21 @@ void Checker::read_surface(const YAML::Node& node, spec::ObjectSpec& object) {
       else if (*name == "checker")
         object.pattern.kind = ir::PatternKind::kChecker;
       else {
-        std::string suggestion = closest_match(*name, names);
         error(node["pattern"],
-              fmt::format("unknown pattern '{}'{}", *name,
-                          suggestion.empty() ? " (expected none, speckle, noise or checker)"
-                                             : fmt::format("; did you mean '{}'?", suggestion)));
+              fmt::format("unknown pattern '{}'", *name) +
+                  did_you_mean(*name, names, " (expected none, speckle, noise or checker)"));
       }
     }
   }
-  if (node["scale"]) {
-    if (auto v =
-            quantity(node["scale"], QuantityKind::kLength, "pattern scale", Range{0.0001, 1})) {
-      object.pattern.scale_m = *v;
-    }
-  }
-  if (node["contrast"]) {
-    if (auto v = quantity(node["contrast"], QuantityKind::kNumber, "contrast", Range{0, 1})) {
-      object.pattern.contrast = *v;
-    }
-  }
-  if (node["seed"]) {
-    if (auto v = integer(node["seed"], "pattern seed", 0, 1 << 30)) {
-      object.pattern.seed = static_cast<std::uint32_t>(*v);
-    }
-  }
-  if (node["color"]) object.surface_color = color(node["color"], "surface color");
+  read(node, "scale", "pattern scale", limit::kPatternScale, object.pattern.scale_m);
+  read(node, "contrast", "contrast", limit::kPatternContrast, object.pattern.contrast);
+  read(node, "seed", "pattern seed", limit::kPatternSeed, object.pattern.seed);
+  if (node["color"]) object.surface_color = color(node["color"], "surface color", limit::kColor);
   if (node["roughness"]) {
-    object.roughness = quantity(node["roughness"], QuantityKind::kNumber, "roughness", Range{0, 1});
+    object.roughness = quantity(node["roughness"], "roughness", limit::kRoughness);
   }
   if (node["metallic"]) {
-    object.metallic = quantity(node["metallic"], QuantityKind::kNumber, "metallic", Range{0, 1});
+    object.metallic = quantity(node["metallic"], "metallic", limit::kMetallic);
   }
 }
 
@@ -480,98 +532,66 @@ void Checker::read_studio(const YAML::Node& node, spec::SceneSpec& scene) {
   if (!expect_map(node, "studio")) return;
   check_keys(node, {"turntable", "backdrop", "lights", "ambient", "floor"}, "studio");
   ir::Studio& studio = scene.studio;
-  if (const YAML::Node table = node["turntable"]) {
-    studio.turntable.loc = loc(table);
-    if (expect_map(table, "turntable")) {
-      check_keys(table, {"diameter", "height", "thickness", "color"}, "turntable");
-      if (table["diameter"]) {
-        if (auto v = quantity(table["diameter"], QuantityKind::kLength, "turntable diameter",
-                              Range{0.01, 10})) {
-          studio.turntable.diameter_m = *v;
-        }
-      }
-      if (table["height"]) {
-        if (auto v =
-                quantity(table["height"], QuantityKind::kLength, "turntable height", Range{0, 5})) {
-          studio.turntable.height_m = *v;
-        }
-      }
-      if (table["thickness"]) {
-        if (auto v = quantity(table["thickness"], QuantityKind::kLength, "turntable thickness",
-                              Range{0.001, 1})) {
-          studio.turntable.thickness_m = *v;
-        }
-      }
-      if (table["color"]) {
-        if (auto c = color(table["color"], "turntable color")) studio.turntable.color = *c;
-      }
-    }
-  }
-  if (const YAML::Node backdrop = node["backdrop"]) {
-    studio.backdrop.loc = loc(backdrop);
-    if (expect_map(backdrop, "backdrop")) {
-      check_keys(backdrop, {"green_screen", "color", "distance", "width", "height"}, "backdrop");
-      if (const YAML::Node green = backdrop["green_screen"]) {
-        if (green.IsMap()) {
-          check_keys(green, {"color"}, "green_screen");
-          studio.backdrop.green_screen = true;
-          if (green["color"]) {
-            if (auto c = color(green["color"], "green screen color")) studio.backdrop.color = *c;
-          }
-        } else if (auto on = boolean(green, "green_screen")) {
-          studio.backdrop.green_screen = *on;
-        }
-      }
-      if (backdrop["color"]) {
-        if (auto c = color(backdrop["color"], "backdrop color")) studio.backdrop.color = *c;
-      }
-      if (backdrop["distance"]) {
-        if (auto v = quantity(backdrop["distance"], QuantityKind::kLength, "backdrop distance",
-                              Range{0.05, 100})) {
-          studio.backdrop.distance_m = *v;
-          scene.backdrop_distance_set = true;
-        }
-      }
-      if (backdrop["width"]) {
-        if (auto v = quantity(backdrop["width"], QuantityKind::kLength, "backdrop width",
-                              Range{0.1, 100})) {
-          studio.backdrop.width_m = *v;
-        }
-      }
-      if (backdrop["height"]) {
-        if (auto v = quantity(backdrop["height"], QuantityKind::kLength, "backdrop height",
-                              Range{0.1, 100})) {
-          studio.backdrop.height_m = *v;
-        }
-      }
-    }
-  }
-  if (const YAML::Node lights = node["lights"]) {
-    if (!lights.IsSequence()) {
-      error(lights,
-            "lights must be a list, e.g. - {type: point, position: [1m, -1m, 1.5m], "
-            "power: 200W}");
-    } else if (lights.size() > kMostLights) {
-      // Each light has a shadow map (tens of MB at full size): 2000 took 3.6 GB for one shot.
-      error(lights,
-            fmt::format("{} lights; a studio here has at most {}", lights.size(), kMostLights));
-    } else {
-      for (const auto& light : lights) read_light(light, scene);
-    }
-  }
-  if (node["ambient"]) {
-    if (auto v =
-            quantity(node["ambient"], QuantityKind::kIlluminance, "ambient", Range{0, 200000})) {
-      studio.ambient_lx = *v;
-    }
-  }
+  if (const YAML::Node table = node["turntable"]) read_turntable(table, studio.turntable);
+  if (const YAML::Node backdrop = node["backdrop"]) read_backdrop(backdrop, scene);
+  if (const YAML::Node lights = node["lights"]) read_lights(lights, scene);
+  read(node, "ambient", "ambient", limits::studio::kAmbient, studio.ambient_lx);
   if (const YAML::Node floor = node["floor"]) {
     if (expect_map(floor, "floor")) {
       check_keys(floor, {"color"}, "floor");
-      if (floor["color"]) {
-        if (auto c = color(floor["color"], "floor color")) studio.floor_color = *c;
-      }
+      read_color(floor, "floor color", limits::studio::kFloorColor, studio.floor_color);
     }
+  }
+}
+
+void Checker::read_turntable(const YAML::Node& table, ir::Turntable& turntable) {
+  namespace limit = limits::studio;
+  turntable.loc = loc(table);
+  if (!expect_map(table, "turntable")) return;
+  check_keys(table, {"diameter", "height", "thickness", "color"}, "turntable");
+  read(table, "diameter", "turntable diameter", limit::kTurntableDiameter, turntable.diameter_m);
+  read(table, "height", "turntable height", limit::kTurntableHeight, turntable.height_m);
+  read(table, "thickness", "turntable thickness", limit::kTurntableThickness,
+       turntable.thickness_m);
+  read_color(table, "turntable color", limit::kTurntableColor, turntable.color);
+}
+
+void Checker::read_backdrop(const YAML::Node& node, spec::SceneSpec& scene) {
+  namespace limit = limits::studio;
+  ir::Backdrop& backdrop = scene.studio.backdrop;
+  backdrop.loc = loc(node);
+  if (!expect_map(node, "backdrop")) return;
+  check_keys(node, {"green_screen", "color", "distance", "width", "height"}, "backdrop");
+  if (const YAML::Node green = node["green_screen"]) {
+    if (green.IsMap()) {
+      check_keys(green, {"color"}, "green_screen");
+      backdrop.green_screen = true;
+      read_color(green, "green screen color", limit::kGreenScreenColor, backdrop.color);
+    } else if (auto on = boolean(green, "green_screen")) {
+      backdrop.green_screen = *on;
+    }
+  }
+  read_color(node, "backdrop color", limit::kBackdropColor, backdrop.color);
+  if (node["distance"]) {
+    if (auto v = quantity(node["distance"], "backdrop distance", limit::kBackdropDistance)) {
+      backdrop.distance_m = *v;
+      scene.backdrop_distance_set = true;
+    }
+  }
+  read(node, "width", "backdrop width", limit::kBackdropWidth, backdrop.width_m);
+  read(node, "height", "backdrop height", limit::kBackdropHeight, backdrop.height_m);
+}
+
+void Checker::read_lights(const YAML::Node& lights, spec::SceneSpec& scene) {
+  if (!lights.IsSequence()) {
+    error(lights,
+          "lights must be a list, e.g. - {type: point, position: [1m, -1m, 1.5m], "
+          "power: 200W}");
+  } else if (lights.size() > limits::studio::kLights.max) {
+    error(lights, fmt::format("{} lights; a studio here has at most {}", lights.size(),
+                              limits::studio::kLights.max));
+  } else {
+    for (const auto& light : lights) read_light(light, scene);
   }
 }
 
@@ -584,25 +604,9 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
     error(node, "a light needs a 'type': point, spot, directional or area");
     return;
   }
-  auto type = scalar(node["type"], "light type");
+  const std::optional<ir::LightType> type = light_type(node["type"]);
   if (!type) return;
-  const std::vector<std::string> types = {"point", "spot", "directional", "area"};
-  if (*type == "point")
-    light.type = ir::LightType::kPoint;
-  else if (*type == "spot")
-    light.type = ir::LightType::kSpot;
-  else if (*type == "directional")
-    light.type = ir::LightType::kDirectional;
-  else if (*type == "area")
-    light.type = ir::LightType::kArea;
-  else {
-    std::string suggestion = closest_match(*type, types);
-    error(node["type"],
-          fmt::format("unknown light type '{}'{}", *type,
-                      suggestion.empty() ? " (expected point, spot, directional or area)"
-                                         : fmt::format("; did you mean '{}'?", suggestion)));
-    return;
-  }
+  light.type = *type;
   std::vector<std::string> allowed = {"type", "temperature"};
   switch (light.type) {
     case ir::LightType::kPoint:
@@ -619,80 +623,94 @@ void Checker::read_light(const YAML::Node& node, spec::SceneSpec& scene) {
       allowed.insert(allowed.end(), {"position", "power", "direction", "look_at", "size"});
       break;
   }
-  check_keys(node, allowed, fmt::format("a {} light", *type));
+  const std::string type_name = node["type"].Scalar();
+  check_keys(node, allowed, fmt::format("a {} light", type_name));
+  read_light_source(node, type_name, light);
+  read_light_aim(node, light_spec);
+  read(node, "temperature", "colour temperature", limits::studio::kLightTemperature,
+       light.temperature_k);
+  read_light_shape(node, light);
+  scene.lights.push_back(light_spec);
+}
+
+std::optional<ir::LightType> Checker::light_type(const YAML::Node& node) {
+  auto type = scalar(node, "light type");
+  if (!type) return std::nullopt;
+  if (*type == "point") return ir::LightType::kPoint;
+  if (*type == "spot") return ir::LightType::kSpot;
+  if (*type == "directional") return ir::LightType::kDirectional;
+  if (*type == "area") return ir::LightType::kArea;
+  error(node, fmt::format("unknown light type '{}'", *type) +
+                  did_you_mean(*type, {"point", "spot", "directional", "area"},
+                               " (expected point, spot, directional or area)"));
+  return std::nullopt;
+}
+
+// Where the light is and how strong: a position and a power, or a directional light's
+// illuminance.
+void Checker::read_light_source(const YAML::Node& node, const std::string& type, ir::Light& light) {
   if (light.type != ir::LightType::kDirectional) {
     if (!node["position"]) {
-      if (lacks(node, "position")) error(node, fmt::format("a {} light needs a 'position'", *type));
+      if (lacks(node, "position")) error(node, fmt::format("a {} light needs a 'position'", type));
     } else if (auto p = vec3(node["position"], QuantityKind::kLength, "light position")) {
       light.position = *p;
     }
     if (!node["power"]) {
       if (lacks(node, "power"))
-        error(node, fmt::format("a {} light needs a 'power' (e.g. 200W)", *type));
-    } else if (auto w = quantity(node["power"], QuantityKind::kPower, "light power",
-                                 Range{0, 1e6, true})) {
+        error(node, fmt::format("a {} light needs a 'power' (e.g. 200W)", type));
+    } else if (auto w = quantity(node["power"], "light power", limits::studio::kLightPower)) {
       light.power_w = *w;
     }
   } else {
     if (!node["illuminance"]) {
       error(node, "a directional light needs an 'illuminance' (e.g. 2000lx)");
-    } else if (auto e = quantity(node["illuminance"], QuantityKind::kIlluminance, "illuminance",
-                                 Range{0, 200000, true})) {
+    } else if (auto e = quantity(node["illuminance"], "illuminance",
+                                 limits::studio::kLightIlluminance)) {
       light.illuminance_lx = *e;
     }
     if (!node["direction"]) error(node, "a directional light needs a 'direction' [x, y, z]");
   }
+}
+
+// A direction, or a point to look at (spot and area lights look at the object by default).
+void Checker::read_light_aim(const YAML::Node& node, spec::LightSpec& light_spec) {
+  ir::Light& light = light_spec.light;
   if (node["direction"] && node["look_at"]) {
     error(node["look_at"], "give a light either 'direction' or 'look_at', not both");
   }
   if (node["direction"]) {
-    if (auto d = vec3(node["direction"], QuantityKind::kNumber, "light direction")) {
-      // stableNorm: [1e200, 0, 0] overflowed norm() to inf and normalized() to a zero vector.
-      if (d->stableNorm() < 1e-9) {
-        error(node["direction"], "light direction must not be zero");
-      } else {
-        light.direction = d->stableNormalized();
-      }
+    if (auto d =
+            direction(node["direction"], "light direction", "light direction must not be zero")) {
+      light.direction = *d;
     }
   } else if (node["look_at"]) {
     light_spec.look_at = target(node["look_at"], "look_at");
   } else if (light.type == ir::LightType::kSpot || light.type == ir::LightType::kArea) {
-    light_spec.look_at = Target{};  // aim at the object by default
+    light_spec.look_at = Target{};
     light_spec.look_at->loc = light.loc;
   }
-  if (node["temperature"]) {
-    if (auto k = quantity(node["temperature"], QuantityKind::kTemperature, "colour temperature",
-                          Range{1000, 40000})) {
-      light.temperature_k = *k;
-    }
-  }
+}
+
+// An area light's size; a spot light's cone.
+void Checker::read_light_shape(const YAML::Node& node, ir::Light& light) {
+  namespace limit = limits::studio;
   if (node["size"]) {
     const YAML::Node size = node["size"];
     if (!size.IsSequence() || size.size() != 2) {
       error(size, "area light size must be [width, height]");
     } else {
-      auto w = quantity(size[0], QuantityKind::kLength, "area light width", Range{0.001, 20});
-      auto h = quantity(size[1], QuantityKind::kLength, "area light height", Range{0.001, 20});
+      auto w = quantity(size[0], "area light width", limit::kAreaLightSize);
+      auto h = quantity(size[1], "area light height", limit::kAreaLightSize);
       if (w && h) light.size_m = {*w, *h};
     }
   } else if (light.type == ir::LightType::kArea) {
     error(node, "an area light needs a 'size' [width, height]");
   }
   if (light.type == ir::LightType::kSpot) {
-    light.spot_angle_rad = 45 * kDeg;
-    if (node["angle"]) {
-      if (auto a = quantity(node["angle"], QuantityKind::kAngle, "spot angle",
-                            Range{1 * kDeg, 180 * kDeg})) {
-        light.spot_angle_rad = *a;
-      }
-    }
-    if (node["blend"]) {
-      if (auto b = quantity(node["blend"], QuantityKind::kNumber, "spot blend", Range{0, 1})) {
-        light.spot_blend = *b;
-      }
-    }
+    light.spot_angle_rad = 45 * kDegree;
+    read(node, "angle", "spot angle", limit::kSpotAngle, light.spot_angle_rad);
+    read(node, "blend", "spot blend", limit::kSpotBlend, light.spot_blend);
   }
-  scene.lights.push_back(light_spec);
 }
 
 void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
@@ -712,214 +730,196 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
           "the camera needs a 'body' preset (e.g. canon-6d) or a 'sensor' {width, height, "
           "pixels}");
   }
-  if (has_body) {
-    if (auto name = scalar(node["body"], "body")) {
-      if (auto preset = find_body_preset(*name)) {
-        camera.body = preset->name;
-        camera.make = preset->make;
-        camera.model = preset->model;
-        camera.sensor_width_m = preset->sensor_width_m;
-        camera.sensor_height_m = preset->sensor_height_m;
-        camera.width_px = preset->width_px;
-        camera.height_px = preset->height_px;
-        camera.noise = preset->noise;
-      } else {
-        std::vector<std::string> names;
-        for (const auto& p : body_presets()) names.push_back(p.name);
-        std::string suggestion = closest_match(*name, names);
-        std::string list;
-        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-        error(node["body"],
-              fmt::format("unknown camera body '{}'{}", *name,
-                          suggestion.empty() ? fmt::format(" (known: {})", list)
-                                             : fmt::format("; did you mean '{}'?", suggestion)));
-      }
-    }
-  }
-  if (has_sensor) {
-    const YAML::Node sensor = node["sensor"];
-    camera.body = "custom";
-    camera.make = "RigC";
-    camera.model = "custom sensor";
-    if (expect_map(sensor, "sensor")) {
-      check_keys(sensor, {"width", "height", "pixels"}, "sensor");
-      for (const char* key : {"width", "height", "pixels"}) {
-        if (lacks(sensor, key)) error(sensor, fmt::format("sensor needs '{}'", key));
-      }
-      if (sensor["width"]) {
-        if (auto v = quantity(sensor["width"], QuantityKind::kLength, "sensor width",
-                              Range{0.001, 0.2})) {
-          camera.sensor_width_m = *v;
-        }
-      }
-      if (sensor["height"]) {
-        if (auto v = quantity(sensor["height"], QuantityKind::kLength, "sensor height",
-                              Range{0.001, 0.2})) {
-          camera.sensor_height_m = *v;
-        }
-      }
-      if (const YAML::Node pixels = sensor["pixels"]) {
-        if (!pixels.IsSequence() || pixels.size() != 2) {
-          error(pixels, "sensor pixels must be [width, height]");
-        } else {
-          auto w = integer(pixels[0], "sensor pixel width", 16, 20000);
-          auto h = integer(pixels[1], "sensor pixel height", 16, 20000);
-          if (w && h) {
-            camera.width_px = *w;
-            camera.height_px = *h;
-          }
-        }
-      }
-    }
-  }
-  // EXIF strings: a JPEG marker holds under 64 KB, and libjpeg ended the process ("Bogus marker
-  // length") on a longer make or model.
-  for (const auto& [key, field] : {std::pair{"make", &camera.make}, {"model", &camera.model}}) {
-    if (!node[key]) continue;
-    if (auto v = scalar(node[key], key)) {
-      // EXIF text is NUL-terminated: a "\0" cut the tag short without a word.
-      const bool control =
-          std::any_of(v->begin(), v->end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; });
-      if (v->size() > kMaxExifText) {
-        error(node[key],
-              fmt::format("camera {} is {} bytes long; at most {}", key, v->size(), kMaxExifText));
-      } else if (control) {
-        error(node[key], fmt::format("camera {} holds a control character (EXIF text is one line "
-                                     "of printable characters)",
-                                     key));
-      } else {
-        *field = *v;
-      }
-    }
-  }
+  if (has_body) read_body(node["body"], camera);
+  if (has_sensor) read_sensor(node["sensor"], camera);
+  read_exif_text(node, camera);
   if (const YAML::Node lens = node["lens"]) {
-    if (expect_map(lens, "lens")) {
-      check_keys(lens, {"focal_length", "distortion", "vignetting"}, "lens");
-      if (lens["focal_length"]) {
-        if (auto f = quantity(lens["focal_length"], QuantityKind::kLength, "focal length",
-                              Range{0.004, 1.2})) {
-          camera.focal_length_m = *f;
-        }
-      } else if (lacks(lens, "focal_length")) {
-        error(lens, "lens needs a 'focal_length' (e.g. 50mm)");
-      }
-      if (const YAML::Node distortion = lens["distortion"]) {
-        if (expect_map(distortion, "distortion")) {
-          camera.distortion_loc = loc(distortion);
-          check_keys(distortion, {"k1", "k2", "k3", "p1", "p2"}, "distortion");
-          auto read = [&](const char* key, double& out) {
-            if (!distortion[key]) return;
-            if (auto v = quantity(distortion[key], QuantityKind::kNumber, key, Range{-1, 1})) {
-              out = *v;
-            }
-          };
-          read("k1", camera.distortion.k1);
-          read("k2", camera.distortion.k2);
-          read("k3", camera.distortion.k3);
-          read("p1", camera.distortion.p1);
-          read("p2", camera.distortion.p2);
-        }
-      }
-      if (lens["vignetting"]) {
-        if (auto v =
-                quantity(lens["vignetting"], QuantityKind::kNumber, "vignetting", Range{0, 0.95})) {
-          camera.vignetting = *v;
-        }
-      }
-    }
+    read_lens(lens, camera);
   } else {
     error(node, "the camera needs a 'lens' with a focal_length");
   }
   if (const YAML::Node exposure = node["exposure"]) {
-    if (expect_map(exposure, "exposure")) {
-      check_keys(exposure, {"aperture", "shutter", "iso"}, "exposure");
-      for (const char* key : {"aperture", "shutter", "iso"}) {
-        if (lacks(exposure, key)) error(exposure, fmt::format("exposure needs '{}'", key));
-      }
-      // The ranges of ISO 12232 stops that the seed paper's DSLR model offers.
-      if (exposure["aperture"]) camera.aperture_loc = loc(exposure["aperture"]);
-      if (exposure["shutter"]) camera.shutter_loc = loc(exposure["shutter"]);
-      if (exposure["iso"]) camera.iso_loc = loc(exposure["iso"]);
-      if (exposure["aperture"]) {
-        if (auto v = quantity(exposure["aperture"], QuantityKind::kFNumber, "aperture",
-                              Range{1.2, 64})) {
-          camera.aperture_f_number = *v;
-        }
-      }
-      if (exposure["shutter"]) {
-        if (auto v = quantity(exposure["shutter"], QuantityKind::kTime, "shutter",
-                              Range{1.0 / 8000, 30})) {
-          camera.shutter_s = *v;
-        }
-      }
-      if (exposure["iso"]) {
-        if (auto v = quantity(exposure["iso"], QuantityKind::kNumber, "ISO", Range{100, 51200})) {
-          camera.iso = *v;
-        }
-      }
-    }
+    read_exposure(exposure, camera);
   } else {
     error(node, "the camera needs an 'exposure' {aperture, shutter, iso}");
   }
-  if (const YAML::Node focus = node["focus"]) {
-    camera.focus_loc = loc(focus);
-    if (focus.IsScalar() && focus.Scalar() == "auto") {
-      scene.focus_auto = true;
-    } else if (auto d =
-                   quantity(focus, QuantityKind::kLength, "focus distance", Range{0.01, 1000})) {
-      scene.focus_auto = false;
-      scene.focus_distance_m = *d;
-    }
+  if (const YAML::Node focus = node["focus"]) read_focus(focus, scene);
+  if (const YAML::Node wb = node["white_balance"]) read_white_balance(wb, camera);
+  if (const YAML::Node effects = node["effects"]) read_effects(effects, camera);
+  if (const YAML::Node output = node["output"]) read_output(output, camera);
+  finish_camera(camera);
+}
+
+void Checker::read_body(const YAML::Node& body, ir::Camera& camera) {
+  auto name = scalar(body, "body");
+  if (!name) return;
+  if (auto preset = find_body_preset(*name)) {
+    camera.body = preset->name;
+    camera.make = preset->make;
+    camera.model = preset->model;
+    camera.sensor_width_m = preset->sensor_width_m;
+    camera.sensor_height_m = preset->sensor_height_m;
+    camera.width_px = preset->width_px;
+    camera.height_px = preset->height_px;
+    camera.noise = preset->noise;
+  } else {
+    std::vector<std::string> names;
+    for (const auto& p : body_presets()) names.push_back(p.name);
+    error(body, fmt::format("unknown camera body '{}'", *name) +
+                    did_you_mean(*name, names, fmt::format(" (known: {})", comma_list(names))));
   }
-  if (const YAML::Node wb = node["white_balance"]) {
-    if (wb.IsScalar() && wb.Scalar() == "auto") {
-      camera.white_balance = ir::WhiteBalanceMode::kAuto;
-    } else if (auto k =
-                   quantity(wb, QuantityKind::kTemperature, "white balance", Range{2000, 12000})) {
-      camera.white_balance = ir::WhiteBalanceMode::kKelvin;
-      camera.white_balance_k = *k;
-    }
+}
+
+void Checker::read_sensor(const YAML::Node& sensor, ir::Camera& camera) {
+  namespace limit = limits::camera;
+  camera.body = "custom";
+  camera.make = "RigC";
+  camera.model = "custom sensor";
+  if (!expect_map(sensor, "sensor")) return;
+  check_keys(sensor, {"width", "height", "pixels"}, "sensor");
+  for (const char* key : {"width", "height", "pixels"}) {
+    if (lacks(sensor, key)) error(sensor, fmt::format("sensor needs '{}'", key));
   }
-  if (const YAML::Node effects = node["effects"]) {
-    if (expect_map(effects, "effects")) {
-      check_keys(
-          effects,
-          {"depth_of_field", "diffraction", "motion_blur", "distortion", "vignetting", "noise"},
-          "effects");
-      auto read = [&](const char* key, bool& out) {
-        if (!effects[key]) return;
-        if (auto v = boolean(effects[key], key)) out = *v;
-      };
-      read("depth_of_field", camera.effects.depth_of_field);
-      read("diffraction", camera.effects.diffraction);
-      read("motion_blur", camera.effects.motion_blur);
-      read("distortion", camera.effects.distortion);
-      read("vignetting", camera.effects.vignetting);
-      read("noise", camera.effects.noise);
-    }
-  }
-  if (const YAML::Node output = node["output"]) {
-    if (expect_map(output, "output")) {
-      check_keys(output, {"format", "quality"}, "output");
-      if (output["format"]) {
-        if (auto f = scalar(output["format"], "output format")) {
-          if (*f == "jpeg" || *f == "jpg")
-            camera.format = ir::ImageFormat::kJpeg;
-          else if (*f == "png16")
-            camera.format = ir::ImageFormat::kPng16;
-          else if (*f == "tiff16")
-            camera.format = ir::ImageFormat::kTiff16;
-          else {
-            error(output["format"],
-                  fmt::format("unknown output format '{}' (expected jpeg, png16 or tiff16)", *f));
-          }
-        }
-      }
-      if (output["quality"]) {
-        if (auto q = integer(output["quality"], "JPEG quality", 1, 100)) camera.jpeg_quality = *q;
+  read(sensor, "width", "sensor width", limit::kSensorWidth, camera.sensor_width_m);
+  read(sensor, "height", "sensor height", limit::kSensorHeight, camera.sensor_height_m);
+  if (const YAML::Node pixels = sensor["pixels"]) {
+    if (!pixels.IsSequence() || pixels.size() != 2) {
+      error(pixels, "sensor pixels must be [width, height]");
+    } else {
+      auto w = integer(pixels[0], "sensor pixel width", limit::kSensorPixels);
+      auto h = integer(pixels[1], "sensor pixel height", limit::kSensorPixels);
+      if (w && h) {
+        camera.width_px = *w;
+        camera.height_px = *h;
       }
     }
   }
+}
+
+// The EXIF make and model: one line of printable text that fits in a JPEG marker (libjpeg
+// aborts, "Bogus marker length", on a longer one). EXIF text is NUL-terminated, so a "\0"
+// would cut the tag short.
+void Checker::read_exif_text(const YAML::Node& node, ir::Camera& camera) {
+  const std::tuple<const char*, std::string*, limits::Count> fields[] = {
+      {"make", &camera.make, limits::camera::kMake},
+      {"model", &camera.model, limits::camera::kModel}};
+  for (const auto& [key, field, limit] : fields) {
+    if (!node[key]) continue;
+    auto v = scalar(node[key], key);
+    if (!v) continue;
+    const bool control =
+        std::any_of(v->begin(), v->end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; });
+    if (v->size() > limit.max) {
+      error(node[key],
+            fmt::format("camera {} is {} bytes long; at most {}", key, v->size(), limit.max));
+    } else if (control) {
+      error(node[key], fmt::format("camera {} holds a control character (EXIF text is one line "
+                                   "of printable characters)",
+                                   key));
+    } else {
+      *field = *v;
+    }
+  }
+}
+
+void Checker::read_lens(const YAML::Node& lens, ir::Camera& camera) {
+  namespace limit = limits::camera;
+  if (!expect_map(lens, "lens")) return;
+  check_keys(lens, {"focal_length", "distortion", "vignetting"}, "lens");
+  if (lens["focal_length"]) {
+    read(lens, "focal_length", "focal length", limit::kFocalLength, camera.focal_length_m);
+  } else if (lacks(lens, "focal_length")) {
+    error(lens, "lens needs a 'focal_length' (e.g. 50mm)");
+  }
+  if (const YAML::Node distortion = lens["distortion"]) read_distortion(distortion, camera);
+  read(lens, "vignetting", "vignetting", limit::kVignetting, camera.vignetting);
+}
+
+void Checker::read_distortion(const YAML::Node& distortion, ir::Camera& camera) {
+  namespace limit = limits::camera;
+  if (!expect_map(distortion, "distortion")) return;
+  camera.distortion_loc = loc(distortion);
+  check_keys(distortion, {"k1", "k2", "k3", "p1", "p2"}, "distortion");
+  read(distortion, "k1", "k1", limit::kDistortionK1, camera.distortion.k1);
+  read(distortion, "k2", "k2", limit::kDistortionK2, camera.distortion.k2);
+  read(distortion, "k3", "k3", limit::kDistortionK3, camera.distortion.k3);
+  read(distortion, "p1", "p1", limit::kDistortionP1, camera.distortion.p1);
+  read(distortion, "p2", "p2", limit::kDistortionP2, camera.distortion.p2);
+}
+
+void Checker::read_exposure(const YAML::Node& exposure, ir::Camera& camera) {
+  namespace limit = limits::camera;
+  if (!expect_map(exposure, "exposure")) return;
+  check_keys(exposure, {"aperture", "shutter", "iso"}, "exposure");
+  for (const char* key : {"aperture", "shutter", "iso"}) {
+    if (lacks(exposure, key)) error(exposure, fmt::format("exposure needs '{}'", key));
+  }
+  if (exposure["aperture"]) camera.aperture_loc = loc(exposure["aperture"]);
+  if (exposure["shutter"]) camera.shutter_loc = loc(exposure["shutter"]);
+  if (exposure["iso"]) camera.iso_loc = loc(exposure["iso"]);
+  read(exposure, "aperture", "aperture", limit::kAperture, camera.aperture_f_number);
+  read(exposure, "shutter", "shutter", limit::kShutter, camera.shutter_s);
+  read(exposure, "iso", "ISO", limit::kIso, camera.iso);
+}
+
+void Checker::read_focus(const YAML::Node& focus, spec::SceneSpec& scene) {
+  scene.camera.focus_loc = loc(focus);
+  if (focus.IsScalar() && focus.Scalar() == "auto") {
+    scene.focus_auto = true;
+  } else if (auto d = quantity(focus, "focus distance", limits::camera::kFocusDistance)) {
+    scene.focus_auto = false;
+    scene.focus_distance_m = *d;
+  }
+}
+
+void Checker::read_white_balance(const YAML::Node& wb, ir::Camera& camera) {
+  if (wb.IsScalar() && wb.Scalar() == "auto") {
+    camera.white_balance = ir::WhiteBalanceMode::kAuto;
+  } else if (auto k = quantity(wb, "white balance", limits::camera::kWhiteBalance)) {
+    camera.white_balance = ir::WhiteBalanceMode::kKelvin;
+    camera.white_balance_k = *k;
+  }
+}
+
+void Checker::read_effects(const YAML::Node& effects, ir::Camera& camera) {
+  if (!expect_map(effects, "effects")) return;
+  check_keys(effects,
+             {"depth_of_field", "diffraction", "motion_blur", "distortion", "vignetting", "noise"},
+             "effects");
+  auto read_switch = [&](const char* key, bool& out) {
+    if (!effects[key]) return;
+    if (auto v = boolean(effects[key], key)) out = *v;
+  };
+  read_switch("depth_of_field", camera.effects.depth_of_field);
+  read_switch("diffraction", camera.effects.diffraction);
+  read_switch("motion_blur", camera.effects.motion_blur);
+  read_switch("distortion", camera.effects.distortion);
+  read_switch("vignetting", camera.effects.vignetting);
+  read_switch("noise", camera.effects.noise);
+}
+
+void Checker::read_output(const YAML::Node& output, ir::Camera& camera) {
+  if (!expect_map(output, "output")) return;
+  check_keys(output, {"format", "quality"}, "output");
+  if (output["format"]) {
+    if (auto f = scalar(output["format"], "output format")) {
+      if (*f == "jpeg" || *f == "jpg")
+        camera.format = ir::ImageFormat::kJpeg;
+      else if (*f == "png16")
+        camera.format = ir::ImageFormat::kPng16;
+      else if (*f == "tiff16")
+        camera.format = ir::ImageFormat::kTiff16;
+      else {
+        error(output["format"],
+              fmt::format("unknown output format '{}' (expected jpeg, png16 or tiff16)", *f));
+      }
+    }
+  }
+  read(output, "quality", "JPEG quality", limits::camera::kJpegQuality, camera.jpeg_quality);
+}
+
+// What follows from the sensor: the circle of confusion, and a warning on non-square pixels.
+void Checker::finish_camera(ir::Camera& camera) {
   // Acceptable circle of confusion: the sensor diagonal / 1500 (0.029 mm for full frame).
   camera.circle_of_confusion_m = std::hypot(camera.sensor_width_m, camera.sensor_height_m) / 1500.0;
   const double pixel_aspect =
@@ -958,60 +958,35 @@ void Checker::read_shots(const YAML::Node& node, spec::SceneSpec& scene) {
 }
 
 void Checker::read_turntable_shots(const YAML::Node& node, spec::ShotGroupSpec& group) {
+  namespace limit = limits::shots;
   group.kind = ir::ShotKind::kTurntable;
   spec::TurntableShotsSpec& shots = group.turntable;
   if (!expect_map(node, "turntable shots")) return;
   check_keys(node, {"steps", "step", "start", "speed", "camera"}, "turntable shots");
-  if (node["steps"]) {
-    if (auto n = integer(node["steps"], "turntable steps", 1, 3600)) shots.steps = *n;
-  }
+  read(node, "steps", "turntable steps", limit::kTurntableSteps, shots.steps);
   if (node["step"]) {
-    if (auto a = quantity(node["step"], QuantityKind::kAngle, "turntable step",
-                          Range{-360 * kDeg, 360 * kDeg})) {
-      shots.step_rad = *a;
-    }
+    read(node, "step", "turntable step", limit::kTurntableStep, shots.step_rad);
   } else {
     shots.step_rad = 2 * std::numbers::pi / shots.steps;
   }
-  if (node["start"]) {
-    if (auto a = quantity(node["start"], QuantityKind::kAngle, "turntable start",
-                          Range{-360 * kDeg, 360 * kDeg})) {
-      shots.start_rad = *a;
-    }
-  }
-  if (node["speed"]) {
-    if (auto w = quantity(node["speed"], QuantityKind::kAngularVelocity, "turntable speed",
-                          Range{-100, 100})) {
-      shots.speed_rad_s = *w;
-    }
-  }
+  read(node, "start", "turntable start", limit::kTurntableStart, shots.start_rad);
+  read(node, "speed", "turntable speed", limit::kTurntableSpeed, shots.speed_rad_s);
   if (const YAML::Node camera = node["camera"]) {
-    if (expect_map(camera, "turntable camera")) {
-      check_keys(camera, {"distance", "height", "azimuth", "aim"}, "turntable camera");
-      if (camera["distance"]) {
-        if (auto d = quantity(camera["distance"], QuantityKind::kLength, "camera distance",
-                              Range{0.01, 1000})) {
-          shots.camera.distance_m = *d;
-        }
-      }
-      if (camera["height"]) {
-        if (auto h = quantity(camera["height"], QuantityKind::kLength, "camera height",
-                              Range{-100, 100})) {
-          shots.camera.height_m = *h;
-        }
-      }
-      if (camera["azimuth"]) {
-        if (auto a = quantity(camera["azimuth"], QuantityKind::kAngle, "camera azimuth",
-                              Range{-360 * kDeg, 360 * kDeg})) {
-          shots.camera.azimuth_rad = *a;
-        }
-      }
-      if (camera["aim"]) {
-        if (auto t = target(camera["aim"], "aim")) shots.camera.aim = *t;
-      }
-    }
+    read_turntable_camera(camera, shots.camera);
   } else {
     error(node, "turntable shots need a 'camera' {distance, height}");
+  }
+}
+
+void Checker::read_turntable_camera(const YAML::Node& camera, spec::TurntableCameraSpec& out) {
+  namespace limit = limits::shots;
+  if (!expect_map(camera, "turntable camera")) return;
+  check_keys(camera, {"distance", "height", "azimuth", "aim"}, "turntable camera");
+  read(camera, "distance", "camera distance", limit::kTurntableCameraDistance, out.distance_m);
+  read(camera, "height", "camera height", limit::kTurntableCameraHeight, out.height_m);
+  read(camera, "azimuth", "camera azimuth", limit::kTurntableCameraAzimuth, out.azimuth_rad);
+  if (camera["aim"]) {
+    if (auto t = target(camera["aim"], "aim")) out.aim = *t;
   }
 }
 
@@ -1021,10 +996,7 @@ void Checker::read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& grou
   if (!expect_map(node, "orbit shots")) return;
   check_keys(node, {"rings", "distance", "aim"}, "orbit shots");
   if (node["distance"]) {
-    if (auto d = quantity(node["distance"], QuantityKind::kLength, "orbit distance",
-                          Range{0.01, 1000})) {
-      orbit.distance_m = *d;
-    }
+    read(node, "distance", "orbit distance", limits::shots::kOrbitDistance, orbit.distance_m);
   } else {
     error(node, "orbit shots need a 'distance' from the object");
   }
@@ -1036,30 +1008,23 @@ void Checker::read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& grou
     error(rings ? rings : node, "orbit shots need 'rings': a list of {elevation, count}");
     return;
   }
-  for (const auto& ring_node : rings) {
-    spec::RingSpec ring;
-    ring.loc = loc(ring_node);
-    if (!expect_map(ring_node, "a ring")) continue;
-    check_keys(ring_node, {"elevation", "count", "start"}, "a ring");
-    if (ring_node["elevation"]) {
-      if (auto e = quantity(ring_node["elevation"], QuantityKind::kAngle, "ring elevation",
-                            Range{-90 * kDeg, 90 * kDeg})) {
-        ring.elevation_rad = *e;
-      }
-    }
-    if (ring_node["count"]) {
-      if (auto n = integer(ring_node["count"], "ring count", 1, 3600)) ring.count = *n;
-    } else {
-      error(ring_node, "a ring needs a 'count' of shots");
-    }
-    if (ring_node["start"]) {
-      if (auto a = quantity(ring_node["start"], QuantityKind::kAngle, "ring start",
-                            Range{-360 * kDeg, 360 * kDeg})) {
-        ring.start_rad = *a;
-      }
-    }
-    orbit.rings.push_back(ring);
+  for (const auto& ring : rings) read_ring(ring, orbit);
+}
+
+void Checker::read_ring(const YAML::Node& node, spec::OrbitShotsSpec& orbit) {
+  namespace limit = limits::shots;
+  spec::RingSpec ring;
+  ring.loc = loc(node);
+  if (!expect_map(node, "a ring")) return;
+  check_keys(node, {"elevation", "count", "start"}, "a ring");
+  read(node, "elevation", "ring elevation", limit::kRingElevation, ring.elevation_rad);
+  if (node["count"]) {
+    read(node, "count", "ring count", limit::kRingCount, ring.count);
+  } else {
+    error(node, "a ring needs a 'count' of shots");
   }
+  read(node, "start", "ring start", limit::kRingStart, ring.start_rad);
+  orbit.rings.push_back(ring);
 }
 
 void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group) {
@@ -1079,19 +1044,9 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
     if (auto t = target(node["look_at"], "look_at")) pose.look_at = *t;
   }
   if (node["up"]) {
-    if (auto u = vec3(node["up"], QuantityKind::kNumber, "up")) {
-      if (u->stableNorm() < 1e-9)
-        error(node["up"], "up must not be zero");
-      else
-        pose.up = u->stableNormalized();
-    }
+    if (auto u = direction(node["up"], "up", "up must not be zero")) pose.up = *u;
   }
-  if (node["turntable"]) {
-    if (auto a = quantity(node["turntable"], QuantityKind::kAngle, "turntable angle",
-                          Range{-360 * kDeg, 360 * kDeg})) {
-      pose.turntable_rad = *a;
-    }
-  }
+  read(node, "turntable", "turntable angle", limits::shots::kPoseTurntable, pose.turntable_rad);
 }
 
 // Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past
@@ -1129,8 +1084,8 @@ bool valid_utf8(const std::string& text) {
 }
 
 // The mark of the first key or scalar value under `root` that is not UTF-8. yaml-cpp passes a
-// Latin-1 byte through: `check` accepted "café" in Latin-1, and writing the IR or the manifest
-// as JSON then failed (exit 2) after the images were written.
+// Latin-1 byte through, and writing the IR or the manifest as JSON would then fail after the
+// images are written.
 std::optional<YAML::Mark> first_invalid_utf8_scalar(const YAML::Node& root) {
   std::vector<YAML::Node> pending = {root};
   // Aliases share nodes, so nested ones (a "billion laughs" file) repeat them exponentially: the

@@ -1,6 +1,8 @@
 // The front end's entry points: read a scene file, parse and check it, lower it to the IR.
 #include "compiler/frontend.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <tuple>
 
 #include "compiler/check.h"
+#include "compiler/limits.h"
 
 namespace rigc {
 
@@ -39,16 +42,15 @@ std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticE
     diag.error({path, 0, 0}, "cannot read the scene file");
     return std::nullopt;
   }
-  // A scene is a few kilobytes; /dev/zero as the scene file grew memory without end.
-  constexpr std::size_t kMostBytes = 16 << 20;
+  // Read in chunks up to the limit, so that /dev/zero as the scene file cannot exhaust memory.
   std::string text;
   std::array<char, 1 << 16> chunk;
   while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
     text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMostBytes) {
-      diag.error({path, 0, 0},
-                 "the scene file is larger than 16 MB (a scene is text; meshes and "
-                 "textures are files of their own)");
+    if (text.size() > limits::kMostSceneFileBytes) {
+      diag.error({path, 0, 0}, fmt::format("the scene file is larger than {} MB (a scene is text; "
+                                           "meshes and textures are files of their own)",
+                                           limits::kMostSceneFileBytes >> 20));
       return std::nullopt;
     }
   }

@@ -193,8 +193,9 @@ TEST(Frontend, OrbitRingsExpandAroundTheObject) {
   EXPECT_GT(alignment, 1 - 1e-9);
 }
 
-// Directions of any length are directions: [1e200, 0, 0] overflowed norm() to inf, and the
-// pose's camera got zero right and down axes (and a non-unit quaternion in images.txt).
+// Directions of any length are directions: norm() overflows to inf on [1e200, 0, 0], which
+// would give the pose's camera zero right and down axes (and a non-unit quaternion in
+// images.txt).
 TEST(Frontend, HugeDirectionVectorsStayDirections) {
   std::string text = kMinimalScene;
   text.replace(text.find("  - turntable:"), std::string::npos,

@@ -13,6 +13,7 @@
 #include "compiler/check.h"
 #include "compiler/color.h"
 #include "compiler/frontend.h"
+#include "compiler/limits.h"
 
 namespace rigc {
 namespace {
@@ -100,6 +101,11 @@ class Lowering {
   }
 
   bool lower_object();
+  bool load_mesh(Eigen::Matrix3d* up);
+  void apply_surface();
+  bool place_object(const Eigen::Matrix3d& up);
+  std::optional<double> fit_scale(const Vec3& extent);
+  void warn_about_object();
   void lower_camera();
   void lower_lights();
   void lower_shots();
@@ -120,42 +126,57 @@ class Lowering {
 };
 
 bool Lowering::lower_object() {
+  scene_.object.loc = spec_.object.loc;
+  Eigen::Matrix3d up = Eigen::Matrix3d::Identity();
+  if (!load_mesh(&up)) return false;
+  apply_surface();
+  if (!place_object(up)) return false;
+  warn_about_object();
+  return true;
+}
+
+// Loads the mesh file or builds the primitive; `up` turns a file's up axis to +Z.
+bool Lowering::load_mesh(Eigen::Matrix3d* up) {
   const spec::ObjectSpec& object = spec_.object;
   ir::Object& out = scene_.object;
-  out.loc = object.loc;
-  Eigen::Matrix3d up = Eigen::Matrix3d::Identity();
-  if (object.mesh_path) {
-    std::string why;
-    auto model = load_model(object.mesh_path_resolved, &why);
-    if (!model) {
-      error(object.mesh_path->loc, fmt::format("cannot load mesh: {}", why));
-      return false;
-    }
-    for (const std::string& warning : model->warnings) {
-      diag_.warning(object.mesh_path->loc, warning);
-    }
-    out.source = object.mesh_path_resolved;
-    out.mesh = std::move(model->mesh);
-    scene_.materials = std::move(model->materials);
-    scene_.textures = std::move(model->textures);
-    std::string ext = fs::path(object.mesh_path_resolved).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    const bool gltf = ext == ".gltf" || ext == ".glb";
-    if (gltf && object.up_axis) {
-      diag_.warning(object.mesh_path->loc,
-                    "glTF files are always +Y up and converted automatically; 'up' is ignored");
-    } else if (!gltf) {
-      // Scans and DCC exports in OBJ/PLY are usually +Y up; STL (CAD) is usually +Z up.
-      char axis = object.up_axis ? object.up_axis : (ext == ".stl" ? 'z' : 'y');
-      up = up_axis_rotation(axis, object.up_negative);
-    }
-  } else {
+  if (!object.mesh_path) {
     auto kind = primitive_from_name(object.primitive->value);
     out.source = "primitive:" + object.primitive->value;
     out.mesh = make_primitive(*kind, object.primitive_detail, object.primitive_seed);
     scene_.materials.push_back(ir::Material{});
     scene_.materials.back().name = object.primitive->value;
+    return true;
   }
+  std::string why;
+  auto model = load_model(object.mesh_path_resolved, &why);
+  if (!model) {
+    error(object.mesh_path->loc, fmt::format("cannot load mesh: {}", why));
+    return false;
+  }
+  for (const std::string& warning : model->warnings) {
+    diag_.warning(object.mesh_path->loc, warning);
+  }
+  out.source = object.mesh_path_resolved;
+  out.mesh = std::move(model->mesh);
+  scene_.materials = std::move(model->materials);
+  scene_.textures = std::move(model->textures);
+  std::string ext = fs::path(object.mesh_path_resolved).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (gltf && object.up_axis) {
+    diag_.warning(object.mesh_path->loc,
+                  "glTF files are always +Y up and converted automatically; 'up' is ignored");
+  } else if (!gltf) {
+    // Scans and DCC exports in OBJ/PLY are usually +Y up; STL (CAD) is usually +Z up.
+    char axis = object.up_axis ? object.up_axis : (ext == ".stl" ? 'z' : 'y');
+    *up = up_axis_rotation(axis, object.up_negative);
+  }
+  return true;
+}
+
+// The scene's surface settings over every material (a texture wins over the pattern).
+void Lowering::apply_surface() {
+  const spec::ObjectSpec& object = spec_.object;
   for (auto& material : scene_.materials) {
     material.loc = object.loc;
     if (object.surface_color) material.base_color = *object.surface_color;
@@ -164,8 +185,12 @@ bool Lowering::lower_object() {
     if (material.base_color_texture < 0) material.pattern = object.pattern;
   }
   if (scene_.materials.empty()) scene_.materials.push_back(ir::Material{});
+}
 
-  // Rotation and scale first, then fit to the requested size, then rest on the turntable.
+// Rotation and scale first, then fit to the requested size, then rest on the turntable.
+bool Lowering::place_object(const Eigen::Matrix3d& up) {
+  const spec::ObjectSpec& object = spec_.object;
+  ir::Object& out = scene_.object;
   Eigen::Matrix3d user_rotation = (Eigen::AngleAxisd(object.rotate_rad.z(), Vec3::UnitZ()) *
                                    Eigen::AngleAxisd(object.rotate_rad.y(), Vec3::UnitY()) *
                                    Eigen::AngleAxisd(object.rotate_rad.x(), Vec3::UnitX()))
@@ -175,47 +200,60 @@ bool Lowering::lower_object() {
   Mat4 shaped = rotation(user_rotation) * user_scale * rotation(up);
   Vec3 lo, hi;
   transformed_bounds(out.mesh, shaped, &lo, &hi);
-  const Vec3 extent = hi - lo;
-  if (!(extent.maxCoeff() > 0) || !extent.allFinite()) {
-    error(object.loc, "the object's mesh has no extent (all vertices at one point)");
-    return false;
-  }
-  double fit_scale = 1;
-  if (object.fit_height) {
-    if (extent.z() <= 0) {
-      error(object.fit_height->loc, "cannot fit the height of a flat object (no extent in z)");
-      return false;
-    }
-    fit_scale = object.fit_height->value / extent.z();
-  } else if (object.fit_width) {
-    fit_scale = object.fit_width->value / std::max(extent.x(), extent.y());
-  } else if (object.fit_size) {
-    fit_scale = object.fit_size->value / extent.maxCoeff();
-  }
+  const std::optional<double> fit = fit_scale(hi - lo);
+  if (!fit) return false;
   Mat4 scaled = Mat4::Identity();
-  scaled.block<3, 3>(0, 0) *= fit_scale;
+  scaled.block<3, 3>(0, 0) *= *fit;
   shaped = scaled * shaped;
   transformed_bounds(out.mesh, shaped, &lo, &hi);
   const Vec3 rest_on_table(-(lo.x() + hi.x()) / 2, -(lo.y() + hi.y()) / 2, -lo.z());
   out.object_from_mesh = translation(rest_on_table + object.translate) * shaped;
   transformed_bounds(out.mesh, out.object_from_mesh, &out.bounds_min_object,
                      &out.bounds_max_object);
-  // An object a camera can photograph: `scale: 1e-300` made one of zero size (coverage printed
-  // -nan), and `translate: [1e300m, 0, 0]` put it beyond any float.
+  // An object a camera can photograph: not of zero size (`scale: 1e-300`), nor beyond any float
+  // (`translate: [1e300m, 0, 0]`).
   const double size_m = (out.bounds_max_object - out.bounds_min_object).maxCoeff();
   const double offset_m =
       out.bounds_min_object.cwiseAbs().cwiseMax(out.bounds_max_object.cwiseAbs()).maxCoeff();
-  if (!(size_m >= 1e-3 && size_m <= 100 && offset_m <= 1000)) {
+  if (!(size_m >= limits::kObjectSmallestM && size_m <= limits::kObjectLargestM &&
+        offset_m <= limits::kObjectReachM)) {
     error(object.loc, fmt::format("the object is {:.3g} m across and reaches {:.3g} m from the "
                                   "table's centre after fit, scale and translate; it must be "
-                                  "1 mm to 100 m across and within 1 km",
-                                  size_m, offset_m));
+                                  "{:g} mm to {:g} m across and within {:g} km",
+                                  size_m, offset_m, limits::kObjectSmallestM * 1000,
+                                  limits::kObjectLargestM, limits::kObjectReachM / 1000));
     return false;
   }
   object_center_ = (out.bounds_min_object + out.bounds_max_object) / 2;
+  return true;
+}
+
+// The factor that gives the shaped object (of `extent`) the size its fit asks for: 1 without
+// a fit; nullopt (reported) when it cannot be fitted.
+std::optional<double> Lowering::fit_scale(const Vec3& extent) {
+  const spec::ObjectSpec& object = spec_.object;
+  if (!(extent.maxCoeff() > 0) || !extent.allFinite()) {
+    error(object.loc, "the object's mesh has no extent (all vertices at one point)");
+    return std::nullopt;
+  }
+  if (object.fit_height) {
+    if (extent.z() <= 0) {
+      error(object.fit_height->loc, "cannot fit the height of a flat object (no extent in z)");
+      return std::nullopt;
+    }
+    return object.fit_height->value / extent.z();
+  }
+  if (object.fit_width) return object.fit_width->value / std::max(extent.x(), extent.y());
+  if (object.fit_size) return object.fit_size->value / extent.maxCoeff();
+  return 1.0;
+}
+
+// An object that overhangs the turntable, or that offers SfM no texture.
+void Lowering::warn_about_object() {
+  const ir::Object& out = scene_.object;
   const double radius = (out.bounds_max_object - out.bounds_min_object).head<2>().norm() / 2;
   if (radius > scene_.studio.turntable.diameter_m / 2 * 1.5) {
-    diag_.warning(object.loc,
+    diag_.warning(out.loc,
                   fmt::format("the object ({:.0f} cm across) overhangs the {:.0f} cm turntable",
                               radius * 200, scene_.studio.turntable.diameter_m * 100));
   }
@@ -224,19 +262,18 @@ bool Lowering::lower_object() {
     textured |= m.base_color_texture >= 0 || m.pattern.kind != ir::PatternKind::kNone;
   }
   if (!textured) {
-    diag_.warning(object.loc,
+    diag_.warning(out.loc,
                   "the object has no texture and no surface pattern: SfM will find few features; "
                   "add surface: {pattern: speckle}");
   }
-  return true;
 }
 
 // Why the Brown-Conrady mapping `d` is no lens over a sensor of half-extents (x, y) in
 // normalised coordinates (empty if it is one): walking out from the centre along every
 // direction, the mapping must stay one-to-one (a positive Jacobian) until it leaves the sensor,
 // and it must leave it. Each coefficient alone may lie in -1..1, but k1 = -1 folds a 50 mm
-// lens's frame over before its corners, and all five at +1 smeared the image beyond
-// recognition, while the exported cameras.txt claimed the mapping as the truth.
+// lens's frame over before its corners, and all five at +1 smear the image beyond recognition,
+// while cameras.txt would export the mapping as the truth.
 std::string distortion_problem(const ir::Distortion& d, double half_x, double half_y) {
   if (d.is_zero()) return {};
   constexpr int kDirections = 256;
@@ -301,11 +338,10 @@ void Lowering::lower_lights() {
 
 void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double angle,
                         double velocity, const Vec3& aim, const SourceLoc& loc) {
-  // Far more photos than a capture takes (and than COLMAP matches in a day): 300 rings of 3600
-  // in a 13 KB file made a million shots and 1.4 GB before any check ran.
-  constexpr std::size_t kMostShots = 5000;
-  if (scene_.shots.size() >= kMostShots) {
-    if (!too_many_shots_) error(loc, fmt::format("the shots make more than {} photos", kMostShots));
+  if (scene_.shots.size() >= limits::kMostShots) {
+    if (!too_many_shots_) {
+      error(loc, fmt::format("the shots make more than {} photos", limits::kMostShots));
+    }
     too_many_shots_ = true;
     return;
   }
@@ -333,8 +369,8 @@ void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double
   if ((eye_in_object.cwiseAbs() - half).maxCoeff() < 0) {
     error(loc, fmt::format("{}: the camera is inside the object's bounding box", shot.name));
   }
-  // Below the floor or inside the turntable's disc the camera sees nothing (the checks warned
-  // only that the object filled 0 % of the frame). The thin stand under the disc is left out.
+  // Below the floor or inside the turntable's disc the camera sees nothing. The thin stand under
+  // the disc is left out.
   const ir::Turntable& table = scene_.studio.turntable;
   if (eye.z() < 0) {
     error(loc, fmt::format("{}: the camera is {:.2f} m below the floor", shot.name, -eye.z()));

@@ -16,16 +16,14 @@ struct UnitDef {
   double to_si;
 };
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 const std::vector<UnitDef>& unit_table() {
   static const std::vector<UnitDef> table = {
       {"m", QuantityKind::kLength, 1.0},
       {"cm", QuantityKind::kLength, 0.01},
       {"mm", QuantityKind::kLength, 0.001},
       {"in", QuantityKind::kLength, 0.0254},
-      {"deg", QuantityKind::kAngle, kDeg},
-      {"°", QuantityKind::kAngle, kDeg},
+      {"deg", QuantityKind::kAngle, kDegree},
+      {"°", QuantityKind::kAngle, kDegree},
       {"rad", QuantityKind::kAngle, 1.0},
       {"s", QuantityKind::kTime, 1.0},
       {"ms", QuantityKind::kTime, 0.001},
@@ -34,7 +32,7 @@ const std::vector<UnitDef>& unit_table() {
       {"kW", QuantityKind::kPower, 1000.0},
       {"lx", QuantityKind::kIlluminance, 1.0},
       {"lux", QuantityKind::kIlluminance, 1.0},
-      {"deg/s", QuantityKind::kAngularVelocity, kDeg},
+      {"deg/s", QuantityKind::kAngularVelocity, kDegree},
       {"rad/s", QuantityKind::kAngularVelocity, 1.0},
       {"rpm", QuantityKind::kAngularVelocity, 2.0 * std::numbers::pi / 60.0},
   };
@@ -121,7 +119,7 @@ std::string format_quantity(double v, QuantityKind kind) {
       if (std::abs(v) < 1) return fmt::format("{:g}cm", v * 100);
       return fmt::format("{:g}m", v);
     case QuantityKind::kAngle:
-      return fmt::format("{:g}deg", v / kDeg);
+      return fmt::format("{:g}deg", v / kDegree);
     case QuantityKind::kTime:
       if (v > 0 && v < 0.5) return fmt::format("1/{:g}s", std::round(1.0 / v));
       return fmt::format("{:g}s", v);
@@ -134,7 +132,7 @@ std::string format_quantity(double v, QuantityKind kind) {
     case QuantityKind::kIlluminance:
       return fmt::format("{:g}lx", v);
     case QuantityKind::kAngularVelocity:
-      return fmt::format("{:g}deg/s", v / kDeg);
+      return fmt::format("{:g}deg/s", v / kDegree);
     case QuantityKind::kNumber:
       return fmt::format("{:g}", v);
   }
@@ -187,7 +185,7 @@ QuantityParse parse_quantity(const std::string& raw, QuantityKind kind) {
   if (!split_number(text, &number, &unit)) return fail(expected);
   if (unit.empty()) {
     result.value = kind == QuantityKind::kAngle || kind == QuantityKind::kAngularVelocity
-                       ? number * kDeg
+                       ? number * kDegree
                        : number;
     return result;
   }

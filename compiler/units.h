@@ -2,10 +2,14 @@
 // Everything is converted to SI (meters, radians, seconds, kelvin, watts, lux, rad/s).
 #pragma once
 
+#include <numbers>
 #include <optional>
 #include <string>
 
 namespace rigc {
+
+// One degree, in radians.
+inline constexpr double kDegree = std::numbers::pi / 180.0;
 
 enum class QuantityKind {
   kNumber,           // dimensionless
