@@ -1,4 +1,4 @@
-// `rigc eval` and `rigc compare` (issue #6): reconstruct an image set with COLMAP (CPU), align the
+// `rigc eval` and `rigc compare`: reconstruct an image set with COLMAP (CPU), align the
 // result to the ground truth, and measure it the way the paper's Table 1 did, plus Tanks and
 // Temples' F-score and camera errors.
 //
@@ -52,8 +52,10 @@ struct EvalSummary {
   nlohmann::json report;
 };
 
-// Runs the whole evaluation, progress and errors to `log`. Returns 0, 1 (user error: bad
-// folder, no ground truth) or 2 (COLMAP missing or failing, or no reconstruction; the message
+// Runs the whole evaluation, progress and errors to `log`: checks the inputs (eval/inputs.h), runs
+// COLMAP (eval/colmap.h), aligns the model to the ground truth (eval/align.h), measures it
+// (eval/measure.h) and writes the report (eval/report.h). Returns 0, 1 (user error: bad folder, no
+// ground truth) or 2 (COLMAP missing or failing, or no reconstruction; the message
 // names the log).
 int evaluate(const EvalOptions& options, std::ostream& log, EvalSummary* summary);
 
