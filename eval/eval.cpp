@@ -1,6 +1,9 @@
 #include "eval/eval.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
+#include <cmath>
 #include <ostream>
 
 #include "eval/align.h"
@@ -11,6 +14,41 @@
 #include "eval/report.h"
 
 namespace rigc::eval {
+
+bool EvalOptions::check(std::string* error) const {
+  auto refuse = [&](std::string why) {
+    *error = std::move(why);
+    return false;
+  };
+  if (run_dir.empty() == photos_dir.empty()) {
+    return refuse("give a run folder or a folder of photos (one of them)");
+  }
+  if (colmap.empty()) return refuse("no COLMAP executable given");
+  if (matcher != "auto" && matcher != "exhaustive" && matcher != "sequential" &&
+      matcher != "neighbours") {
+    return refuse(
+        fmt::format("unknown matcher '{}' (auto, exhaustive, sequential or neighbours)", matcher));
+  }
+  if (!(neighbour_angle_deg > 0 && neighbour_angle_deg <= 180)) {
+    return refuse(
+        fmt::format("the neighbour angle is {} deg; it must be in (0, 180]", neighbour_angle_deg));
+  }
+  if (poisson_depth < 1 || poisson_depth > 16) {
+    return refuse(fmt::format("the Poisson depth is {}; it must be in 1 .. 16", poisson_depth));
+  }
+  if (!(std::isfinite(tau_mm) && tau_mm > 0)) {
+    return refuse(fmt::format("the F-score threshold is {} mm; it must be positive", tau_mm));
+  }
+  if (ground_truth_samples < 1) {
+    return refuse(
+        fmt::format("{} ground-truth samples; at least 1 is needed", ground_truth_samples));
+  }
+  if (!(std::isfinite(color_range_mm) && color_range_mm >= 0)) {
+    return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
+                              color_range_mm));
+  }
+  return true;
+}
 
 namespace {
 
@@ -25,6 +63,11 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const auto t_start = Clock::now();
   EvalSummary local;
   EvalSummary& sum = summary ? *summary : local;
+  std::string error;
+  if (!o.check(&error)) {
+    log << "rigc eval: error: " << error << "\n";
+    return 1;
+  }
   const auto in = gather_inputs(o, log, sum);
   if (!in) return 1;
   EvalReport report(*in, log, sum);
@@ -37,7 +80,6 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);
   }
   const auto t_rigc = Clock::now();
-  std::string error;
   const auto model = read_sparse_model(colmap.model_txt, &error);
   if (!model) return report.fail("reconstruction", error, 2);
   report.add_reconstruction(*model, colmap, o.quiet);

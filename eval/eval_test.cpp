@@ -307,6 +307,41 @@ TEST(EvalPictures, HeatColoursFollowCloudCompare) {
   EXPECT_EQ(signed_distance_color(5, 1), (C{255, 0, 0}));
 }
 
+TEST(EvalOptions, CheckRefusesFieldsOutOfRangeBeforeAnythingRuns) {
+  EvalOptions o;
+  std::string error;
+  EXPECT_FALSE(o.check(&error)) << "neither a run nor photos";
+  o.run_dir = "run";
+  EXPECT_TRUE(o.check(&error)) << error;
+  o.photos_dir = "photos";
+  EXPECT_FALSE(o.check(&error)) << "both a run and photos";
+  o.photos_dir.clear();
+  auto refused = [&](auto change) {
+    EvalOptions bad = o;
+    change(bad);
+    return !bad.check(&error);
+  };
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.matcher = "fastest"; }));
+  EXPECT_NE(error.find("unknown matcher 'fastest'"), std::string::npos) << error;
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.colmap.clear(); }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = NAN; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.poisson_depth = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.tau_mm = -1; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.ground_truth_samples = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.color_range_mm = -2; }));
+  // evaluate() refuses them as a user error, and writes nothing.
+  rigc::testing::TempDir dir;
+  EvalOptions bad = o;
+  bad.run_dir = dir.file("run");
+  bad.tau_mm = 0;
+  std::ostringstream log;
+  EXPECT_EQ(evaluate(bad, log, nullptr), 1);
+  EXPECT_NE(log.str().find("rigc eval: error: the F-score threshold is 0 mm"), std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "run"));
+}
+
 TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   rigc::testing::TempDir dir;
   fs::create_directories(dir.path() / "photos");
