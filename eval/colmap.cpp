@@ -1,12 +1,15 @@
 #include "eval/colmap.h"
 
+#include <OpenImageIO/imagebuf.h>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <numeric>
+#include <regex>
 #include <sstream>
 
 #include "io/child_processes.h"
@@ -15,6 +18,7 @@
 namespace rigc::eval {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
 
 int run_logged(const std::vector<std::string>& argv, const fs::path& log, std::string* error,
                double* cpu_seconds) {
@@ -196,6 +200,394 @@ std::optional<SparseModel> read_sparse_model(const fs::path& dir, std::string* e
   model.images = std::move(*images);
   model.points = std::move(*points);
   return model;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Mean "Features: N" of COLMAP's feature_extractor log (3.8 prints one per image).
+std::optional<double> mean_features(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line;
+  static const std::regex re(R"(^\s*Features:\s*(\d+))");
+  double sum = 0;
+  int n = 0;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (std::regex_search(line, m, re)) {
+      sum += std::stod(m[1]);
+      ++n;
+    }
+  }
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+// Puts every image of `set` into `to` under the same name, 8 bits a channel: COLMAP 3.8 cannot
+// read 16-bit PNG and TIFF (what a camera's `output: {format: png16}` writes), and its SIFT works
+// on 8-bit grey anyway. 8-bit files are copied as they are (a JPEG is not encoded twice). False
+// with `error` when an image's pixels cannot be read (its header could: the input is at fault) or
+// a copy cannot be written.
+bool write_eight_bit_copies(const ImageSet& set, const fs::path& to, bool* input_fault,
+                            std::string* error) {
+  const fs::path& from = set.dir;
+  std::error_code ec;
+  fs::create_directories(to, ec);
+  for (const auto& [name, size] : set.size) {
+    if (!set.wider_than_eight_bit.count(name)) {
+      fs::copy_file(from / name, to / name, fs::copy_options::overwrite_existing, ec);
+      if (ec) {
+        *error = fmt::format("cannot copy {} for COLMAP: {}", (from / name).string(), ec.message());
+        return false;
+      }
+      continue;
+    }
+    OIIO::ImageBuf image((from / name).string());
+    if (!image.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
+      *input_fault = true;
+      *error =
+          fmt::format("cannot read the pixels of {}: {}", (from / name).string(), image.geterror());
+      return false;
+    }
+    if (!image.write((to / name).string(), OIIO::TypeDesc::UINT8)) {
+      *error = fmt::format("cannot write an 8-bit copy of {} for COLMAP: {}",
+                           (from / name).string(), image.geterror());
+      return false;
+    }
+  }
+  return true;
+}
+
+using Argv = std::vector<std::string>;
+
+// One run_colmap: its folders, the probed COLMAP, and the ColmapRun it fills in step by step.
+class ColmapPipeline {
+ public:
+  ColmapPipeline(const EvalOptions& o, const EvalInputs& in, std::ostream& log)
+      : o_(o),
+        in_(in),
+        log_(log),
+        work_(in.out / "colmap"),
+        logs_(in.out / "logs"),
+        txt_(work_ / "model_txt"),
+        db_(work_ / "database.db"),
+        images_dir_(in.images.dir) {}
+
+  ColmapRun run() {
+    if (o_.reuse_colmap && fs::exists(txt_ / "points3D.txt")) {
+      reuse_earlier_model();
+      return r_;
+    }
+    std::error_code ec;
+    fs::remove_all(work_, ec);
+    fs::create_directories(work_ / "sparse", ec);
+    fs::create_directories(logs_, ec);
+    if (!prepare_images() || !probe()) return r_;
+    const Argv extract = feature_extractor_args();
+    std::optional<Argv> match = matcher_args();
+    if (!match) return r_;
+    const std::vector<Step> steps = {
+        {"feature_extractor", extract}, {(*match)[1], *match}, {"mapper", mapper_args()}};
+    if (run_steps(steps)) keep_largest_model();
+    return r_;
+  }
+
+ private:
+  struct Step {
+    std::string name;
+    Argv argv;
+  };
+
+  void fail(int exit_code, std::string why) {
+    r_.exit_code = exit_code;
+    r_.failure = std::move(why);
+  }
+
+  // --reuse-colmap: the model in the output folder, with the steps and times of the eval.json
+  // that made it.
+  void reuse_earlier_model() {
+    r_.ok = true;
+    r_.reused = true;
+    r_.model_txt = txt_;
+    const json previous =
+        json::parse(std::ifstream(in_.out / "eval.json", std::ios::binary), nullptr, false);
+    if (!previous.is_discarded() && previous.contains("colmap") && previous["colmap"].is_object()) {
+      r_.steps = previous["colmap"].value("steps", json::array());
+      r_.seconds = previous["colmap"].value("seconds", 0.0);
+      r_.prior = previous["colmap"].value("intrinsics_prior", json());
+      r_.matching = previous["colmap"].value("matching", json::object());
+      if (!r_.matching.is_object()) r_.matching = json::object();
+    }
+    if (!o_.quiet) log_ << "rigc eval: reusing the COLMAP model in " << txt_.string() << "\n";
+  }
+
+  // 8-bit copies of the images when some are wider.
+  bool prepare_images() {
+    if (in_.images.wider_than_eight_bit.empty()) return true;
+    images_dir_ = work_ / "images_8bit";
+    if (!o_.quiet) {
+      log_ << "rigc eval: 8-bit copies of the images for COLMAP in " << images_dir_.string()
+           << "\n";
+    }
+    bool input_fault = false;
+    std::string error;
+    if (write_eight_bit_copies(in_.images, images_dir_, &input_fault, &error)) return true;
+    fail(input_fault ? 1 : 2, error);
+    return false;
+  }
+
+  bool probe() {
+    std::string error;
+    auto flags = probe_colmap(o_.colmap, logs_, &error);
+    if (!flags) {
+      fail(2, error);
+      return false;
+    }
+    flags_ = *flags;
+    return true;
+  }
+
+  Argv feature_extractor_args() {
+    Argv argv = {o_.colmap, "feature_extractor", "--database_path", db_.string(), "--image_path",
+                 images_dir_.string(), "--ImageReader.single_camera",
+                 // One camera for photos of one size; COLMAP refuses a single camera over
+                 // images of different sizes.
+                 in_.images.one_size() ? "1" : "0"};
+    if (!flags_.extraction_gpu.empty()) {
+      argv.push_back(flags_.extraction_gpu);
+      argv.push_back("0");
+    }
+    add_intrinsics_prior(argv);
+    add_masks(argv);
+    return argv;
+  }
+
+  // The intrinsics prior: the run's ground-truth camera (exact), else COLMAP reads EXIF.
+  void add_intrinsics_prior(Argv& argv) {
+    const fs::path cameras_txt = in_.run_dir / "sparse" / "cameras.txt";
+    std::string why;
+    auto cams = run::read_colmap_cameras(cameras_txt, &why);
+    if (cams && !cams->empty()) {
+      const auto& c = cams->front();
+      std::string params;
+      for (double v : c.params) params += (params.empty() ? "" : ",") + fmt::format("{:.17g}", v);
+      argv.insert(argv.end(),
+                  {"--ImageReader.camera_model", c.model, "--ImageReader.camera_params", params});
+      exact_prior_ = true;
+      r_.prior = {{"source", cameras_txt.string()},
+                  {"model", c.model},
+                  {"params", c.params},
+                  {"refined_by_colmap", o_.refine_intrinsics}};
+    } else {
+      argv.insert(argv.end(), {"--ImageReader.camera_model", "OPENCV"});
+      r_.prior = {{"source", "EXIF focal length, read by COLMAP"},
+                  {"model", "OPENCV"},
+                  {"refined_by_colmap", true}};
+    }
+  }
+
+  // The run's object masks: COLMAP wants masks/<image name>.png and ignores zero pixels.
+  void add_masks(Argv& argv) {
+    const fs::path masks = in_.run_dir / "masks";
+    if (!o_.use_masks || !fs::is_directory(masks)) return;
+    const fs::path mask_dir = work_ / "masks";
+    std::error_code ec;
+    fs::create_directories(mask_dir, ec);
+    int linked = 0;
+    for (const auto& name : in_.images.names) {
+      const fs::path src = masks / (fs::path(name).stem().string() + ".png");
+      if (!fs::exists(src)) continue;
+      fs::create_symlink(fs::absolute(src), mask_dir / (name + ".png"), ec);
+      if (!ec) ++linked;
+    }
+    if (linked > 0) {
+      argv.insert(argv.end(), {"--ImageReader.mask_path", mask_dir.string()});
+      r_.prior["masks"] = masks.string();
+    }
+  }
+
+  // Matching costs about features^2 per pair on the CPU: with a capture plan, match only the
+  // views that can overlap. nullopt when the neighbours matcher cannot run.
+  std::optional<Argv> matcher_args() {
+    const int image_count = static_cast<int>(in_.images.names.size());
+    std::string matcher = o_.matcher;
+    if (matcher == "auto") {
+      const bool planned = every_image_planned(in_.images.names, in_.truth.poses);
+      matcher = planned && flags_.imports_pair_lists ? "neighbours"
+                : image_count > 100                  ? "sequential"
+                                                     : "exhaustive";
+    }
+    const long all_pairs = static_cast<long>(image_count) * (image_count - 1) / 2;
+    r_.matching = {{"matcher", matcher}, {"all_pairs", all_pairs}};
+    Argv argv;
+    if (matcher == "neighbours") {
+      auto importer = neighbour_matching_args();
+      if (!importer) return std::nullopt;
+      argv = std::move(*importer);
+    } else {
+      argv = {o_.colmap, matcher + "_matcher", "--database_path", db_.string()};
+      if (matcher == "exhaustive") r_.matching["pairs"] = all_pairs;
+    }
+    if (!flags_.matching_gpu.empty()) {
+      argv.push_back(flags_.matching_gpu);
+      argv.push_back("0");
+    }
+    return argv;
+  }
+
+  // matches_importer on the pairs of views whose planned optical axes are close.
+  std::optional<Argv> neighbour_matching_args() {
+    if (!flags_.imports_pair_lists) {
+      fail(2,
+           fmt::format("this COLMAP's matches_importer takes no pair list (see {}); use --matcher "
+                       "exhaustive",
+                       (logs_ / "colmap_probe.log").string()));
+      return std::nullopt;
+    }
+    NeighbourPairOptions rule;
+    rule.max_angle_deg = o_.neighbour_angle_deg;
+    std::vector<ir::Vec3> axes;
+    for (const auto& name : in_.images.names) {
+      // The optical axis (camera +Z) in the world: the third row of camera_from_world's rotation.
+      axes.push_back(in_.truth.poses.at(name).block<1, 3>(2, 0).transpose());
+    }
+    const auto pairs = neighbour_pairs(axes, rule);
+    const fs::path pair_list = work_ / "pairs.txt";
+    std::string error;
+    if (!write_pair_list(pair_list, in_.images.names, pairs, &error)) {
+      fail(2, error);
+      return std::nullopt;
+    }
+    r_.matching["pairs"] = pairs.size();
+    r_.matching["pair_list"] = pair_list.string();
+    r_.matching["rule"] = fmt::format(
+        "planned poses ({}): views whose optical axes are at most {} deg apart, the nearest {} "
+        "at most, the nearest {} at least",
+        (in_.run_dir / "sparse" / "images.txt").string(), rule.max_angle_deg, rule.max_per_image,
+        rule.min_per_image);
+    return Argv{o_.colmap,           "matches_importer", "--database_path", db_.string(),
+                "--match_list_path", pair_list.string(), "--match_type",    "pairs"};
+  }
+
+  Argv mapper_args() const {
+    Argv argv = {o_.colmap, "mapper", "--database_path", db_.string(), "--image_path",
+                 images_dir_.string(), "--output_path", (work_ / "sparse").string(),
+                 // COLMAP 3.8 drops a model of fewer than min(images, 10) registered images: a
+                 // ring with one photo lost registers in parts, which would be reported as
+                 // nothing reconstructed.
+                 "--Mapper.min_model_size", "3"};
+    if (exact_prior_ && !o_.refine_intrinsics) {
+      // A known camera: refining focal length and distortion from two narrow-angle views of a
+      // small object is ill-conditioned and can stop the reconstruction at its first pair.
+      argv.insert(argv.end(),
+                  {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point",
+                   "0", "--Mapper.ba_refine_extra_params", "0"});
+    }
+    return argv;
+  }
+
+  // Runs the steps in order, each logged to OUT/logs/<step>.log and timed; false when one fails
+  // (a mapper that finds nothing is reported by keep_largest_model).
+  bool run_steps(const std::vector<Step>& steps) {
+    std::error_code ec;
+    for (const auto& step : steps) {
+      const fs::path step_log = logs_ / (step.name + ".log");
+      fs::remove(step_log, ec);
+      if (!o_.quiet) log_ << fmt::format("rigc eval: colmap {} ...\n", step.name);
+      const auto t0 = Clock::now();
+      double cpu_s = 0;
+      std::string error;
+      const int rc = run_logged(step.argv, step_log, &error, &cpu_s);
+      const double s = seconds_since(t0);
+      r_.seconds += s;
+      r_.steps.push_back({{"name", step.name},
+                          {"seconds", s},
+                          {"cpu_seconds", cpu_s},
+                          {"exit_code", rc},
+                          {"log", step_log.string()}});
+      if (step.name == "feature_extractor") {
+        if (const auto features = mean_features(step_log)) {
+          r_.matching["mean_features_per_image"] = *features;
+        }
+      }
+      if (rc != 0 && step.name != "mapper") {
+        fail(2, rc < 0 ? error
+                       : fmt::format("colmap {} failed (exit {}); see {}", step.name, rc,
+                                     step_log.string()));
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // The mapper may write several models (sparse/0, sparse/1, ...): converts each to text and
+  // keeps the one with the most images as OUT/colmap/model_txt.
+  void keep_largest_model() {
+    fs::path best;
+    std::size_t best_images = 0;
+    const auto t_convert = Clock::now();
+    double convert_cpu_s = 0;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(work_ / "sparse", ec)) {
+      if (!e.is_directory()) continue;
+      const fs::path tmp = work_ / ("txt_" + e.path().filename().string());
+      fs::create_directories(tmp, ec);
+      double cpu_s = 0;
+      std::string error;
+      const int rc = run_logged({o_.colmap, "model_converter", "--input_path", e.path().string(),
+                                 "--output_path", tmp.string(), "--output_type", "TXT"},
+                                logs_ / "model_converter.log", &error, &cpu_s);
+      convert_cpu_s += cpu_s;
+      if (rc != 0) continue;
+      auto images = run::read_colmap_images(tmp / "images.txt", &error);
+      if (images && images->size() > best_images) {
+        best_images = images->size();
+        best = tmp;
+      }
+    }
+    const double convert_s = seconds_since(t_convert);
+    r_.seconds += convert_s;
+    r_.steps.push_back({{"name", "model_converter"},
+                        {"seconds", convert_s},
+                        {"cpu_seconds", convert_cpu_s},
+                        {"log", (logs_ / "model_converter.log").string()}});
+    if (best.empty()) {
+      fail(2, nothing_reconstructed());
+      return;
+    }
+    fs::rename(best, txt_, ec);
+    r_.model_txt = ec ? best : txt_;
+    r_.ok = true;
+  }
+
+  std::string nothing_reconstructed() const {
+    const auto features = mean_features(logs_ / "feature_extractor.log");
+    return fmt::format(
+        "COLMAP reconstructed nothing from {} images{}: no initial image pair (too few features "
+        "or matches: the object may need more texture, or the shots more overlap); see {}",
+        in_.images.names.size(),
+        features ? fmt::format(" ({:.0f} features per image on average)", *features) : "",
+        (logs_ / "mapper.log").string());
+  }
+
+  const EvalOptions& o_;
+  const EvalInputs& in_;
+  std::ostream& log_;
+  const fs::path work_, logs_, txt_, db_;
+  fs::path images_dir_;  // the images COLMAP reads: the inputs, or their 8-bit copies
+  ColmapFlags flags_;
+  bool exact_prior_ = false;  // the run's own camera is the intrinsics prior
+  ColmapRun r_;
+};
+
+}  // namespace
+
+ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log) {
+  return ColmapPipeline(options, inputs, log).run();
 }
 
 }  // namespace rigc::eval

@@ -1,13 +1,18 @@
-// Driving COLMAP's command line (CPU only) as subprocesses, and reading its text models.
+// Driving COLMAP's command line (CPU only) as subprocesses, and reading its text models. The
+// second stage of `rigc eval`: run_colmap reconstructs the checked inputs.
 #pragma once
 
 #include <array>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "eval/eval.h"
+#include "eval/inputs.h"
 #include "ir/ir.h"
 #include "run/colmap_text.h"
 
@@ -38,8 +43,8 @@ std::optional<ColmapFlags> probe_colmap(const std::string& executable,
 
 // Which image pairs to match when the capture plan is known (a run folder's sparse/images.txt):
 // views whose optical axes are close. A turntable's neighbours wrap around, a multi-ring orbit's
-// include the rings above and below. On the paper scene (24 views, 15 deg apart), exhaustive
-// matching verified ~1900 matches at 15 deg, ~530 at 30, ~120 at 45, ~20 at 60 and none beyond.
+// include the rings above and below. Verified matches fall off fast with the angle between two
+// views: 45 deg keeps the pairs that still share features on a turntable.
 struct NeighbourPairOptions {
   double max_angle_deg = 45;  // pair views up to this angle apart ...
   int max_per_image = 10;     // ... the nearest ones at most (dense captures) ...
@@ -74,5 +79,22 @@ std::optional<std::vector<Point3D>> read_colmap_points(const std::filesystem::pa
                                                        std::string* error);
 // Reads cameras.txt, images.txt and points3D.txt of a text model folder.
 std::optional<SparseModel> read_sparse_model(const std::filesystem::path& dir, std::string* error);
+
+// One COLMAP reconstruction, as eval.json's "colmap" section reports it.
+struct ColmapRun {
+  bool ok = false;
+  int exit_code = 0;  // when not ok: 1 the input's fault, 2 COLMAP's
+  std::string failure;
+  nlohmann::json steps = nlohmann::json::array();  // name, seconds, cpu_seconds, exit_code, log
+  double seconds = 0;
+  std::filesystem::path model_txt;                     // the largest model, as text
+  nlohmann::json prior;                                // the intrinsics COLMAP started from
+  nlohmann::json matching = nlohmann::json::object();  // matcher, pairs and how they were chosen
+  bool reused = false;  // --reuse-colmap found a model: the times are the earlier run's
+};
+
+// Features (with the run's camera as the intrinsics prior and its masks), matching, mapper, and
+// the text export of the largest model, in OUT/colmap with each step's log in OUT/logs.
+ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log);
 
 }  // namespace rigc::eval

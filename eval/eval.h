@@ -1,4 +1,4 @@
-// `rigc eval` and `rigc compare` (issue #6): reconstruct an image set with COLMAP (CPU), align the
+// `rigc eval` and `rigc compare`: reconstruct an image set with COLMAP (CPU), align the
 // result to the ground truth, and measure it the way the paper's Table 1 did, plus Tanks and
 // Temples' F-score and camera errors.
 //
@@ -38,6 +38,10 @@ struct EvalOptions {
   int ground_truth_samples = 200000;  // surface samples before the visibility test
   double color_range_mm = 0;          // heat-map colour range; 0 = 3 x RMS of the distances
   bool quiet = false;
+
+  // False with a one-line `error` when a field is out of its range or the folders are not one
+  // run folder or one photos folder. evaluate() checks it first.
+  bool check(std::string* error) const;
 };
 
 // The headline numbers (all of them are in `report`, which is eval.json).
@@ -52,7 +56,9 @@ struct EvalSummary {
   nlohmann::json report;
 };
 
-// Runs the whole evaluation, progress and errors to `log`. Returns 0, 1 (user error: bad
+// Runs the whole evaluation, progress and errors to `log`: checks the inputs (eval/inputs.h), runs
+// COLMAP (eval/colmap.h), aligns the model to the ground truth (eval/align.h), measures it
+// (eval/measure.h) and writes the report (eval/report.h). Returns 0, 1 (user error: bad options or
 // folder, no ground truth) or 2 (COLMAP missing or failing, or no reconstruction; the message
 // names the log).
 int evaluate(const EvalOptions& options, std::ostream& log, EvalSummary* summary);

@@ -16,10 +16,9 @@
 #include <sstream>
 
 #include "assets/mesh_io.h"
-#include "backends/preview/preview_backend.h"
-#include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "eval/colmap.h"
+#include "eval/eval_test_support.h"
 #include "eval/geometry.h"
 #include "eval/metrics.h"
 #include "run/manifest.h"
@@ -29,22 +28,9 @@ namespace rigc::eval {
 namespace {
 
 namespace fs = std::filesystem;
-
-// An axis-aligned cube [-h, h]^3 with outward-facing triangles.
-void cube(double h, std::vector<Eigen::Vector3f>* v, std::vector<std::array<std::uint32_t, 3>>* t) {
-  v->clear();
-  t->clear();
-  for (int i = 0; i < 8; ++i) {
-    v->emplace_back((i & 1 ? h : -h), (i & 2 ? h : -h), (i & 4 ? h : -h));
-  }
-  // Quads (counter-clockwise seen from outside).
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    t->push_back({std::uint32_t(q[0]), std::uint32_t(q[1]), std::uint32_t(q[2])});
-    t->push_back({std::uint32_t(q[0]), std::uint32_t(q[2]), std::uint32_t(q[3])});
-  }
-}
+using test_inputs::cube;
+using test_inputs::write_cube_ply;
+using test_inputs::write_small_image;
 
 TEST(EvalAlign, RansacRecoversKnownSimilarityDespiteOutliers) {
   Similarity truth;
@@ -321,47 +307,39 @@ TEST(EvalPictures, HeatColoursFollowCloudCompare) {
   EXPECT_EQ(signed_distance_color(5, 1), (C{255, 0, 0}));
 }
 
-// A 10 cm cube as a PLY file: a ground truth for the command tests.
-void write_cube_ply(const std::string& path) {
-  std::vector<Eigen::Vector3f> v;
-  std::vector<std::array<std::uint32_t, 3>> t;
-  cube(0.1, &v, &t);
-  ir::Mesh mesh;
-  mesh.positions = v;
-  mesh.triangles = t;
-  std::string error;
-  ASSERT_TRUE(write_ply(path, mesh, &error)) << error;
-}
-
-// A small grey image in the format its name asks for, which eval's readability check accepts.
-void write_small_image(const std::string& path, int side = 64) {
-  const OIIO::ImageSpec spec(side, side, 3, OIIO::TypeDesc::UINT8);
-  const std::vector<unsigned char> pixels(static_cast<std::size_t>(side) * side * 3, 128);
-  auto out = OIIO::ImageOutput::create(path);
-  ASSERT_TRUE(out && out->open(path, spec)) << path;
-  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-  ASSERT_TRUE(out->close());
-}
-
-TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
-  rigc::testing::TempDir dir;
-  EXPECT_EQ(cli::run_eval_command({"rigc eval", dir.file("nothing")}), 1);
-  // A run folder with images but a COLMAP that does not exist.
-  fs::create_directories(dir.path() / "run" / "images");
-  for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("run/images/") + name);
-  write_cube_ply(dir.file("cube.ply"));
+TEST(EvalOptions, CheckRefusesFieldsOutOfRangeBeforeAnythingRuns) {
   EvalOptions o;
-  o.run_dir = dir.file("run");
-  o.ground_truth = dir.file("cube.ply");
-  o.colmap = dir.file("no-such-colmap");
-  o.quiet = true;
+  std::string error;
+  EXPECT_FALSE(o.check(&error)) << "neither a run nor photos";
+  o.run_dir = "run";
+  EXPECT_TRUE(o.check(&error)) << error;
+  o.photos_dir = "photos";
+  EXPECT_FALSE(o.check(&error)) << "both a run and photos";
+  o.photos_dir.clear();
+  auto refused = [&](auto change) {
+    EvalOptions bad = o;
+    change(bad);
+    return !bad.check(&error);
+  };
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.matcher = "fastest"; }));
+  EXPECT_NE(error.find("unknown matcher 'fastest'"), std::string::npos) << error;
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.colmap.clear(); }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = NAN; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.poisson_depth = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.tau_mm = -1; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.ground_truth_samples = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.color_range_mm = -2; }));
+  // evaluate() refuses them as a user error, and writes nothing.
+  rigc::testing::TempDir dir;
+  EvalOptions bad = o;
+  bad.run_dir = dir.file("run");
+  bad.tau_mm = 0;
   std::ostringstream log;
-  EvalSummary s;
-  EXPECT_EQ(evaluate(o, log, &s), 2);
-  EXPECT_NE(log.str().find("COLMAP is not available"), std::string::npos) << log.str();
-  std::ifstream report(dir.file("run/eval/eval.json"));
-  ASSERT_TRUE(report.good());
-  EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");
+  EXPECT_EQ(evaluate(bad, log, nullptr), 1);
+  EXPECT_NE(log.str().find("rigc eval: error: the F-score threshold is 0 mm"), std::string::npos)
+      << log.str();
+  EXPECT_FALSE(fs::exists(dir.path() / "run"));
 }
 
 TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
@@ -380,8 +358,6 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   EXPECT_NE(log.str().find("planned pose"), std::string::npos) << log.str();
 }
 
-// COLMAP's extractor only logs a file it cannot read, and its matcher then aborted (exit 134)
-// without naming it: eval reads every image's header first and names the ones that fail.
 // Options for evaluating dir/photos against a cube (written here) into dir/eval, with a COLMAP
 // that does not exist: for the checks that come before COLMAP runs.
 EvalOptions photos_without_colmap(const rigc::testing::TempDir& dir) {
@@ -394,6 +370,8 @@ EvalOptions photos_without_colmap(const rigc::testing::TempDir& dir) {
   return o;
 }
 
+// COLMAP's extractor only logs a file it cannot read, and its matcher then aborts without naming
+// it: eval reads every image's header first and names the ones that fail.
 TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
   rigc::testing::TempDir dir;
   fs::create_directories(dir.path() / "photos");
@@ -422,7 +400,7 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
   o.colmap = dir.file("no-such-colmap");
-  // The images are 64 x 64: a camera of 64 x 3 tripped an assertion in OpenImageIO.
+  // The images are 64 x 64, the camera 64 x 3.
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"),
                             "1 OPENCV 64 3 80 80 32 32 0 0 0 0\n");
   std::ostringstream log;
@@ -430,7 +408,7 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   EXPECT_NE(log.str().find("a.jpg is 64x64 pixels, but"), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("gives the camera as 64x3"), std::string::npos) << log.str();
   EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "a refused input leaves nothing behind";
-  // An empty camera file printed "rigc eval: error: " and nothing more.
+  // An empty camera file is named (not a bare "rigc eval: error: ").
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"), "");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
@@ -510,189 +488,6 @@ TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
   EXPECT_NE(log.str().find("cannot read the pixels of"), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("b.png"), std::string::npos) << log.str();
   EXPECT_TRUE(fs::exists(dir.path() / "eval" / "colmap" / "images_8bit" / "a.png"));
-}
-
-// ---------------------------------------------------------------------------------------------
-// End to end with COLMAP: SLOW (the textured one takes about 1-2 minutes on 2 busy cores, the
-// untextured one seconds). Skipped without colmap. Filter them out with -EvalEndToEnd.*
-
-bool have_colmap() {
-  return std::system("colmap -h > /dev/null 2>&1") == 0;
-}
-
-struct RenderedRun {
-  fs::path scene_file, run_dir;
-};
-
-RenderedRun render(const rigc::testing::TempDir& dir, const std::string& text, double scale) {
-  RenderedRun r;
-  r.scene_file = dir.path() / "scene.yaml";
-  r.run_dir = dir.path() / "run";
-  rigc::testing::write_text(r.scene_file.string(), text);
-  DiagnosticEngine diag;
-  diag.set_handler([](const Diagnostic&, const std::string&) {});
-  auto scene = compile_scene_file(r.scene_file.string(), diag);
-  EXPECT_TRUE(scene.has_value());
-  if (!scene) return r;
-  run::RunOptions options;
-  options.output_dir = r.run_dir;
-  options.settings.scale = scale;
-  std::ostringstream log;
-  preview::PreviewBackend backend;
-  EXPECT_EQ(run::run_backend(*scene, backend, options, log), 0) << log.str();
-  return r;
-}
-
-TEST(EvalEndToEnd, SlowTexturedTurntableRegistersEveryImageAndIsAccurate) {
-  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
-  rigc::testing::TempDir dir;
-  // 16 shots, 656 x 437 px, a speckled statue against a green screen.
-  const RenderedRun run = render(dir, R"(rigc: 1
-name: eval-e2e
-object:
-  primitive: {shape: statue, detail: 5, seed: 3}
-  fit: {height: 25cm}
-  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
-studio:
-  backdrop: {green_screen: true}
-  lights:
-    - {type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
-    - {type: area, position: [-0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
-  ambient: 50lx
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
-  effects: {motion_blur: false}
-shots:
-  - turntable: {steps: 16, step: 22.5deg, camera: {distance: 70cm, height: 15cm}}
-)",
-                                 0.12);
-  EvalOptions o;
-  o.run_dir = run.run_dir.string();
-  o.quiet = true;
-  std::ostringstream log;
-  EvalSummary s;
-  ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
-  EXPECT_EQ(s.images, 16);
-  EXPECT_EQ(s.registered, 16);
-  EXPECT_GT(s.points, 1000);
-  const auto& d = s.report["signed_distance_mm"];
-  EXPECT_LT(d["mean_abs"].get<double>(), 0.5) << s.report.dump(2);
-  EXPECT_LT(std::abs(d["median"].get<double>()), 0.2);
-  // Camera centres: depth along a 50 mm lens's axis is the weak direction (0.7 % of 70 cm).
-  EXPECT_LT(s.report["cameras"]["position_error_mm"]["median"].get<double>(), 5.0);
-  std::cout << "[ eval     ] " << s.registered << "/" << s.images << " registered, " << s.points
-            << " points, " << s.mean_mm << " ± " << s.std_mm << " mm, mean |d| "
-            << d["mean_abs"].get<double>() << " mm, COLMAP " << s.colmap_s << " s, RigC "
-            << s.rigc_s << " s\n";
-  EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "cloud_signed_distance.ply"));
-  EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "heatmap.png"));
-  EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "histogram.png"));
-  // Every file was renamed into place: no hidden temporary is left beside them.
-  for (const auto& entry : fs::directory_iterator(run.run_dir / "eval")) {
-    EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
-  }
-}
-
-// A small speckled statue on a turntable, `steps` shots 20 degrees apart, 656 px wide at the
-// tests' 0.12 scale; `camera_extra` lines go into the camera section.
-std::string small_statue_ring(const std::string& name, int steps, const std::string& camera_extra) {
-  return fmt::format(R"(rigc: 1
-name: {}
-object:
-  primitive: {{shape: statue, detail: 4, seed: 3}}
-  fit: {{height: 25cm}}
-  surface: {{pattern: speckle, scale: 2mm, contrast: 0.8}}
-studio:
-  backdrop: {{green_screen: true}}
-  lights:
-    - {{type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}}
-  ambient: 50lx
-camera:
-  body: canon-6d
-  lens: {{focal_length: 50mm}}
-  exposure: {{aperture: f/11, shutter: 1/125, iso: 200}}
-  effects: {{motion_blur: false}}
-{}shots:
-  - turntable: {{steps: {}, step: 20deg, camera: {{distance: 70cm, height: 15cm}}}}
-)",
-                     name, camera_extra, steps);
-}
-
-// Evaluates a small rendered run quietly (20000 ground-truth samples); false, with the log
-// printed, if eval does not exit 0.
-bool evaluate_small_run(const RenderedRun& run, EvalSummary* s) {
-  EvalOptions o;
-  o.run_dir = run.run_dir.string();
-  o.quiet = true;
-  o.ground_truth_samples = 20000;
-  std::ostringstream log;
-  const int code = evaluate(o, log, s);
-  if (code != 0) ADD_FAILURE() << "eval exited " << code << ":\n" << log.str();
-  return code == 0;
-}
-
-// COLMAP 3.8 reads 8-bit images only: a run in the language's own 16-bit PNG made its matcher
-// abort (exit 134). Eval hands it 8-bit copies.
-TEST(EvalEndToEnd, SlowSixteenBitRunIsEvaluated) {
-  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
-  rigc::testing::TempDir dir;
-  const RenderedRun run =
-      render(dir, small_statue_ring("eval-e2e-png16", 8, "  output: {format: png16}\n"), 0.12);
-  ASSERT_TRUE(fs::exists(run.run_dir / "images" / "shot_000.png"));
-  EvalSummary s;
-  ASSERT_TRUE(evaluate_small_run(run, &s));
-  EXPECT_EQ(s.registered, 8);
-  EXPECT_TRUE(fs::exists(run.run_dir / "eval" / "colmap" / "images_8bit" / "shot_000.png"));
-}
-
-// A ring with a gap (one of ten photos lost) registers in part. COLMAP 3.8 drops models smaller
-// than min(images, 10) unless told otherwise: this said "reconstructed nothing".
-TEST(EvalEndToEnd, SlowCaptureWithAGapReportsThePartItReconstructs) {
-  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
-  rigc::testing::TempDir dir;
-  const RenderedRun run = render(dir, small_statue_ring("eval-e2e-gap", 10, ""), 0.12);
-  ASSERT_TRUE(fs::remove(run.run_dir / "images" / "shot_005.jpg"));
-  EvalSummary s;
-  ASSERT_TRUE(evaluate_small_run(run, &s));
-  EXPECT_EQ(s.images, 9);
-  EXPECT_GE(s.registered, 3);
-  EXPECT_LT(s.registered, 9) << "the gap splits the ring";
-}
-
-TEST(EvalEndToEnd, SlowUntexturedObjectReportsTheFailure) {
-  if (!have_colmap()) GTEST_SKIP() << "colmap is not installed";
-  rigc::testing::TempDir dir;
-  const RenderedRun run = render(dir, R"(rigc: 1
-name: eval-e2e-plain
-object:
-  primitive: sphere
-  fit: {height: 20cm}
-studio:
-  backdrop: {green_screen: true}
-  lights:
-    - {type: area, position: [0.7m, -1.3m, 1.3m], size: [50cm, 50cm], power: 60W}
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
-  effects: {motion_blur: false}
-shots:
-  - turntable: {steps: 8, step: 45deg, camera: {distance: 70cm, height: 15cm}}
-)",
-                                 0.1);
-  EvalOptions o;
-  o.run_dir = run.run_dir.string();
-  o.quiet = true;
-  std::ostringstream log;
-  EvalSummary s;
-  EXPECT_EQ(evaluate(o, log, &s), 2);
-  EXPECT_FALSE(s.reconstructed);
-  EXPECT_NE(log.str().find("texture"), std::string::npos) << log.str();
-  std::ifstream report(run.run_dir / "eval" / "eval.json");
-  ASSERT_TRUE(report.good());
-  EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");
 }
 
 }  // namespace

@@ -289,8 +289,8 @@ std::vector<std::uint32_t> spatial_order(const std::vector<Vec3>& points) {
 }  // namespace
 
 // One Embree BVH answers both ray casts and nearest-triangle queries (rtcPointQuery). The
-// Open3D mesh is kept only for its area-uniform sampler. (Debian's Open3D 0.16 build returns no
-// hits from RaycastingScene's CastRays/TestOcclusions, so rays never went through Open3D.)
+// Open3D mesh is kept only for its area-uniform sampler: Debian's Open3D 0.16 build returns no
+// hits from RaycastingScene's CastRays/TestOcclusions.
 struct Surface::Impl {
   std::shared_ptr<o3d::geometry::TriangleMesh> legacy;  // with triangle normals, for sampling
   Eigen::AlignedBox3d box;

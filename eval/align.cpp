@@ -1,0 +1,238 @@
+#include "eval/align.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace rigc::eval {
+
+using nlohmann::json;
+
+Eigen::AlignedBox3d object_crop(const Surface& surface) {
+  const Eigen::AlignedBox3d box = surface.bounds();
+  const double diag = box.diagonal().norm();
+  Eigen::AlignedBox3d crop = box;
+  crop.extend(box.min() - Vec3::Constant(0.05 * diag));
+  crop.extend(box.max() + Vec3::Constant(0.05 * diag));
+  return crop;
+}
+
+Vec3 camera_centre(const Mat4& camera_from_world) {
+  return -camera_from_world.topLeftCorner<3, 3>().transpose() *
+         camera_from_world.topRightCorner<3, 1>();
+}
+
+double rotation_angle_deg(const Eigen::Matrix3d& r) {
+  const double c = std::clamp((r.trace() - 1) / 2, -1.0, 1.0);
+  return std::acos(c) * 180 / M_PI;
+}
+
+namespace {
+
+ViewCamera view_camera(const run::ColmapCamera& cam, const Mat4& camera_from_world) {
+  ViewCamera v;
+  v.camera_from_world = camera_from_world;
+  v.width = cam.width;
+  v.height = cam.height;
+  const auto& p = cam.params;
+  if (cam.model == "SIMPLE_PINHOLE" || cam.model == "SIMPLE_RADIAL" || cam.model == "RADIAL") {
+    v.fx = v.fy = p.at(0);
+    v.cx = p.at(1);
+    v.cy = p.at(2);
+  } else {
+    v.fx = p.at(0);
+    v.fy = p.at(1);
+    v.cx = p.at(2);
+    v.cy = p.at(3);
+  }
+  return v;
+}
+
+json similarity_json(const Similarity& s) {
+  json m = json::array();
+  const Mat4 x = s.matrix();
+  for (int r = 0; r < 4; ++r) m.push_back({x(r, 0), x(r, 1), x(r, 2), x(r, 3)});
+  return {{"scale", s.scale}, {"matrix", m}};
+}
+
+// The centroid of `points` and the median distance from it.
+std::pair<Vec3, double> robust_radius(const std::vector<Vec3>& points) {
+  Vec3 c = Vec3::Zero();
+  for (const auto& p : points) c += p;
+  c /= static_cast<double>(points.size());
+  std::vector<double> r;
+  for (const auto& p : points) r.push_back((p - c).norm());
+  std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+  return {c, r[r.size() / 2]};
+}
+
+// One alignment of one reconstruction; align() runs its steps.
+class Aligner {
+ public:
+  Aligner(const EvalOptions& o, const SparseModel& model, const GroundTruth& truth,
+          const Surface& surface)
+      : o_(o),
+        model_(model),
+        truth_(truth),
+        surface_(surface),
+        diag_(surface.bounds().diagonal().norm()),
+        crop_(object_crop(surface)) {
+    for (const auto& p : model.points) rec_points_.push_back(p.position);
+  }
+
+  Alignment align() {
+    const bool coarse = truth_.poses.empty() ? register_clouds() : fit_camera_centres();
+    if (!coarse) return std::move(a_);
+    for (const auto& p : rec_points_) a_.points.push_back(a_.transform.apply(p));
+    sample_visible_surface();
+    if (o_.icp) refine_with_icp();
+    a_.report["status"] = "ok";
+    a_.report["reconstruction_to_ground_truth"] = similarity_json(a_.transform);
+    a_.ok = true;
+    return std::move(a_);
+  }
+
+ private:
+  bool fail(std::string why) {
+    a_.failure = std::move(why);
+    return false;
+  }
+
+  // A run: the similarity that takes the reconstructed camera centres to the planned ones.
+  bool fit_camera_centres() {
+    std::vector<Vec3> src, dst;
+    for (const auto& im : model_.images) {
+      auto it = truth_.poses.find(im.name);
+      if (it == truth_.poses.end()) continue;
+      src.push_back(camera_centre(im.camera_from_world));
+      dst.push_back(camera_centre(it->second));
+    }
+    for (const auto& [name, pose] : truth_.poses) {
+      a_.views.push_back(view_camera(*truth_.camera, pose));
+    }
+    Vec3 centroid = Vec3::Zero();
+    for (const auto& d : dst) centroid += d;
+    if (!dst.empty()) centroid /= static_cast<double>(dst.size());
+    double spread = 0;
+    for (const auto& d : dst) spread += (d - centroid).squaredNorm();
+    spread = dst.empty() ? 0 : std::sqrt(spread / static_cast<double>(dst.size()));
+    auto robust = fit_similarity_ransac(src, dst, std::max(0.02 * spread, 1e-6), 2000, 1);
+    if (!robust) {
+      return fail(fmt::format(
+          "cannot align: fewer than 3 registered images have a ground-truth pose ({} matched)",
+          src.size()));
+    }
+    a_.transform = robust->transform;
+    a_.report = {{"method", "Umeyama similarity in RANSAC on camera centres"},
+                 {"cameras", src.size()},
+                 {"inliers", robust->inliers.size()},
+                 {"rms_camera_error_mm", robust->rms_inlier_error * 1000}};
+    return true;
+  }
+
+  // Photos: no poses. Scale from the spread of the clouds, then FPFH + RANSAC, then ICP with
+  // scale.
+  bool register_clouds() {
+    std::vector<Vec3> samples, normals;
+    surface_.sample(50000, 3, &samples, &normals);
+    const auto [c_rec, r_rec] = robust_radius(rec_points_);
+    const auto [c_gt, r_gt] = robust_radius(samples);
+    Similarity pre;
+    pre.scale = r_gt / std::max(r_rec, 1e-12);
+    pre.translation = c_gt - pre.scale * c_rec;
+    std::vector<Vec3> moved;
+    for (const auto& p : rec_points_) moved.push_back(pre.apply(p));
+    auto global = global_registration(moved, samples, diag_ / 40);
+    if (!global) {
+      return fail("global registration found no alignment of the reconstruction to the mesh");
+    }
+    Similarity g = Similarity::from_matrix(*global) * pre;
+    for (auto& p : moved) p = Similarity::from_matrix(*global).apply(p);
+    const IcpResult scaled = icp_similarity(moved, samples, diag_ / 50, 60);
+    a_.transform = Similarity::from_matrix(scaled.transform) * g;
+    a_.report = {{"method", "scale from cloud spread, FPFH + RANSAC (Open3D), ICP with scale"},
+                 {"icp_with_scale_fitness", scaled.fitness}};
+    views_from_reconstruction();
+    return true;
+  }
+
+  // Without planned cameras, the reconstructed ones (aligned) see the ground truth:
+  // camera_from_gt = camera_from_rec * rec_from_gt, made rigid (the scale goes into t).
+  void views_from_reconstruction() {
+    if (model_.cameras.empty()) return;
+    const auto& cam = model_.cameras.front();
+    const Similarity inv = a_.transform.inverse();
+    for (const auto& im : model_.images) {
+      Mat4 c = Mat4::Identity();
+      c.topLeftCorner<3, 3>() = im.camera_from_world.topLeftCorner<3, 3>() * inv.rotation;
+      c.topRightCorner<3, 1>() = im.camera_from_world.topLeftCorner<3, 3>() * inv.translation +
+                                 im.camera_from_world.topRightCorner<3, 1>();
+      c.topRightCorner<3, 1>() /= inv.scale;
+      a_.views.push_back(view_camera(cam, c));
+    }
+  }
+
+  void sample_visible_surface() {
+    SurfaceSamples& s = a_.samples;
+    surface_.sample(o_.ground_truth_samples, 7, &s.all, &s.all_normals);
+    for (int i : surface_.visible(s.all, s.all_normals, a_.views)) {
+      s.visible.push_back(s.all[i]);
+      s.visible_normals.push_back(s.all_normals[i]);
+    }
+  }
+
+  // Point-to-plane ICP of the points near the object onto the visible samples (all samples when
+  // none is visible), applied when it found correspondences for 30 % of them.
+  void refine_with_icp() {
+    std::vector<Vec3> inside;
+    for (const auto& p : a_.points) {
+      if (crop_.contains(p)) inside.push_back(p);
+    }
+    // ICP needs no more than 100k points to settle a rigid transform.
+    if (inside.size() > 100000) {
+      const std::size_t stride = (inside.size() + 99999) / 100000;
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < inside.size(); i += stride) inside[k++] = inside[i];
+      inside.resize(k);
+    }
+    const SurfaceSamples& s = a_.samples;
+    const bool none_visible = s.visible.empty();
+    const std::vector<Vec3>& target = none_visible ? s.all : s.visible;
+    const std::vector<Vec3>& target_n = none_visible ? s.all_normals : s.visible_normals;
+    const IcpResult icp = icp_point_to_plane(inside, target, target_n, 0.01 * diag_, 50);
+    json j = {{"method", "point-to-plane ICP (Open3D) on the visible ground-truth samples"},
+              {"fitness", icp.fitness},
+              {"inlier_rmse_mm", icp.inlier_rmse * 1000},
+              {"translation_change_mm", icp.transform.topRightCorner<3, 1>().norm() * 1000},
+              {"rotation_change_deg", rotation_angle_deg(icp.transform.topLeftCorner<3, 3>())}};
+    if (icp.fitness >= 0.3) {
+      a_.transform = Similarity::from_matrix(icp.transform) * a_.transform;
+      for (auto& p : a_.points) p = Similarity::from_matrix(icp.transform).apply(p);
+      j["applied"] = true;
+    } else {
+      j["applied"] = false;
+      j["reason"] = "fewer than 30 % of the points found a correspondence";
+    }
+    a_.report["icp"] = j;
+  }
+
+  const EvalOptions& o_;
+  const SparseModel& model_;
+  const GroundTruth& truth_;
+  const Surface& surface_;
+  const double diag_;
+  const Eigen::AlignedBox3d crop_;
+  std::vector<Vec3> rec_points_;
+  Alignment a_;
+};
+
+}  // namespace
+
+Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& model,
+                                const GroundTruth& truth, const Surface& surface) {
+  return Aligner(options, model, truth, surface).align();
+}
+
+}  // namespace rigc::eval

@@ -1,0 +1,47 @@
+// The third stage of `rigc eval`: the reconstruction in the ground-truth frame. With a run's
+// planned cameras, a similarity fitted to the camera centres (RANSAC + Umeyama); for photos, a
+// scale from the spread of the clouds, global registration and ICP with scale. Then point-to-plane
+// ICP onto the visible ground-truth surface.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "eval/colmap.h"
+#include "eval/eval.h"
+#include "eval/geometry.h"
+#include "eval/inputs.h"
+
+namespace rigc::eval {
+
+// Area-uniform samples of the ground truth and those a camera sees: Tanks and Temples' recall
+// reference, and the ICP target.
+struct SurfaceSamples {
+  std::vector<Vec3> all, all_normals;
+  std::vector<Vec3> visible, visible_normals;
+};
+
+struct Alignment {
+  bool ok = false;
+  std::string failure;
+  Similarity transform;           // reconstruction -> ground truth
+  nlohmann::json report;          // eval.json's "alignment"
+  std::vector<Vec3> points;       // the reconstructed points, aligned
+  std::vector<ViewCamera> views;  // the cameras over the ground truth, planned or reconstructed
+  SurfaceSamples samples;
+};
+
+Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& model,
+                                const GroundTruth& truth, const Surface& surface);
+
+// The region compared: the ground truth's bounds grown by 5 % of their diagonal on every side
+// (reconstructed points beyond it are background).
+Eigen::AlignedBox3d object_crop(const Surface& surface);
+
+// Where a camera of pose camera_from_world is, in the world.
+Vec3 camera_centre(const Mat4& camera_from_world);
+double rotation_angle_deg(const Eigen::Matrix3d& r);
+
+}  // namespace rigc::eval

@@ -1,0 +1,173 @@
+#include "eval/measure.h"
+
+#include <algorithm>
+#include <map>
+#include <string>
+
+#include "assets/mesh_io.h"
+
+namespace rigc::eval {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json stats_json(const DistanceStats& s) {
+  return {{"count", s.count},   {"mean", s.mean},       {"std", s.stddev},
+          {"median", s.median}, {"p90_abs", s.p90_abs}, {"mean_abs", s.mean_abs},
+          {"rms", s.rms},       {"min", s.min},         {"max", s.max}};
+}
+
+std::vector<double> signed_distance_mm(const Surface& surface, const std::vector<Vec3>& points) {
+  std::vector<double> d_mm;
+  for (double d : surface.signed_distance(points)) d_mm.push_back(1000 * d);
+  return d_mm;
+}
+
+// The geometry whose distances give the precision and the recall: the points, or the Poisson
+// mesh's samples.
+struct Compared {
+  std::vector<double> distance_mm;
+  std::vector<Vec3> cloud;
+};
+
+// One measurement of an aligned reconstruction; run() takes its steps.
+class Measurer {
+ public:
+  Measurer(const EvalOptions& o, const SparseModel& model, const GroundTruth& truth,
+           const Surface& surface, const Alignment& a, const fs::path& out, json& report)
+      : o_(o), model_(model), truth_(truth), surface_(surface), a_(a), out_(out), report_(report) {}
+
+  Measurements run() {
+    keep_points_near_object();
+    m_.distance_mm = signed_distance_mm(surface_, m_.points);
+    m_.stats = distance_stats(m_.distance_mm);
+    json distances = stats_json(m_.stats);
+    distances["cropped_points"] = a_.points.size() - m_.points.size();
+    distances["crop"] = "ground-truth bounds grown by 5 % of their diagonal on every side";
+    report_["compared"] = "points";
+    report_["signed_distance_mm"] = distances;
+    report_["signed_distance_mm"]["convention"] =
+        "nearest ground-truth triangle, positive on its normal's side (outside)";
+    Compared compared{m_.distance_mm, m_.points};
+    if (o_.poisson) compare_poisson_mesh(compared);
+    score(compared);
+    if (!truth_.poses.empty()) camera_errors();
+    return std::move(m_);
+  }
+
+ private:
+  // The points inside object_crop, and for each the mean centre of the cameras observing it
+  // (Poisson orients its normals towards them).
+  void keep_points_near_object() {
+    const Eigen::AlignedBox3d box = surface_.bounds();
+    const double diag = box.diagonal().norm();
+    const Eigen::AlignedBox3d crop = object_crop(surface_);
+    std::map<int, Vec3> centre_gt;
+    for (const auto& im : model_.images) {
+      centre_gt[im.image_id] = a_.transform.apply(camera_centre(im.camera_from_world));
+    }
+    for (std::size_t i = 0; i < a_.points.size(); ++i) {
+      if (!crop.contains(a_.points[i])) continue;
+      m_.points.push_back(a_.points[i]);
+      Vec3 v = Vec3::Zero();
+      int n = 0;
+      for (int id : model_.points[i].track_images) {
+        auto it = centre_gt.find(id);
+        if (it != centre_gt.end()) {
+          v += it->second;
+          ++n;
+        }
+      }
+      view_points_.push_back(n ? Vec3(v / n) : Vec3(box.center() + Vec3(0, 0, diag)));
+    }
+  }
+
+  // --poisson: a screened Poisson mesh of the points, measured by its surface samples.
+  void compare_poisson_mesh(Compared& compared) {
+    std::string why;
+    auto mesh = poisson_mesh(m_.points, view_points_, o_.poisson_depth, &why);
+    if (!mesh) {
+      report_["poisson_mesh"] = {{"status", "failed"}, {"reason", why}};
+      return;
+    }
+    Surface rec_surface(mesh->positions, mesh->triangles);
+    std::vector<Vec3> mesh_samples, mesh_normals;
+    rec_surface.sample(std::max<int>(100000, static_cast<int>(m_.points.size())), 11, &mesh_samples,
+                       &mesh_normals);
+    std::vector<double> dm = signed_distance_mm(surface_, mesh_samples);
+    const DistanceStats ms = distance_stats(dm);
+    report_["compared"] = "poisson_mesh";
+    report_["poisson_mesh"] = {{"depth", o_.poisson_depth},
+                               {"triangles", mesh->triangles.size()},
+                               {"samples", mesh_samples.size()},
+                               {"signed_distance_mm", stats_json(ms)}};
+    ir::Mesh m;
+    m.positions = mesh->positions;
+    m.triangles = mesh->triangles;
+    if (write_ply((out_ / "poisson_mesh.ply").string(), m, &why)) {
+      report_["poisson_mesh"]["file"] = (out_ / "poisson_mesh.ply").string();
+    }
+    compared = {std::move(dm), std::move(mesh_samples)};
+    m_.stats = ms;
+  }
+
+  void score(const Compared& compared) {
+    const SurfaceSamples& s = a_.samples;
+    std::vector<double> truth_to_rec = nearest_distances(s.visible, compared.cloud);
+    for (auto& d : truth_to_rec) d *= 1000;
+    m_.f = f_score(compared.distance_mm, truth_to_rec, o_.tau_mm);
+    report_["fscore"] = {
+        {"tau_mm", m_.f.tau},
+        {"precision", m_.f.precision},
+        {"recall", m_.f.recall},
+        {"fscore", m_.f.fscore},
+        {"ground_truth_samples", s.all.size()},
+        {"visible_ground_truth_samples", s.visible.size()},
+        {"definition",
+         "Tanks and Temples: precision = share of the compared geometry within tau of the "
+         "ground-truth mesh; recall = share of visible ground-truth samples within tau of it"}};
+  }
+
+  // The reconstructed cameras, aligned, against the planned ones.
+  void camera_errors() {
+    std::vector<double> pos_mm, rot_deg;
+    const Similarity& align = a_.transform;
+    const Similarity inv = align.inverse();
+    for (const auto& im : model_.images) {
+      auto it = truth_.poses.find(im.name);
+      if (it == truth_.poses.end()) continue;
+      pos_mm.push_back(
+          1000 *
+          (align.apply(camera_centre(im.camera_from_world)) - camera_centre(it->second)).norm());
+      const Eigen::Matrix3d r_rec = im.camera_from_world.topLeftCorner<3, 3>() * inv.rotation;
+      rot_deg.push_back(rotation_angle_deg(it->second.topLeftCorner<3, 3>() * r_rec.transpose()));
+    }
+    const DistanceStats ps = distance_stats(pos_mm), rs = distance_stats(rot_deg);
+    report_["cameras"] = {
+        {"compared", pos_mm.size()},
+        {"position_error_mm", {{"mean", ps.mean}, {"median", ps.median}, {"max", ps.max}}},
+        {"rotation_error_deg", {{"mean", rs.mean}, {"median", rs.median}, {"max", rs.max}}}};
+  }
+
+  const EvalOptions& o_;
+  const SparseModel& model_;
+  const GroundTruth& truth_;
+  const Surface& surface_;
+  const Alignment& a_;
+  const fs::path& out_;
+  json& report_;
+  std::vector<Vec3> view_points_;  // per kept point: where it was seen from
+  Measurements m_;
+};
+
+}  // namespace
+
+Measurements measure(const EvalOptions& options, const SparseModel& model, const GroundTruth& truth,
+                     const Surface& surface, const Alignment& alignment, const fs::path& out,
+                     json& report) {
+  return Measurer(options, model, truth, surface, alignment, out, report).run();
+}
+
+}  // namespace rigc::eval

@@ -1,0 +1,137 @@
+#include "eval/report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "eval/metrics.h"
+#include "io/files.h"
+
+namespace rigc::eval {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+EvalReport::EvalReport(const EvalInputs& in, std::ostream& log, EvalSummary& summary)
+    : out_(in.out), image_count_(in.images.names.size()), log_(log), summary_(summary) {
+  report_["rigc_eval_version"] = 1;
+  report_["input"] = {{"images_dir", in.images.dir.string()},
+                      {"images", in.images.names.size()},
+                      {"kind", in.photos ? "photos" : "run"},
+                      {"ground_truth", in.truth.description},
+                      {"ground_truth_triangles", in.truth.triangles.size()},
+                      {"ground_truth_poses", !in.truth.poses.empty()}};
+}
+
+bool EvalReport::write() {
+  std::string why;
+  if (!rigc::write_file_atomically(out_ / "eval.json", report_.dump(2) + "\n", &why)) {
+    log_ << "rigc eval: error: " << why << "\n";
+    return false;
+  }
+  summary_.report = report_;
+  return true;
+}
+
+int EvalReport::fail(const std::string& section, const std::string& reason, int exit_code) {
+  summary_.failure = reason;
+  report_[section]["status"] = "failed";
+  report_[section]["reason"] = reason;
+  write();
+  log_ << "rigc eval: error: " << reason << "\n";
+  return exit_code;
+}
+
+void EvalReport::add_colmap(const ColmapRun& colmap) {
+  report_["colmap"] = {{"steps", colmap.steps},
+                       {"seconds", colmap.seconds},
+                       {"matching", colmap.matching},
+                       {"intrinsics_prior", colmap.prior}};
+  summary_.colmap_s = colmap.seconds;
+}
+
+void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& colmap, bool quiet) {
+  summary_.reconstructed = true;
+  summary_.registered = static_cast<int>(model.images.size());
+  summary_.points = static_cast<long>(model.points.size());
+  report_["reconstruction"] = {{"status", "ok"},
+                               {"model", colmap.model_txt.string()},
+                               {"images", image_count_},
+                               {"registered_images", model.images.size()},
+                               {"points", model.points.size()},
+                               {"mean_track_length", model.mean_track_length()},
+                               {"mean_reprojection_error_px", model.mean_reprojection_error()}};
+  if (quiet) return;
+  log_ << fmt::format(
+      "rigc eval: COLMAP: {}/{} images registered, {} points, track {:.2f}, reprojection "
+      "{:.3f} px ({:.1f} s)\n",
+      model.images.size(), image_count_, model.points.size(), model.mean_track_length(),
+      model.mean_reprojection_error(), colmap.seconds);
+}
+
+void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
+                                const Alignment& alignment, const Measurements& m) {
+  const std::vector<double>& d_mm = m.distance_mm;
+  const double range =
+      o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * distance_stats(d_mm).rms);
+  json files;
+  std::string why;
+  if (write_colored_ply(out_ / "cloud_signed_distance.ply", m.points, d_mm, range, &why)) {
+    files["cloud_ply"] = (out_ / "cloud_signed_distance.ply").string();
+  } else {
+    log_ << "rigc eval: warning: " << why << "\n";
+  }
+  if (write_histogram_png(out_ / "histogram.png", d_mm, range, distance_stats(d_mm), &why)) {
+    files["histogram_png"] = (out_ / "histogram.png").string();
+    summary_.histogram_png = files["histogram_png"];
+  } else {
+    log_ << "rigc eval: warning: " << why << "\n";
+  }
+  if (!alignment.views.empty()) {
+    if (write_heatmap_png(out_ / "heatmap.png", surface, alignment.views.front(), m.points, d_mm,
+                          range, 1280, &why)) {
+      files["heatmap_png"] = (out_ / "heatmap.png").string();
+      summary_.heatmap_png = files["heatmap_png"];
+    } else {
+      log_ << "rigc eval: warning: " << why << "\n";
+    }
+  }
+  files["color_range_mm"] = range;
+  report_["files"] = files;
+}
+
+void EvalReport::add_timing(const ColmapRun& colmap, const EvalTimes& t) {
+  report_["timing_s"] = {{"colmap", colmap.seconds},     {"colmap_reused", colmap.reused},
+                         {"rigc_ground_truth", t.setup}, {"rigc_alignment_and_metrics", t.metrics},
+                         {"rigc_total", t.rigc},         {"total", t.total}};
+}
+
+void EvalReport::print_summary(const EvalOptions& o, const ColmapRun& colmap, const Measurements& m,
+                               const EvalTimes& t) const {
+  const DistanceStats& stats = m.stats;
+  log_ << fmt::format(
+      "rigc eval: signed distance {:.3f} ± {:.3f} mm (median {:.3f}, p90 |d| {:.3f}) over {} "
+      "{}; F-score {:.3f} at {} mm (P {:.3f}, R {:.3f})\n",
+      stats.mean, stats.stddev, stats.median, stats.p90_abs, stats.count,
+      report_["compared"].get<std::string>() == "points" ? "points" : "Poisson-mesh samples",
+      m.f.fscore, o.tau_mm, m.f.precision, m.f.recall);
+  // The time split: COLMAP's steps, then RigC's own parts.
+  std::string colmap_split;
+  for (const auto& step : colmap.steps) {
+    if (!step.is_object()) continue;
+    colmap_split += fmt::format(", {} {:.1f}", step.value("name", "?"), step.value("seconds", 0.0));
+  }
+  if (colmap.matching.contains("pairs")) {
+    colmap_split += fmt::format("; {} matching, {} pairs", colmap.matching.value("matcher", "?"),
+                                colmap.matching["pairs"].dump());
+  }
+  log_ << fmt::format(
+      "rigc eval: {:.1f} s in all: COLMAP {:.1f} s{}{}, RigC {:.1f} s (ground truth {:.1f}, "
+      "alignment and metrics {:.1f}, files {:.1f})\n",
+      t.total, colmap.seconds, colmap.reused ? " (reused: the earlier run's)" : "",
+      colmap_split.empty() ? "" : " (" + colmap_split.substr(2) + ")", t.setup + t.rigc, t.setup,
+      t.metrics, t.rigc - t.metrics);
+  log_ << fmt::format("rigc eval: wrote {}\n", (out_ / "eval.json").string());
+}
+
+}  // namespace rigc::eval
