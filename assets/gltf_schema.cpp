@@ -15,7 +15,7 @@ namespace {
 
 using json = nlohmann::json;
 
-// The checks, one glTF section at a time, in the order of the first error reported.
+// The checks, one glTF section at a time; the first wrong member found is reported.
 class GltfSchemaCheck {
  public:
   void run(const json& root) {
