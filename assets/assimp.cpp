@@ -166,38 +166,55 @@ class AssimpLoader {
         !mesh.mVertices) {
       return;
     }
-    const Eigen::Matrix3f linear = world.topLeftCorner<3, 3>().cast<float>();
-    const Vector3f offset = world.topRightCorner<3, 1>().cast<float>();
-    bool normals_ok = false;
-    const Eigen::Matrix3f to_normal =
-        normal_matrix(world.topLeftCorner<3, 3>(), &normals_ok).cast<float>();
-    const bool flip = world.topLeftCorner<3, 3>().determinant() < 0;
+    const Placement placement(world);
     const int material =
         mesh.mMaterialIndex < out_->materials.size() ? static_cast<int>(mesh.mMaterialIndex) : 0;
+    check_positions(mesh);
+    const aiVector3D* file_normals = use_file_normals_ ? mesh.mNormals : nullptr;
+    const aiVector3D* uvs = mesh.mTextureCoords[0];
+    // OBJ and STL give every triangle corner its own vertex: weld the identical ones.
+    std::vector<std::uint32_t> remap, keep;
+    weld_identical(mesh, file_normals, uvs, &remap, &keep);
+    const std::uint32_t base = copy_vertices(mesh, keep, file_normals, uvs, placement);
+    builder_.reserve_triangles(mesh.mNumFaces);
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      for (unsigned k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= mesh.mNumVertices) {
+          fail("mesh '{}' face {} index {} is out of range ({} vertices)", mesh.mName.C_Str(), f,
+               face.mIndices[k], mesh.mNumVertices);
+        }
+      }
+      builder_.add_triangle(base + remap[face.mIndices[0]], base + remap[face.mIndices[1]],
+                            base + remap[face.mIndices[2]], material, placement.flip);
+    }
+  }
 
-    const std::uint32_t n = mesh.mNumVertices;
-    for (std::uint32_t i = 0; i < n; ++i) {
+  static void check_positions(const aiMesh& mesh) {
+    for (std::uint32_t i = 0; i < mesh.mNumVertices; ++i) {
       const aiVector3D& v = mesh.mVertices[i];
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
         fail("mesh '{}' vertex {} has a position that is not finite ({}, {}, {})",
              mesh.mName.C_Str(), i, v.x, v.y, v.z);
       }
     }
-    const aiVector3D* file_normals = use_file_normals_ ? mesh.mNormals : nullptr;
-    const aiVector3D* uvs = mesh.mTextureCoords[0];
-    // OBJ and STL give every triangle corner its own vertex: weld the identical ones.
-    std::vector<std::uint32_t> remap, keep;
-    weld_identical(mesh, file_normals, uvs, &remap, &keep);
+  }
 
+  // Appends the vertices `keep` lists, placed in the world; returns the index of the first. A
+  // mesh without normals, or with a broken one, gets all its normals computed.
+  std::uint32_t copy_vertices(const aiMesh& mesh, const std::vector<std::uint32_t>& keep,
+                              const aiVector3D* file_normals, const aiVector3D* uvs,
+                              const Placement& placement) {
     const std::uint32_t base = builder_.add_vertices(keep.size());
-    bool has_normals = file_normals != nullptr && normals_ok;
+    bool has_normals = file_normals != nullptr && placement.normals_ok;
     for (std::uint32_t k = 0; k < keep.size(); ++k) {
       const std::uint32_t i = keep[k];
       const aiVector3D& v = mesh.mVertices[i];
-      builder_.position(base + k) = linear * Vector3f(v.x, v.y, v.z) + offset;
+      builder_.position(base + k) = placement.linear * Vector3f(v.x, v.y, v.z) + placement.offset;
       if (has_normals) {
         const aiVector3D& an = file_normals[i];
-        const Vector3f nn = to_normal * Vector3f(an.x, an.y, an.z);
+        const Vector3f nn = placement.to_normal * Vector3f(an.x, an.y, an.z);
         const float len = nn.norm();
         if (!std::isfinite(len) || len < 1e-6f) {
           has_normals = false;
@@ -216,19 +233,7 @@ class AssimpLoader {
       builder_.set_needs_normal(base, keep.size());
     }
     if (uvs) builder_.set_has_uvs();
-    builder_.reserve_triangles(mesh.mNumFaces);
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      for (unsigned k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= n) {
-          fail("mesh '{}' face {} index {} is out of range ({} vertices)", mesh.mName.C_Str(), f,
-               face.mIndices[k], n);
-        }
-      }
-      builder_.add_triangle(base + remap[face.mIndices[0]], base + remap[face.mIndices[1]],
-                            base + remap[face.mIndices[2]], material, flip);
-    }
+    return base;
   }
 
   // Maps every vertex to the first one with bit-identical position (and normal and uv, when they

@@ -221,21 +221,6 @@ Mat4 node_local_matrix(const tinygltf::Node& node, int index) {
   return m;
 }
 
-// A node's world matrix, ready to apply to vertex positions and normals.
-struct Placement {
-  explicit Placement(const Mat4& world)
-      : linear(world.topLeftCorner<3, 3>().cast<float>()),
-        offset(world.topRightCorner<3, 1>().cast<float>()),
-        to_normal(normal_matrix(world.topLeftCorner<3, 3>(), &normals_ok).cast<float>()),
-        flip(world.topLeftCorner<3, 3>().determinant() < 0) {}
-
-  Eigen::Matrix3f linear;
-  Vector3f offset;
-  bool normals_ok = false;  // false: the matrix is singular, so normals are computed
-  Eigen::Matrix3f to_normal;
-  bool flip;  // the matrix mirrors, so the triangles' winding is reversed
-};
-
 // A triangle primitive's vertex attributes; normals and uvs are optional.
 struct PrimitiveAttributes {
   AccessorView positions, normals, uvs;

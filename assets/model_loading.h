@@ -46,6 +46,21 @@ std::vector<unsigned char> read_file_bytes(const std::filesystem::path& path);
 // when `linear` is singular.
 Eigen::Matrix3d normal_matrix(const Eigen::Matrix3d& linear, bool* ok);
 
+// A node's world matrix, ready to apply to vertex positions and normals.
+struct Placement {
+  explicit Placement(const ir::Mat4& world)
+      : linear(world.topLeftCorner<3, 3>().cast<float>()),
+        offset(world.topRightCorner<3, 1>().cast<float>()),
+        to_normal(normal_matrix(world.topLeftCorner<3, 3>(), &normals_ok).cast<float>()),
+        flip(world.topLeftCorner<3, 3>().determinant() < 0) {}
+
+  Eigen::Matrix3f linear;
+  Eigen::Vector3f offset;
+  bool normals_ok = false;  // false: the matrix is singular, so normals are computed
+  Eigen::Matrix3f to_normal;
+  bool flip;  // the matrix mirrors, so the triangles' winding is reversed
+};
+
 // Appends vertices and triangles to a LoadedModel's mesh, and at the end computes the normals the
 // file did not give.
 class MeshBuilder {
