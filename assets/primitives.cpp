@@ -110,9 +110,14 @@ struct Icosphere {
   std::vector<Tri> triangles;        // counter-clockwise seen from outside
 };
 
-Icosphere make_icosphere(int n) {
-  // Icosahedron with vertices at the poles: 0 = north, 1..5 upper ring, 6..10 lower ring,
-  // 11 = south.
+// The icosahedron the sphere is cut from, with vertices at the poles: 0 = north, 1..5 upper ring,
+// 6..10 lower ring, 11 = south.
+struct Icosahedron {
+  std::array<Vector3d, 12> corners;  // unit
+  std::vector<Tri> faces;            // 20, counter-clockwise seen from outside
+};
+
+Icosahedron make_icosahedron() {
   // cos and sin of multiples of 36 degrees from square roots only (no libm trigonometry, so the
   // corners are bit-identical on every platform).
   const double s5 = std::sqrt(5.0);
@@ -126,58 +131,77 @@ Icosphere make_icosphere(int n) {
     const double s = q <= 2 ? sin36[q] : sin36[5 - q];
     return {c, step <= 5 ? s : -s};
   };
-  std::array<Vector3d, 12> corners;
+  Icosahedron ico;
   const double ring_z = 1.0 / s5;
   const double ring_r = 2.0 / s5;
-  corners[0] = {0, 0, 1};
-  corners[11] = {0, 0, -1};
+  ico.corners[0] = {0, 0, 1};
+  ico.corners[11] = {0, 0, -1};
   for (int k = 0; k < 5; ++k) {
     const auto [cu, su] = cos_sin(2 * k);
     const auto [cl, sl] = cos_sin(2 * k + 1);
-    corners[1 + k] = {ring_r * cu, ring_r * su, ring_z};
-    corners[6 + k] = {ring_r * cl, ring_r * sl, -ring_z};
+    ico.corners[1 + k] = {ring_r * cu, ring_r * su, ring_z};
+    ico.corners[6 + k] = {ring_r * cl, ring_r * sl, -ring_z};
   }
-  std::vector<Tri> faces;
   for (std::uint32_t k = 0; k < 5; ++k) {
     const std::uint32_t u0 = 1 + k, u1 = 1 + (k + 1) % 5;
     const std::uint32_t l0 = 6 + k, l1 = 6 + (k + 1) % 5;
-    faces.push_back({0, u0, u1});
-    faces.push_back({u0, l0, u1});
-    faces.push_back({u1, l0, l1});
-    faces.push_back({11, l1, l0});
+    ico.faces.push_back({0, u0, u1});
+    ico.faces.push_back({u0, l0, u1});
+    ico.faces.push_back({u1, l0, l1});
+    ico.faces.push_back({11, l1, l0});
+  }
+  return ico;
+}
+
+// Cuts each icosahedron face into n x n triangles. The vertices are numbered corners first (12),
+// then each of the 30 edges' n - 1 inner points, then each face's interior points, so that a
+// point on an edge is one vertex shared by the edge's two faces.
+class IcosphereSubdivision {
+ public:
+  IcosphereSubdivision(const Icosahedron& ico, int n)
+      : ico_(ico),
+        n_(n),
+        un_(static_cast<std::uint32_t>(n)),
+        edge_verts_(static_cast<std::size_t>(n - 1)),
+        face_verts_(static_cast<std::size_t>(n - 1) * (n - 2) / 2) {
+    number_edges();
   }
 
-  // Number the 30 edges.
-  std::array<std::array<int, 12>, 12> edge_id;
-  for (auto& row : edge_id) row.fill(-1);
-  int edge_count = 0;
-  for (const Tri& f : faces) {
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = f[e], b = f[(e + 1) % 3];
-      if (edge_id[a][b] < 0) edge_id[a][b] = edge_id[b][a] = edge_count++;
+  Icosphere build() {
+    Icosphere out;
+    out.directions.resize(12 + 30 * edge_verts_ + 20 * face_verts_);
+    out.triangles.reserve(static_cast<std::size_t>(20) * n_ * n_);
+    for (int c = 0; c < 12; ++c) out.directions[c] = ico_.corners[c];
+    for (std::size_t fi = 0; fi < ico_.faces.size(); ++fi) subdivide_face(fi, &out);
+    return out;
+  }
+
+ private:
+  void number_edges() {
+    for (auto& row : edge_id_) row.fill(-1);
+    int edge_count = 0;
+    for (const Tri& f : ico_.faces) {
+      for (int e = 0; e < 3; ++e) {
+        const std::uint32_t a = f[e], b = f[(e + 1) % 3];
+        if (edge_id_[a][b] < 0) edge_id_[a][b] = edge_id_[b][a] = edge_count++;
+      }
     }
   }
 
-  const std::uint32_t un = static_cast<std::uint32_t>(n);
-  const std::size_t edge_verts = static_cast<std::size_t>(n - 1);
-  const std::size_t face_verts = static_cast<std::size_t>(n - 1) * (n - 2) / 2;
-  const std::size_t vertex_count = 12 + 30 * edge_verts + 20 * face_verts;
-  Icosphere out;
-  out.directions.resize(vertex_count);
-  out.triangles.reserve(static_cast<std::size_t>(20) * n * n);
-  for (int c = 0; c < 12; ++c) out.directions[c] = corners[c];
-
   // Vertex on edge a->b, t steps (1..n-1) from a.
-  auto edge_vertex = [&](std::uint32_t a, std::uint32_t b, std::uint32_t t) -> std::uint32_t {
-    const std::uint32_t k = a < b ? t : un - t;
-    return static_cast<std::uint32_t>(12 + edge_id[a][b] * edge_verts + (k - 1));
-  };
+  std::uint32_t edge_vertex(std::uint32_t a, std::uint32_t b, std::uint32_t t) const {
+    const std::uint32_t k = a < b ? t : un_ - t;
+    return static_cast<std::uint32_t>(12 + edge_id_[a][b] * edge_verts_ + (k - 1));
+  }
 
-  std::vector<std::uint32_t> grid;  // (n+1) x (n+1), index i + j * (n+1), for i + j <= n
-  for (std::size_t fi = 0; fi < faces.size(); ++fi) {
-    const auto [a, b, c] = faces[fi];
-    const std::size_t face_base = 12 + 30 * edge_verts + fi * face_verts;
-    grid.assign(static_cast<std::size_t>(n + 1) * (n + 1), kNone);
+  // Numbers and places the points of face fi's triangular grid (point (i, j) is i steps from its
+  // corner a towards b and j towards c), and adds the face's n x n triangles.
+  void subdivide_face(std::size_t fi, Icosphere* out) {
+    const auto [a, b, c] = ico_.faces[fi];
+    const std::size_t face_base = 12 + 30 * edge_verts_ + fi * face_verts_;
+    const int n = n_;
+    const std::uint32_t un = un_;
+    grid_.assign(static_cast<std::size_t>(n + 1) * (n + 1), kNone);
     std::size_t interior = 0;
     for (std::uint32_t j = 0; j <= un; ++j) {
       for (std::uint32_t i = 0; i + j <= un; ++i) {
@@ -197,25 +221,40 @@ Icosphere make_icosphere(int n) {
         } else {
           id = static_cast<std::uint32_t>(face_base + interior++);
         }
-        grid[i + j * (n + 1)] = id;
+        grid_[i + j * (n + 1)] = id;
         if (id >= 12) {
           // Edge vertices are written by both faces; both compute the same normalised point
           // up to rounding, and the order of faces is fixed, so the result is deterministic.
           const double wb = static_cast<double>(i) / n, wc = static_cast<double>(j) / n;
-          const Vector3d p = corners[a] * (1.0 - wb - wc) + corners[b] * wb + corners[c] * wc;
-          out.directions[id] = p.normalized();
+          const Vector3d p =
+              ico_.corners[a] * (1.0 - wb - wc) + ico_.corners[b] * wb + ico_.corners[c] * wc;
+          out->directions[id] = p.normalized();
         }
       }
     }
-    auto at = [&](std::uint32_t i, std::uint32_t j) { return grid[i + j * (n + 1)]; };
+    auto at = [&](std::uint32_t i, std::uint32_t j) { return grid_[i + j * (n + 1)]; };
     for (std::uint32_t j = 0; j < un; ++j) {
       for (std::uint32_t i = 0; i + j < un; ++i) {
-        out.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-        if (i + j + 1 < un) out.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+        out->triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+        if (i + j + 1 < un) {
+          out->triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
       }
     }
   }
-  return out;
+
+  const Icosahedron& ico_;
+  const int n_;
+  const std::uint32_t un_;
+  const std::size_t edge_verts_;                 // inner points per edge
+  const std::size_t face_verts_;                 // interior points per face
+  std::array<std::array<int, 12>, 12> edge_id_;  // the 30 edges' numbers, -1 for no edge
+  std::vector<std::uint32_t> grid_;  // (n+1) x (n+1), index i + j * (n+1), for i + j <= n
+};
+
+Icosphere make_icosphere(int n) {
+  const Icosahedron ico = make_icosahedron();
+  return IcosphereSubdivision(ico, n).build();
 }
 
 // Area-weighted vertex normals.
