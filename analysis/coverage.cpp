@@ -11,7 +11,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "compiler/color.h"
+#include "ir/color.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/optics.h"

@@ -9,7 +9,7 @@
 #include "backends/external/process.h"
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
-#include "compiler/color.h"
+#include "ir/color.h"
 #include "compiler/frontend.h"
 #include "dslr/pipeline.h"
 #include "tests/test_support.h"

@@ -11,7 +11,7 @@
 #include "assets/mesh_io.h"
 #include "assets/primitives.h"
 #include "compiler/check.h"
-#include "compiler/color.h"
+#include "ir/color.h"
 #include "compiler/frontend.h"
 #include "compiler/limits.h"
 

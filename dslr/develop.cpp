@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "compiler/color.h"
+#include "ir/color.h"
 #include "dslr/buffer_pool.h"
 
 namespace rigc::dslr {

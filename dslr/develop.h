@@ -28,7 +28,7 @@ double srgb_oetf(double linear);
 // Tone curve and encoding: the white-balanced signal is clipped to [0, 1] (highlights clip as
 // on the sensor; no filmic shoulder, so the response stays exactly invertible) and encoded with
 // the sRGB transfer function to `bits` (8 or 16). A metered average (v = 12.5·q/78 ≈ 0.104)
-// lands at code 92/255, where camera JPEGs typically lift a metered grey to ~118 with their tone
+// lands at code 91/255, where camera JPEGs typically lift a metered grey to ~118 with their tone
 // curve: previews look about 3/4 stop darker than in-camera JPEGs, but stay linear to invert.
 std::vector<std::uint16_t> encode_srgb(const std::vector<float>& linear,
                                        const std::array<double, 3>& gains, int bits);

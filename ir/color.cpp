@@ -1,4 +1,4 @@
-#include "compiler/color.h"
+#include "ir/color.h"
 
 #include <algorithm>
 #include <cmath>
