@@ -71,6 +71,15 @@ struct LinearFrame {
   TileRanges tile_ranges;
 
   Intrinsics intrinsics() const { return {width, height, fx, fy, cx, cy}; }
+  // Takes the canvas's size and pinhole (the pixel buffers are left as they are).
+  void set_intrinsics(const Intrinsics& canvas) {
+    width = canvas.width;
+    height = canvas.height;
+    fx = canvas.fx;
+    fy = canvas.fy;
+    cx = canvas.cx;
+    cy = canvas.cy;
+  }
 };
 
 // Per-shot inputs that are not part of the camera.

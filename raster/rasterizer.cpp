@@ -17,12 +17,7 @@ namespace {
 // A frame of the canvas's size, its buffers taken from the pool (the shading writes every pixel).
 dslr::LinearFrame blank_frame(const dslr::Intrinsics& canvas) {
   dslr::LinearFrame frame;
-  frame.width = canvas.width;
-  frame.height = canvas.height;
-  frame.fx = canvas.fx;
-  frame.fy = canvas.fy;
-  frame.cx = canvas.cx;
-  frame.cy = canvas.cy;
+  frame.set_intrinsics(canvas);
   const size_t pixel_count = static_cast<size_t>(canvas.width) * canvas.height;
   frame.rgb = dslr::take_floats(pixel_count * 3);
   frame.depth_m = dslr::take_floats(pixel_count);

@@ -289,12 +289,7 @@ bool CyclesBackend::render(const ir::Scene& scene, const scene::StudioScene& /*s
     return false;
   }
   dslr::LinearFrame& frame = out->frame;
-  frame.width = canvas.width;
-  frame.height = canvas.height;
-  frame.fx = canvas.fx;
-  frame.fy = canvas.fy;
-  frame.cx = canvas.cx;
-  frame.cy = canvas.cy;
+  frame.set_intrinsics(canvas);
   frame.rgb = std::move(image.rgb);
   for (float& v : frame.rgb) v *= static_cast<float>(external::kCandelaPerBlenderUnit);
   frame.mask.resize(mask.alpha.size());

@@ -458,12 +458,7 @@ bool PovrayBackend::render(const ir::Scene& scene, const scene::StudioScene& /*s
   }
   const dslr::RenderGeometry canvas = dslr::render_geometry_for(scene.camera, scale);
   dslr::LinearFrame& frame = out->frame;
-  frame.width = canvas.width;
-  frame.height = canvas.height;
-  frame.fx = canvas.fx;
-  frame.fy = canvas.fy;
-  frame.cx = canvas.cx;
-  frame.cy = canvas.cy;
+  frame.set_intrinsics(canvas);
   const size_t pixels = static_cast<size_t>(canvas.width) * canvas.height;
   frame.rgb.assign(pixels * 3, 0.0f);
   for (const auto& path : frames) {

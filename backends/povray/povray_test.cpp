@@ -11,7 +11,6 @@
 #include "compiler/frontend.h"
 #include "run/run_loop.h"
 #include "scene/studio_scene.h"
-#include "tests/hostile_scene.h"
 #include "tests/test_support.h"
 
 namespace rigc::povray {
@@ -32,8 +31,6 @@ bool emit(const ir::Scene& scene, const fs::path& dir, double scale, std::string
   settings.scale = scale;
   return PovrayBackend().emit(scene, scene::prepare_studio_scene(scene), dir, settings, error);
 }
-using ::rigc::testing::hostile_scene;
-using ::rigc::testing::pwned_anywhere;
 using ::rigc::testing::read_text;
 using ::rigc::testing::TempDir;
 
@@ -188,21 +185,6 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
                            "transforms.json", "manifest.json"}) {
     EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
   }
-}
-
-TEST(PovrayRun, HostileMeshPathRendersWithoutRunningAnything) {
-  RIGC_REQUIRE_TOOL(external::find_executable("povray"), "povray");
-  TempDir dir;
-  const ir::Scene scene = hostile_scene(dir);
-  ASSERT_FALSE(scene.shots.empty());
-  run::RunOptions options;
-  options.output_dir = (dir.path() / "out \"'; touch PWNED #").string();
-  options.settings.scale = 0.02;
-  options.settings.samples = 1;
-  std::ostringstream log;
-  EXPECT_EQ(render_run(scene, options, log), 0) << log.str();
-  EXPECT_TRUE(fs::exists(options.output_dir / "masks" / "shot_000.png"));
-  EXPECT_FALSE(pwned_anywhere(dir.path()));
 }
 
 }  // namespace
