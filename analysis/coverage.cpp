@@ -11,10 +11,10 @@
 #include <optional>
 #include <stdexcept>
 
-#include "ir/color.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/optics.h"
+#include "ir/color.h"
 #include "raster/rasterizer.h"
 
 namespace rigc::analysis {

@@ -9,9 +9,9 @@
 #include "backends/external/process.h"
 #include "backends/povray/povray_backend.h"
 #include "backends/preview/preview_backend.h"
-#include "ir/color.h"
 #include "compiler/frontend.h"
 #include "dslr/pipeline.h"
+#include "ir/color.h"
 #include "tests/test_support.h"
 
 namespace rigc::backends {
@@ -205,9 +205,8 @@ TEST(ReferenceAgreement, PaperSceneMasksAndExposure) {
 }
 
 TEST(ReferenceAgreement, TexturedSceneMasksAndExposure) {
-  RIGC_REQUIRE_TOOL(
-      fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf"),
-      "assimp-testmodels");
+  RIGC_REQUIRE_TOOL(fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf"),
+                    "assimp-testmodels");
   const ir::Scene scene = compile_file("scenes/orbit-textured.yaml");
   expect_agreement(scene, 3, 192.0 / scene.camera.width_px);
 }

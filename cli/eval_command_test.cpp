@@ -13,11 +13,11 @@
 #include <string>
 
 #include "backends/preview/preview_backend.h"
-#include "run/run_loop.h"
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "eval/eval.h"
 #include "eval/eval_test_support.h"
+#include "run/run_loop.h"
 #include "tests/test_support.h"
 
 namespace rigc::eval {

@@ -11,9 +11,9 @@
 #include "assets/mesh_io.h"
 #include "assets/primitives.h"
 #include "compiler/check.h"
-#include "ir/color.h"
 #include "compiler/frontend.h"
 #include "compiler/limits.h"
+#include "ir/color.h"
 
 namespace rigc {
 namespace {

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ir/color.h"
 #include "dslr/buffer_pool.h"
+#include "ir/color.h"
 
 namespace rigc::dslr {
 

@@ -30,8 +30,9 @@ struct ChildResult {
 
 // Runs the program and waits for it. While it runs, a SIGINT, SIGTERM or SIGHUP that stops rigc
 // sends it a SIGTERM first, so that a signal sent to rigc alone (`kill`, `timeout`, a closed ssh
-// session) does not leave a renderer writing into a folder a rerun renders into. A signal that comes while the child is being started stops it too. (A SIGKILL cannot be
-// caught: the child then runs on.)
+// session) does not leave a renderer writing into a folder a rerun renders into. A signal that
+// comes while the child is being started stops it too. (A SIGKILL cannot be caught: the child then
+// runs on.)
 ChildResult run_child(const ChildRun& run);
 
 // Tests only: `hook` runs in run_child between the child's spawn and its watch, where a stop

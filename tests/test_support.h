@@ -45,10 +45,10 @@ void write_text(const std::string& path, const std::string& text);
 
 // Skips the test when `available` is false, naming `what` is missing; fails it instead where
 // tools are required (see tools_required()).
-#define RIGC_REQUIRE_TOOL(available, what)                                                  \
-  do {                                                                                      \
-    if (!(available)) {                                                                     \
-      if (::rigc::testing::tools_required()) FAIL() << what << " is not installed";          \
-      GTEST_SKIP() << what << " is not installed";                                          \
-    }                                                                                       \
+#define RIGC_REQUIRE_TOOL(available, what)                                          \
+  do {                                                                              \
+    if (!(available)) {                                                             \
+      if (::rigc::testing::tools_required()) FAIL() << what << " is not installed"; \
+      GTEST_SKIP() << what << " is not installed";                                  \
+    }                                                                               \
   } while (0)
