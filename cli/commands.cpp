@@ -113,7 +113,7 @@ int emit_scripts(const ir::Scene& scene, const std::string& target, const std::s
 }
 
 int run_compile(std::vector<std::string> args) {
-  CLI::App app{"Compile a scene for a target: the IR as JSON (more targets come with backends)."};
+  CLI::App app{"Compile a scene for a target: the IR as JSON, or a backend's scripts."};
   std::string scene_path, target = "ir", output;
   bool no_geometry = false;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
@@ -125,7 +125,7 @@ int run_compile(std::vector<std::string> args) {
       ->check(CLI::IsMember(targets))
       ->capture_default_str();
   app.add_option("-o,--output", output,
-                 "output file for ir (default: standard output); folder for povray and cycles "
+                 "output file for ir (default: standard output); folder for a backend's scripts "
                  "(default: out/<scene>/<target>/render)");
   app.add_option("--scale", scale, "multiplies the sensor resolution")
       ->check(finite_number())
