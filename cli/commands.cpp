@@ -103,8 +103,7 @@ int emit_scripts(const ir::Scene& scene, const std::string& target, const std::s
   settings.scale = scale;
   settings.samples = samples;
   std::string error;
-  if (!settings.check(&error) ||
-      !backend->emit(scene, scene::prepare_studio_scene(scene), output, settings, &error)) {
+  if (!backend->emit(scene, scene::prepare_studio_scene(scene), output, settings, &error)) {
     std::cerr << "rigc: error: " << error << '\n';
     return kExitUserError;
   }

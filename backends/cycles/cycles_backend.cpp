@@ -170,7 +170,7 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                          std::string* error) {
   const double scale = settings.scale;
   const int samples = settings.samples;
-  if (!external::prepare_emit_folder(scene, dir, scale, error)) return false;
+  if (!external::prepare_emit_folder(scene, dir, settings, error)) return false;
   const int object_materials = static_cast<int>(scene.materials.size());
   const int total_materials = static_cast<int>(studio.materials.size());
   const ir::Camera& camera = scene.camera;

@@ -56,12 +56,9 @@ bool write_texture_png(const fs::path& path, const ir::Texture& texture, std::st
   return true;
 }
 
-bool prepare_emit_folder(const ir::Scene& scene, const fs::path& dir, double scale,
-                         std::string* error) {
-  if (!(scale > 0) || !std::isfinite(scale)) {
-    *error = "the render scale must be a positive number";
-    return false;
-  }
+bool prepare_emit_folder(const ir::Scene& scene, const fs::path& dir,
+                         const run::RenderSettings& settings, std::string* error) {
+  if (!settings.check(error)) return false;
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir)) {

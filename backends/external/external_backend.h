@@ -33,10 +33,10 @@ class ExternalBackend : public run::Backend {
                std::string* error) override;
 };
 
-// What every emit() checks first: a positive scale, that `dir` exists or can be made, and that
-// every shot name can be a file name. False with a one-line `error`.
-bool prepare_emit_folder(const ir::Scene& scene, const std::filesystem::path& dir, double scale,
-                         std::string* error);
+// What every emit() checks first: the settings (RenderSettings::check), that `dir` exists or can
+// be made, and that every shot name can be a file name. False with a one-line `error`.
+bool prepare_emit_folder(const ir::Scene& scene, const std::filesystem::path& dir,
+                         const run::RenderSettings& settings, std::string* error);
 
 // A linear image (OpenEXR, Radiance HDR...) through OpenImageIO: RGB as floats, and alpha when
 // the file has one (else empty). False with a one-line `error`.
