@@ -170,6 +170,7 @@ class CoverageAnalysis {
                              double depth_m) const;
   double footprint_px(const ShotView& view, size_t f) const;
   double face_signal(const ShotView& view, size_t f) const;
+  void keep_sight(const ShotView& view);
   void add_to_histograms(const FaceView& face, double area, ShotSums& sum) const;
   ViewFaults judge(const FaceView& face) const;
   bool triangulates_with_earlier_shot(int s, size_t f, const Vector3d& to_eye) const;
@@ -187,6 +188,7 @@ class CoverageAnalysis {
   const double exposure_;
   const double cos_max_angle_;
   const double cos_min_triangulation_;
+  const bool keep_sights_;
 
   CoverageResult result_;
   std::vector<Vector3d> center_, normal_;  // object frame
@@ -217,6 +219,7 @@ CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioSc
       exposure_(dslr::exposure_scale(camera_)),
       cos_max_angle_(std::cos(settings_.max_view_angle_rad)),
       cos_min_triangulation_(std::cos(settings_.min_triangulation_angle_rad)),
+      keep_sights_(options.keep_sights),
       usable_by_shot_(shot_count_),
       seen_previous_(face_count_, 0),
       seen_now_(face_count_, 0),
@@ -228,9 +231,14 @@ CoverageResult CoverageAnalysis::run() {
   for (int s = 0; s < shot_count_; ++s) {
     const ShotView view = view_shot(s);
     result_.shots.push_back(summarise_shot(view, analyse_faces(view)));
+    if (keep_sights_) keep_sight(view);
     std::swap(seen_previous_, seen_now_);
   }
   result_.blur_ratio_95 = totals_.blur_ratio_95();
+  if (keep_sights_) {
+    result_.face_center = center_;
+    result_.face_normal = normal_;
+  }
   return std::move(result_);
 }
 
@@ -399,6 +407,17 @@ double CoverageAnalysis::face_signal(const ShotView& view, size_t f) const {
         luminance(raster::light_illuminance(light, world_center, world_normal).cast<double>());
   }
   return albedo_[f] * illuminance / std::numbers::pi * exposure_;
+}
+
+void CoverageAnalysis::keep_sight(const ShotView& view) {
+  ShotSight sight;
+  sight.eye = view.eye;
+  const std::vector<std::uint8_t>& usable = usable_by_shot_[view.index];
+  for (size_t f = 0; f < face_count_; ++f) {
+    if (seen_now_[f]) sight.seen.push_back(static_cast<std::uint32_t>(f));
+    if (usable[f]) sight.usable.push_back(static_cast<std::uint32_t>(f));
+  }
+  result_.sights.push_back(std::move(sight));
 }
 
 void CoverageAnalysis::add_to_histograms(const FaceView& face, double area, ShotSums& sum) const {

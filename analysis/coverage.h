@@ -3,6 +3,7 @@
 // whether some pair of usable views triangulates it. Area-weighted throughout.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +32,13 @@ struct ShotCoverage {
   std::vector<double> signal_histogram;
 };
 
+// What one shot sees, kept for planning (CoverageOptions::keep_sights).
+struct ShotSight {
+  Eigen::Vector3d eye = Eigen::Vector3d::Zero();  // camera centre, object frame
+  std::vector<std::uint32_t> seen;                // faces the shot sees
+  std::vector<std::uint32_t> usable;              // of those, faces SfM can use
+};
+
 struct CoverageResult {
   std::vector<double> face_area_m2;         // object frame
   std::vector<std::uint16_t> views;         // shots that see each face
@@ -45,6 +53,9 @@ struct CoverageResult {
   // Blur needed to keep 95 % of the seen surface sharp, as a multiple of max_blur_px at the
   // current aperture (> 1: stop down by that factor).
   double blur_ratio_95 = 0;
+  // With keep_sights: every shot's sight, and each face's centre and unit normal (object frame).
+  std::vector<ShotSight> sights;
+  std::vector<Eigen::Vector3d> face_center, face_normal;
 };
 
 struct CoverageOptions {
@@ -52,6 +63,7 @@ struct CoverageOptions {
   // full resolution. 0 picks about 1400 px across; otherwise 0.01..1 (smaller buffers are too
   // coarse to tell which faces are hidden).
   double visibility_scale = 0;
+  bool keep_sights = false;  // fill CoverageResult::sights, face_center and face_normal
 
   // Whether every field holds a value the analysis takes; if not, says why in `error` (when
   // given). analyse_coverage throws std::invalid_argument on options that fail it.
