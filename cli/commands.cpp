@@ -265,6 +265,7 @@ const std::vector<Command>& commands() {
        run_eval_command},
       {"compare", "render with several backends and compare reconstruction accuracy",
        run_compare_command},
+      {"plan", "plan the fewest shots that reach a coverage target", run_plan_command},
       {"version", "print the version", run_version},
   };
   return table;

@@ -1,0 +1,170 @@
+#include "plan/plan_scene.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "compiler/check.h"
+#include "compiler/frontend.h"
+#include "compiler/limits.h"
+#include "plan/scene_text.h"
+#include "scene/studio_scene.h"
+
+namespace rigc::plan {
+namespace {
+
+namespace fs = std::filesystem;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string folder_of(const std::string& path) {
+  const std::string folder = fs::path(path).parent_path().string();
+  return folder.empty() ? std::string(".") : folder;
+}
+
+// The checked description of a scene that compiled: the stations the candidates start from.
+std::optional<spec::SceneSpec> scene_spec(const std::string& text, const std::string& path) {
+  DiagnosticEngine quiet;
+  quiet.set_handler([](const Diagnostic&, const std::string&) {});
+  const auto root = parse_yaml(text, path, quiet);
+  if (!root) return std::nullopt;
+  return check_scene(*root, path, folder_of(path), quiet);
+}
+
+// The first error of a compile, rendered, for messages about text RigC wrote itself.
+std::string first_error(const DiagnosticEngine& diag) {
+  for (const Diagnostic& d : diag.diagnostics()) {
+    if (d.severity == Severity::kError) return diag.render(d);
+  }
+  return "no diagnostic";
+}
+
+PlanProblem make_problem(const CandidateSet& set, const ir::Scene& candidate_scene,
+                         const analysis::CoverageResult& coverage) {
+  PlanProblem problem;
+  problem.coverage = &coverage;
+  for (const Candidate& candidate : set.candidates) {
+    problem.station.push_back(candidate.station);
+    problem.angle_deg.push_back(candidate.angle_deg);
+  }
+  for (const Station& station : set.stations) {
+    // Poses come last: after the rings.
+    problem.station_elevation_rad.push_back(
+        station.kind == StationKind::kPose ? 1e9 : station.elevation_rad);
+  }
+  problem.cos_min_triangulation = std::cos(candidate_scene.coverage.min_triangulation_angle_rad);
+  return problem;
+}
+
+// Every candidate compiled as one scene, and its coverage with sights.
+bool analyse_candidates(const std::string& text, const PlanRequest& request, PlanOutcome& outcome,
+                        std::string* error) {
+  std::string replace_error;
+  const auto candidate_text = replace_shots_section(
+      text, shots_yaml(outcome.candidates, all_candidates(outcome.candidates), false),
+      &replace_error);
+  if (!candidate_text) {
+    *error = replace_error;
+    return false;
+  }
+  DiagnosticEngine diag;
+  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  const auto candidate_scene = compile_scene_text(
+      *candidate_text, request.scene_path + " (candidates)", folder_of(request.scene_path), diag);
+  if (!candidate_scene || candidate_scene->shots.size() != outcome.candidates.candidates.size()) {
+    *error = "the candidate poses do not compile: " + first_error(diag);
+    return false;
+  }
+  const scene::StudioScene studio = scene::prepare_studio_scene(*candidate_scene);
+  analysis::CoverageOptions options;
+  options.visibility_scale = request.visibility_scale;
+  options.keep_sights = true;
+  outcome.candidate_coverage = analysis::analyse_coverage(*candidate_scene, studio, options);
+  outcome.problem = make_problem(outcome.candidates, *candidate_scene, outcome.candidate_coverage);
+  return true;
+}
+
+std::optional<std::string> read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEngine& diag,
+                                        std::string* error) {
+  auto scene = compile_scene_file(request.scene_path, diag);
+  if (!scene) return nullptr;
+  const auto text = read_text(request.scene_path);
+  const auto spec = text ? scene_spec(*text, request.scene_path) : std::nullopt;
+  if (!spec) {
+    *error = fmt::format("cannot read {} again", request.scene_path);
+    return nullptr;
+  }
+  auto outcome = std::make_unique<PlanOutcome>();
+  outcome->scene = std::move(*scene);
+  const auto start = std::chrono::steady_clock::now();
+  {
+    const scene::StudioScene studio = scene::prepare_studio_scene(outcome->scene);
+    analysis::CoverageOptions options;
+    options.visibility_scale = request.visibility_scale;
+    outcome->coverage = analysis::analyse_coverage(outcome->scene, studio, options);
+  }
+  outcome->candidates = make_candidates(*spec, outcome->scene, request.candidates);
+  const size_t count = outcome->candidates.candidates.size();
+  if (count == 0 || count > static_cast<size_t>(limits::kMostShots)) {
+    *error = fmt::format(
+        "{} candidate poses; a plan needs 1 to {} (change --rings, --distances "
+        "or --azimuth-step)",
+        count, limits::kMostShots);
+    return nullptr;
+  }
+  if (!analyse_candidates(*text, request, *outcome, error)) return nullptr;
+  outcome->candidate_seconds = seconds_since(start);
+
+  const auto search_start = std::chrono::steady_clock::now();
+  outcome->options.target = request.target;
+  outcome->options.max_shots = request.max_shots;
+  outcome->options.min_overlap = outcome->scene.coverage.min_overlap;
+  outcome->plan = plan_capture(outcome->problem, outcome->options);
+  outcome->search_seconds = seconds_since(search_start);
+
+  std::string replace_error;
+  const auto planned =
+      replace_shots_section(*text, planned_shots_section(*outcome), &replace_error);
+  if (!planned) {
+    *error = replace_error;
+    return nullptr;
+  }
+  outcome->planned_text = *planned;
+  // The planned file must compile where it will be written (relative mesh paths).
+  DiagnosticEngine check;
+  check.set_handler([](const Diagnostic&, const std::string&) {});
+  if (!compile_scene_text(outcome->planned_text, request.output_path,
+                          folder_of(request.output_path), check)) {
+    *error = fmt::format("the planned scene would not compile at {}: {}", request.output_path,
+                         first_error(check));
+    return nullptr;
+  }
+  return outcome;
+}
+
+std::string planned_shots_section(const PlanOutcome& outcome) {
+  std::vector<int> order;
+  for (const PlannedShot& shot : outcome.plan.shots) order.push_back(shot.candidate);
+  const std::string header = fmt::format(
+      "# Planned by `rigc plan`: {} shots make {:.1f} % of the surface reconstructable (target "
+      "{:.1f} %).\n",
+      order.size(), outcome.plan.reconstructable * 100, outcome.options.target * 100);
+  return header + shots_yaml(outcome.candidates, order, true);
+}
+
+}  // namespace rigc::plan

@@ -1,0 +1,296 @@
+#include "plan/planner.h"
+
+#include <algorithm>
+#include <numeric>
+#include <queue>
+#include <utility>
+
+namespace rigc::plan {
+namespace {
+
+using Eigen::Vector3d;
+
+// The faces' state under a growing set of shots: the usable views of each, and whether two of
+// them triangulate it.
+class SurfaceState {
+ public:
+  explicit SurfaceState(const PlanProblem& problem)
+      : problem_(problem),
+        coverage_(*problem.coverage),
+        views_(coverage_.face_area_m2.size()),
+        reconstructable_(coverage_.face_area_m2.size(), 0) {}
+
+  // What adding candidate `c` is worth (m²): the area it makes reconstructable, plus half the area
+  // it gives a first usable view (half of what such a face needs).
+  double gain(int c) const {
+    double value = 0;
+    const Vector3d& eye = coverage_.sights[c].eye;
+    for (const std::uint32_t f : coverage_.sights[c].usable) {
+      if (reconstructable_[f]) continue;
+      if (views_[f].empty() || triangulates(eye, f)) value += 0.5 * coverage_.face_area_m2[f];
+    }
+    return value;
+  }
+
+  void add(int c) {
+    const Vector3d& eye = coverage_.sights[c].eye;
+    for (const std::uint32_t f : coverage_.sights[c].usable) {
+      if (!reconstructable_[f] && !views_[f].empty() && triangulates(eye, f)) {
+        reconstructable_[f] = 1;
+        reconstructable_area_ += coverage_.face_area_m2[f];
+      }
+      views_[f].push_back(c);
+    }
+  }
+
+  double share() const { return reconstructable_area_ / std::max(coverage_.total_area_m2, 1e-30); }
+  const std::vector<std::uint8_t>& faces() const { return reconstructable_; }
+
+ private:
+  // Whether a view from `eye` and one of the face's views are at least the triangulation angle
+  // apart.
+  bool triangulates(const Vector3d& eye, std::uint32_t f) const {
+    const Vector3d& center = coverage_.face_center[f];
+    const Vector3d ray = (eye - center).normalized();
+    for (const int v : views_[f]) {
+      const Vector3d other = (coverage_.sights[v].eye - center).normalized();
+      if (ray.dot(other) <= problem_.cos_min_triangulation) return true;
+    }
+    return false;
+  }
+
+  const PlanProblem& problem_;
+  const analysis::CoverageResult& coverage_;
+  std::vector<std::vector<int>> views_;
+  std::vector<std::uint8_t> reconstructable_;
+  double reconstructable_area_ = 0;
+};
+
+// The share of candidate `later`'s seen surface that `earlier` saw; `marks` is all zero, per face,
+// and is left so.
+double overlap_marked(const PlanProblem& problem, int earlier, int later,
+                      std::vector<std::uint8_t>& marks) {
+  const analysis::CoverageResult& coverage = *problem.coverage;
+  for (const std::uint32_t f : coverage.sights[earlier].seen) marks[f] = 1;
+  double shared = 0, visible = 0;
+  for (const std::uint32_t f : coverage.sights[later].seen) {
+    visible += coverage.face_area_m2[f];
+    if (marks[f]) shared += coverage.face_area_m2[f];
+  }
+  for (const std::uint32_t f : coverage.sights[earlier].seen) marks[f] = 0;
+  return visible > 0 ? shared / visible : 0;
+}
+
+// The share of the surface that the coverage's shots together make reconstructable.
+double reachable_share(const analysis::CoverageResult& coverage) {
+  double area = 0;
+  for (size_t f = 0; f < coverage.face_area_m2.size(); ++f) {
+    if (coverage.reconstructable[f]) area += coverage.face_area_m2[f];
+  }
+  return area / std::max(coverage.total_area_m2, 1e-30);
+}
+
+constexpr double kShortOfReachable = 0.005;
+
+class Planner {
+ public:
+  Planner(const PlanProblem& problem, const PlanOptions& options)
+      : problem_(problem),
+        options_(options),
+        candidate_count_(static_cast<int>(problem.coverage->sights.size())),
+        scratch_(problem.coverage->face_area_m2.size(), 0) {}
+
+  Plan run() {
+    // Short of an unreachable target, the plan stops near what the candidates can reach instead
+    // of adding shots for slivers.
+    goal_ = std::min(options_.target, reachable_share(*problem_.coverage) - kShortOfReachable);
+    std::vector<int> order = capture_order(choose_greedily());
+    bridge_weak_links(order);
+    prune(order);
+    return summarise(order);
+  }
+
+ private:
+  std::vector<int> choose_greedily();
+  std::vector<int> capture_order(std::vector<int> chosen) const;
+  void bridge_weak_links(std::vector<int>& order);
+  int best_bridge(int before, int after, const std::vector<int>& order) const;
+  void prune(std::vector<int>& order) const;
+  bool can_remove(const std::vector<int>& order, size_t i) const;
+  Plan summarise(const std::vector<int>& order) const;
+  bool full(const std::vector<int>& order) const {
+    return options_.max_shots > 0 && static_cast<int>(order.size()) >= options_.max_shots;
+  }
+  double overlap(int earlier, int later) const;
+
+  const PlanProblem& problem_;
+  const PlanOptions& options_;
+  const int candidate_count_;
+  double goal_ = 0;
+  mutable std::vector<std::uint8_t> scratch_;  // per face, for overlaps
+  long evaluations_ = 0;
+};
+
+// Lazy greedy: a candidate's last gain bounds its next one (nearly: a new view can let a face
+// triangulate with a candidate that it could not before), so only the best stale entry is
+// re-evaluated each round.
+std::vector<int> Planner::choose_greedily() {
+  SurfaceState state(problem_);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry> heap;
+  for (int c = 0; c < candidate_count_; ++c) heap.push({state.gain(c), c});
+  evaluations_ += candidate_count_;
+  std::vector<int> chosen;
+  while (state.share() < goal_ && !full(chosen) && !heap.empty()) {
+    const int c = heap.top().second;
+    heap.pop();
+    const double gain = state.gain(c);
+    ++evaluations_;
+    if (!heap.empty() && gain < heap.top().first) {
+      heap.push({gain, c});
+      continue;
+    }
+    if (gain <= 0) break;
+    state.add(c);
+    chosen.push_back(c);
+  }
+  return chosen;
+}
+
+// Ring by ring from the lowest, each ring around the turntable from the end of its widest gap, so
+// that consecutive shots are neighbours.
+std::vector<int> Planner::capture_order(std::vector<int> chosen) const {
+  std::stable_sort(chosen.begin(), chosen.end(), [&](int a, int b) {
+    const int sa = problem_.station[a], sb = problem_.station[b];
+    if (sa != sb) {
+      const double ea = problem_.station_elevation_rad[sa], eb = problem_.station_elevation_rad[sb];
+      return ea != eb ? ea < eb : sa < sb;
+    }
+    return problem_.angle_deg[a] < problem_.angle_deg[b];
+  });
+  for (size_t begin = 0; begin < chosen.size();) {
+    size_t end = begin + 1;
+    while (end < chosen.size() &&
+           problem_.station[chosen[end]] == problem_.station[chosen[begin]]) {
+      ++end;
+    }
+    size_t widest_gap_end = begin;
+    double widest = -1;
+    for (size_t i = begin; i < end; ++i) {
+      const double previous = problem_.angle_deg[chosen[i == begin ? end - 1 : i - 1]];
+      double gap = problem_.angle_deg[chosen[i]] - previous;
+      if (gap <= 0) gap += 360;
+      if (gap > widest) widest = gap, widest_gap_end = i;
+    }
+    std::rotate(chosen.begin() + begin, chosen.begin() + widest_gap_end, chosen.begin() + end);
+    begin = end;
+  }
+  return chosen;
+}
+
+double Planner::overlap(int earlier, int later) const {
+  return overlap_marked(problem_, earlier, later, scratch_);
+}
+
+// Between neighbours that overlap too little, the candidate that overlaps both best.
+void Planner::bridge_weak_links(std::vector<int>& order) {
+  for (size_t i = 1; i < order.size(); ++i) {
+    while (overlap(order[i - 1], order[i]) < options_.min_overlap && !full(order)) {
+      const int bridge = best_bridge(order[i - 1], order[i], order);
+      if (bridge < 0) break;
+      order.insert(order.begin() + static_cast<std::ptrdiff_t>(i), bridge);
+    }
+  }
+}
+
+// The candidate whose weaker overlap with `before` and `after` is best, if better than theirs:
+// from `after`'s station when one there overlaps both enough, so a ring stays one sequence.
+int Planner::best_bridge(int before, int after, const std::vector<int>& order) const {
+  int best_candidate = -1, best_same_station = -1;
+  double best = overlap(before, after), best_on_station = options_.min_overlap - 1e-9;
+  for (int c = 0; c < candidate_count_; ++c) {
+    if (std::find(order.begin(), order.end(), c) != order.end()) continue;
+    const double weaker = std::min(overlap(before, c), overlap(c, after));
+    if (weaker > best + 1e-9) best = weaker, best_candidate = c;
+    if (problem_.station[c] == problem_.station[after] && weaker > best_on_station) {
+      best_on_station = weaker, best_same_station = c;
+    }
+  }
+  return best_same_station >= 0 ? best_same_station : best_candidate;
+}
+
+// Local search: drop shots the target does not need, the least useful first, as long as their
+// neighbours still overlap enough.
+void Planner::prune(std::vector<int>& order) const {
+  const double needed = std::min(goal_, reconstructable_share(problem_, order));
+  for (bool removed = true; removed && order.size() > 1;) {
+    removed = false;
+    std::vector<std::pair<double, size_t>> by_share;  // the share left without each shot
+    for (size_t i = 0; i < order.size(); ++i) {
+      std::vector<int> without = order;
+      without.erase(without.begin() + static_cast<std::ptrdiff_t>(i));
+      by_share.push_back({reconstructable_share(problem_, without), i});
+    }
+    std::sort(by_share.rbegin(), by_share.rend());
+    for (const auto& [share, i] : by_share) {
+      if (share < needed - 1e-12) break;
+      if (!can_remove(order, i)) continue;
+      order.erase(order.begin() + static_cast<std::ptrdiff_t>(i));
+      removed = true;
+      break;
+    }
+  }
+}
+
+// Whether the neighbours of shot `i` would still chain (or did not before either).
+bool Planner::can_remove(const std::vector<int>& order, size_t i) const {
+  if (i == 0 || i + 1 == order.size()) return true;
+  const double joined = overlap(order[i - 1], order[i + 1]);
+  return joined >= options_.min_overlap ||
+         joined >= std::min(overlap(order[i - 1], order[i]), overlap(order[i], order[i + 1]));
+}
+
+Plan Planner::summarise(const std::vector<int>& order) const {
+  Plan plan;
+  SurfaceState state(problem_);
+  for (size_t i = 0; i < order.size(); ++i) {
+    PlannedShot shot;
+    shot.candidate = order[i];
+    const double before = state.share();
+    state.add(order[i]);
+    shot.reconstructable = state.share();
+    shot.gain = shot.reconstructable - before;
+    shot.overlap_with_previous = i > 0 ? overlap(order[i - 1], order[i]) : 0;
+    if (i > 0 && shot.overlap_with_previous < options_.min_overlap) {
+      plan.weak_links.push_back(static_cast<int>(i));
+    }
+    plan.shots.push_back(shot);
+  }
+  plan.reconstructable = state.share();
+  plan.face_reconstructable = state.faces();
+  plan.target_reached = plan.reconstructable >= options_.target;
+  plan.reachable = reachable_share(*problem_.coverage);
+  plan.gain_evaluations = evaluations_;
+  return plan;
+}
+
+}  // namespace
+
+Plan plan_capture(const PlanProblem& problem, const PlanOptions& options) {
+  return Planner(problem, options).run();
+}
+
+double reconstructable_share(const PlanProblem& problem, const std::vector<int>& shots,
+                             std::vector<std::uint8_t>* faces) {
+  SurfaceState state(problem);
+  for (const int c : shots) state.add(c);
+  if (faces) *faces = state.faces();
+  return state.share();
+}
+
+double overlap_share(const PlanProblem& problem, int earlier, int later) {
+  std::vector<std::uint8_t> marks(problem.coverage->face_area_m2.size(), 0);
+  return overlap_marked(problem, earlier, later, marks);
+}
+
+}  // namespace rigc::plan
