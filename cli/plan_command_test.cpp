@@ -1,0 +1,70 @@
+// `rigc plan` as a user runs it: the planned file, the report, the errors.
+#include <gtest/gtest.h>
+
+#include "tests/test_support.h"
+
+namespace rigc::cli {
+namespace {
+
+using testing::read_text;
+using testing::run_rigc;
+using testing::source_path;
+using testing::TempDir;
+using testing::write_text;
+
+std::string small_paper_scene() {
+  std::string text = read_text(source_path("scenes/paper-turntable.yaml"));
+  const std::string detail = "detail: 6";
+  text.replace(text.find(detail), detail.size(), "detail: 4");
+  return text;
+}
+
+TEST(CliPlan, WritesThePlannedSceneBesideTheScene) {
+  TempDir dir;
+  write_text(dir.file("paper.yaml"), small_paper_scene());
+  const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--target", "85%",
+                                "--visibility-scale", "0.15", "--rings", "20,40deg"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("the scene's 18 shots reach"), std::string::npos) << result.out;
+  const std::string planned = read_text(dir.file("paper-plan.yaml"));
+  // Everything but the shots is the user's text, comments included.
+  EXPECT_NE(planned.find("# Elinchrom D-Lite RX4 softboxes"), std::string::npos);
+  EXPECT_NE(planned.find("# Planned by `rigc plan`"), std::string::npos);
+  EXPECT_EQ(planned.find("steps: 18"), std::string::npos);
+  const auto check = run_rigc({"check", dir.file("paper-plan.yaml"), "--no-advice"});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+}
+
+TEST(CliPlan, BadRequestsAreUserErrors) {
+  TempDir dir;
+  write_text(dir.file("paper.yaml"), small_paper_scene());
+  const std::string scene = dir.file("paper.yaml");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"plan", scene, "--target", "150%"}, "--target '150%'"},
+      {{"plan", scene, "--target", "nan"}, "--target 'nan'"},
+      {{"plan", scene, "--rings", "20,95deg"}, "--rings '95deg' is outside"},
+      {{"plan", scene, "--distances", "1m,fast"}, "--distances 'fast'"},
+      {{"plan", scene, "--azimuth-step", "0.1deg"}, "--azimuth-step"},
+      {{"plan", scene, "-o", scene}, "is the scene itself"},
+      {{"plan", scene, "-o", dir.file("no/such/folder/p.yaml")}, "does not exist"},
+      {{"plan", dir.file("missing.yaml")}, "cannot read the scene file"},
+  };
+  for (const auto& [args, message] : cases) {
+    const auto result = run_rigc(args);
+    EXPECT_EQ(result.exit_code, 1) << args.back() << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+  }
+  EXPECT_EQ(read_text(scene), small_paper_scene());
+}
+
+TEST(CliPlan, AnUnreachableTargetExitsOneAndExplains) {
+  TempDir dir;
+  write_text(dir.file("paper.yaml"), small_paper_scene());
+  const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--target", "99.5%",
+                                "--turntable-only", "--visibility-scale", "0.15"});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_NE(result.out.find("cannot be reached"), std::string::npos) << result.out;
+}
+
+}  // namespace
+}  // namespace rigc::cli

@@ -1,0 +1,214 @@
+#include "plan/plan_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "compiler/frontend.h"
+#include "plan/report.h"
+#include "scene/studio_scene.h"
+#include "tests/test_support.h"
+
+namespace rigc::plan {
+namespace {
+
+using testing::TempDir;
+using testing::write_text;
+
+// A primitive on the turntable, lit all round, four turntable shots at the object's height.
+std::string primitive_scene(const std::string& object, const std::string& coverage) {
+  return "rigc: 1\nname: plan-test\nobject:\n  " + object +
+         "\n  surface: {pattern: speckle, scale: 2mm}\nstudio:\n"
+         "  turntable: {diameter: 40cm, height: 75cm}\n  lights:\n"
+         "    - {type: directional, direction: [0, 1, -1], illuminance: 2000lx}\n"
+         "  ambient: 1500lx\ncamera:\n  body: canon-6d\n  lens: {focal_length: 50mm}\n"
+         "  exposure: {aperture: f/16, shutter: 1/125, iso: 400}\n  focus: auto\n"
+         "coverage: " +
+         coverage +
+         "\nshots:\n  - turntable: {steps: 4, step: 90deg, camera: {distance: 90cm, height: "
+         "10cm}}\n";
+}
+
+struct Planned {
+  std::unique_ptr<PlanOutcome> outcome;
+  std::string error, diagnostics;
+};
+
+Planned plan_text(const TempDir& dir, const std::string& text, PlanRequest request) {
+  request.scene_path = dir.file("scene.yaml");
+  request.output_path = dir.file("planned.yaml");
+  if (request.visibility_scale == 0) request.visibility_scale = 0.15;
+  write_text(request.scene_path, text);
+  DiagnosticEngine diag;
+  std::ostringstream diagnostics;
+  diag.set_handler([&](const Diagnostic&, const std::string& r) { diagnostics << r; });
+  Planned planned;
+  planned.outcome = plan_scene(request, diag, &planned.error);
+  planned.diagnostics = diagnostics.str();
+  return planned;
+}
+
+// A lower bound on any plan's shot count: each reconstructable face needs two usable views, and
+// no candidate gives more usable area than the best one.
+int lower_bound_on_shots(const PlanOutcome& outcome, double target) {
+  const analysis::CoverageResult& c = outcome.candidate_coverage;
+  double best_usable = 0;
+  for (const analysis::ShotSight& sight : c.sights) {
+    double usable = 0;
+    for (const std::uint32_t f : sight.usable) usable += c.face_area_m2[f];
+    best_usable = std::max(best_usable, usable / c.total_area_m2);
+  }
+  return static_cast<int>(std::ceil(2 * target / best_usable - 1e-9));
+}
+
+TEST(Plan, ACubeNeedsTheFourCornerViewsOnly) {
+  TempDir dir;
+  PlanRequest request;
+  request.target = 0.8;  // of 5/6: the bottom rests on the table
+  request.candidates.ring_elevations_rad = {35.26 * kDegree};
+  request.candidates.azimuth_step_rad = 15 * kDegree;
+  const Planned planned = plan_text(
+      dir, primitive_scene("primitive: {shape: box}\n  fit: {size: 20cm}", "{min_overlap: 0}"),
+      request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  const Plan& plan = planned.outcome->plan;
+  EXPECT_TRUE(plan.target_reached);
+  // Each of five faces needs two views and a view sees at most three faces: 4 is the optimum.
+  EXPECT_EQ(lower_bound_on_shots(*planned.outcome, request.target), 4);
+  EXPECT_EQ(plan.shots.size(), 4u);
+}
+
+TEST(Plan, ASphereNeedsFewShotsMoreThanTheLowerBound) {
+  TempDir dir;
+  PlanRequest request;
+  request.target = 0.7;
+  const Planned planned = plan_text(
+      dir, primitive_scene("primitive: {shape: sphere}\n  fit: {size: 20cm}", "{min_overlap: 0}"),
+      request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  const Plan& plan = planned.outcome->plan;
+  EXPECT_TRUE(plan.target_reached);
+  const int bound = lower_bound_on_shots(*planned.outcome, request.target);
+  // The stated bound: at most 1.5 times the lower bound, plus one.
+  EXPECT_LE(static_cast<double>(plan.shots.size()), 1.5 * bound + 1) << "lower bound " << bound;
+}
+
+// A hemispherical bowl, open at the top: its inside faces the sky.
+std::string bowl_obj() {
+  std::ostringstream obj;
+  const int rings = 8, segments = 24;
+  const double outer = 0.1, inner = 0.09;
+  // Vertices: outer shell then inner shell, ring 0 at the rim down to the pole.
+  for (const double radius : {outer, inner}) {
+    for (int r = 0; r <= rings; ++r) {
+      const double polar = std::numbers::pi / 2 * r / rings;  // 0 at the rim
+      for (int s = 0; s < segments; ++s) {
+        const double azimuth = 2 * std::numbers::pi * s / segments;
+        obj << "v " << radius * std::cos(polar) * std::cos(azimuth) << ' '
+            << -radius * std::sin(polar) << ' ' << radius * std::cos(polar) * std::sin(azimuth)
+            << '\n';
+      }
+    }
+  }
+  auto index = [&](int shell, int r, int s) {
+    return 1 + shell * (rings + 1) * segments + r * segments + (s % segments);
+  };
+  for (int r = 0; r < rings; ++r) {
+    for (int s = 0; s < segments; ++s) {
+      // Outside facing out (+Y up in OBJ), inside facing the bowl's axis.
+      obj << "f " << index(0, r, s) << ' ' << index(0, r, s + 1) << ' ' << index(0, r + 1, s + 1)
+          << ' ' << index(0, r + 1, s) << '\n';
+      obj << "f " << index(1, r, s) << ' ' << index(1, r + 1, s) << ' ' << index(1, r + 1, s + 1)
+          << ' ' << index(1, r, s + 1) << '\n';
+    }
+  }
+  for (int s = 0; s < segments; ++s) {  // the rim
+    obj << "f " << index(0, 0, s) << ' ' << index(1, 0, s) << ' ' << index(1, 0, s + 1) << ' '
+        << index(0, 0, s + 1) << '\n';
+  }
+  return obj.str();
+}
+
+TEST(Plan, ABowlGetsShotsFromAbove) {
+  TempDir dir;
+  write_text(dir.file("bowl.obj"), bowl_obj());
+  PlanRequest request;
+  request.target = 0.6;
+  const Planned planned = plan_text(
+      dir, primitive_scene("mesh: bowl.obj\n  fit: {width: 20cm}", "{min_overlap: 0.3}"), request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  const PlanOutcome& outcome = *planned.outcome;
+  EXPECT_TRUE(outcome.plan.target_reached);
+  // The inside (normals up) is reconstructable only from high rings.
+  double inside = 0, inside_reconstructable = 0;
+  const analysis::CoverageResult& c = outcome.candidate_coverage;
+  for (size_t f = 0; f < c.face_area_m2.size(); ++f) {
+    if (c.face_normal[f].z() < 0.7) continue;
+    inside += c.face_area_m2[f];
+    if (outcome.plan.face_reconstructable[f]) inside_reconstructable += c.face_area_m2[f];
+  }
+  EXPECT_GT(inside_reconstructable, 0.8 * inside);
+  double highest = 0;
+  for (const PlannedShot& shot : outcome.plan.shots) {
+    const Candidate& candidate = outcome.candidates.candidates[shot.candidate];
+    highest = std::max(highest, outcome.candidates.stations[candidate.station].elevation_rad);
+  }
+  EXPECT_GE(highest, 40 * kDegree);
+}
+
+std::string statue_scene() {
+  return primitive_scene("primitive: {shape: statue, detail: 4}\n  fit: {height: 25cm}",
+                         "{min_overlap: 0.6}");
+}
+
+TEST(Plan, AnUnreachableTargetSaysWhatStaysUnseen) {
+  TempDir dir;
+  PlanRequest request;
+  request.target = 0.99;
+  request.candidates.turntable_only = true;
+  const Planned planned = plan_text(dir, statue_scene(), request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  EXPECT_FALSE(planned.outcome->plan.target_reached);
+  std::ostringstream report;
+  print_plan_report(*planned.outcome, report);
+  EXPECT_NE(report.str().find("cannot be reached"), std::string::npos) << report.str();
+  EXPECT_NE(report.str().find("rests on the turntable"), std::string::npos) << report.str();
+  EXPECT_NE(report.str().find("faces up, seen by no candidate"), std::string::npos) << report.str();
+}
+
+TEST(Plan, ThePlannedSceneCompilesAndItsCoverageIsThePlans) {
+  TempDir dir;
+  PlanRequest request;
+  request.target = 0.85;
+  const Planned planned = plan_text(dir, statue_scene(), request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  const PlanOutcome& outcome = *planned.outcome;
+  ASSERT_TRUE(outcome.plan.target_reached);
+  // Every shot chains to the one before it.
+  EXPECT_TRUE(outcome.plan.weak_links.empty());
+  for (size_t i = 1; i < outcome.plan.shots.size(); ++i) {
+    EXPECT_GE(outcome.plan.shots[i].overlap_with_previous, 0.6) << i;
+  }
+  // The file keeps the rest of the scene and compiles to the plan's shots and coverage.
+  EXPECT_NE(outcome.planned_text.find("fit: {height: 25cm}"), std::string::npos);
+  DiagnosticEngine diag;
+  const auto planned_scene =
+      compile_scene_text(outcome.planned_text, request.output_path, dir.path().string(), diag);
+  ASSERT_TRUE(planned_scene);
+  ASSERT_EQ(planned_scene->shots.size(), outcome.plan.shots.size());
+  analysis::CoverageOptions options;
+  options.visibility_scale = 0.15;
+  const analysis::CoverageResult coverage = analysis::analyse_coverage(
+      *planned_scene, scene::prepare_studio_scene(*planned_scene), options);
+  EXPECT_NEAR(coverage.shots.back().reconstructable, outcome.plan.reconstructable, 0.002);
+  for (size_t i = 1; i < coverage.shots.size(); ++i) {
+    EXPECT_NEAR(coverage.shots[i].overlap_with_previous,
+                outcome.plan.shots[i].overlap_with_previous, 0.01)
+        << i;
+  }
+}
+
+}  // namespace
+}  // namespace rigc::plan
