@@ -1,8 +1,14 @@
 #include "plan/planner.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <queue>
+#include <span>
 #include <utility>
 
 namespace rigc::plan {
@@ -116,6 +122,8 @@ class Planner {
   void bridge_weak_links(std::vector<int>& order);
   int best_bridge(int before, int after, const std::vector<int>& order) const;
   void prune(std::vector<int>& order) const;
+  std::vector<double> losses(const std::vector<int>& order) const;
+  std::array<int, 2> critical_views(const std::vector<Vector3d>& rays) const;
   bool can_remove(const std::vector<int>& order, size_t i) const;
   Plan summarise(const std::vector<int>& order) const;
   bool full(const std::vector<int>& order) const {
@@ -225,21 +233,89 @@ void Planner::prune(std::vector<int>& order) const {
   const double needed = std::min(goal_, reconstructable_share(problem_, order));
   for (bool removed = true; removed && order.size() > 1;) {
     removed = false;
-    std::vector<std::pair<double, size_t>> by_share;  // the share left without each shot
-    for (size_t i = 0; i < order.size(); ++i) {
-      std::vector<int> without = order;
-      without.erase(without.begin() + static_cast<std::ptrdiff_t>(i));
-      by_share.push_back({reconstructable_share(problem_, without), i});
-    }
-    std::sort(by_share.rbegin(), by_share.rend());
-    for (const auto& [share, i] : by_share) {
-      if (share < needed - 1e-12) break;
+    const double share = reconstructable_share(problem_, order);
+    const std::vector<double> loss = losses(order);
+    std::vector<size_t> by_loss(order.size());
+    std::iota(by_loss.begin(), by_loss.end(), 0);
+    std::stable_sort(by_loss.begin(), by_loss.end(),
+                     [&](size_t a, size_t b) { return loss[a] < loss[b]; });
+    for (const size_t i : by_loss) {
+      if (share - loss[i] < needed - 1e-12) break;
       if (!can_remove(order, i)) continue;
       order.erase(order.begin() + static_cast<std::ptrdiff_t>(i));
       removed = true;
       break;
     }
   }
+}
+
+// For each shot of `order`, the share of the surface that is reconstructable with it and not
+// without it: the faces all of whose triangulating pairs of views include it.
+std::vector<double> Planner::losses(const std::vector<int>& order) const {
+  const analysis::CoverageResult& coverage = *problem_.coverage;
+  const size_t face_count = coverage.face_area_m2.size();
+  // The faces' usable views among the shots, as positions in `order` (compressed rows).
+  std::vector<std::uint32_t> offsets(face_count + 1, 0);
+  for (const int c : order) {
+    for (const std::uint32_t f : coverage.sights[c].usable) ++offsets[f + 1];
+  }
+  for (size_t f = 0; f < face_count; ++f) offsets[f + 1] += offsets[f];
+  std::vector<std::uint32_t> views(offsets.back()), next(offsets.begin(), offsets.end() - 1);
+  for (size_t i = 0; i < order.size(); ++i) {
+    for (const std::uint32_t f : coverage.sights[order[i]].usable) {
+      views[next[f]++] = static_cast<std::uint32_t>(i);
+    }
+  }
+  tbb::enumerable_thread_specific<std::vector<double>> partial(
+      std::vector<double>(order.size(), 0.0));
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, face_count, 4096),
+      [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<double>& loss = partial.local();
+        std::vector<Vector3d> rays;
+        for (size_t f = range.begin(); f != range.end(); ++f) {
+          const std::span<const std::uint32_t> face_views(views.data() + offsets[f],
+                                                          offsets[f + 1] - offsets[f]);
+          if (face_views.size() < 2) continue;
+          rays.clear();
+          for (const std::uint32_t i : face_views) {
+            rays.push_back((coverage.sights[order[i]].eye - coverage.face_center[f]).normalized());
+          }
+          for (const int critical : critical_views(rays)) {
+            if (critical < 0) continue;
+            loss[face_views[critical]] += coverage.face_area_m2[f] / coverage.total_area_m2;
+          }
+        }
+      });
+  std::vector<double> loss(order.size(), 0.0);
+  for (const std::vector<double>& part : partial) {
+    for (size_t i = 0; i < loss.size(); ++i) loss[i] += part[i];
+  }
+  return loss;
+}
+
+// The views (up to two; -1 for none) that every triangulating pair of `rays` includes: a face
+// loses its reconstructability to the removal of one of those only.
+std::array<int, 2> Planner::critical_views(const std::vector<Vector3d>& rays) const {
+  const double cos_min = problem_.cos_min_triangulation;
+  auto pair_without = [&](int excluded) {
+    for (size_t a = 0; a < rays.size(); ++a) {
+      for (size_t b = a + 1; b < rays.size(); ++b) {
+        if (static_cast<int>(a) == excluded || static_cast<int>(b) == excluded) continue;
+        if (rays[a].dot(rays[b]) <= cos_min) return true;
+      }
+    }
+    return false;
+  };
+  for (size_t a = 0; a < rays.size(); ++a) {
+    for (size_t b = a + 1; b < rays.size(); ++b) {
+      if (rays[a].dot(rays[b]) > cos_min) continue;
+      // The first pair: only its two views can be in every pair.
+      const int first = static_cast<int>(a), second = static_cast<int>(b);
+      return {pair_without(first) ? -1 : first, pair_without(second) ? -1 : second};
+    }
+  }
+  return {-1, -1};
 }
 
 // Whether the neighbours of shot `i` would still chain (or did not before either).
