@@ -54,7 +54,8 @@ std::optional<std::vector<double>> parse_list(const std::string& text, QuantityK
 }
 
 struct PlanArguments {
-  std::string target = "95%", rings, distances, azimuth_step = "10deg";
+  std::string target = "95%", rings, distances, azimuth_step = "10deg", max_step = "30deg";
+  bool next = false;
 };
 
 // The request from the options; false after printing why it is not one.
@@ -81,6 +82,14 @@ bool make_request(const PlanArguments& args, plan::PlanRequest& request) {
           fmt::format("--azimuth-step '{}' is not an angle within 1deg..180deg", args.azimuth_step);
     } else {
       request.candidates.azimuth_step_rad = *step.value;
+    }
+  }
+  if (error.empty()) {
+    const QuantityParse step = parse_quantity(args.max_step, QuantityKind::kAngle);
+    if (!step.value || !(*step.value >= 5 * kDegree && *step.value <= 180 * kDegree)) {
+      error = fmt::format("--max-step '{}' is not an angle within 5deg..180deg", args.max_step);
+    } else {
+      request.max_step_rad = *step.value;
     }
   }
   if (!error.empty()) std::cerr << "rigc: error: " << error << '\n';
@@ -131,6 +140,14 @@ int run_plan_command(std::vector<std::string> args) {
       ->capture_default_str();
   app.add_option("--max-shots", request.max_shots, "most shots in the plan (0: no limit)")
       ->check(CLI::Range(0, 5000));
+  app.add_option("--max-step", arguments.max_step,
+                 "widest angle between neighbouring shots, seen from the object, that still "
+                 "chains them")
+      ->capture_default_str();
+  app.add_flag("--keep-shots", request.keep_scene_shots,
+               "keep the scene's shots and plan the ones to add");
+  app.add_flag("--next", arguments.next,
+               "only the one shot that adds most to the scene's own (as --keep-shots)");
   app.add_flag("--turntable-only", request.candidates.turntable_only,
                "only the scene's own camera stations; the plan picks turntable angles");
   app.add_option("--visibility-scale", request.visibility_scale,
@@ -139,6 +156,13 @@ int run_plan_command(std::vector<std::string> args) {
                                   "is neither 0 (automatic) nor within 0.01..1", ""));
   if (auto code = parse_options(app, args)) return *code;
   if (!make_request(arguments, request) || !choose_output(request)) return kExitUserError;
+  if (arguments.next) {
+    // The best shot to add, whatever the scene reaches already.
+    request.keep_scene_shots = true;
+    request.target = 1;
+    request.max_shots = 0;
+    request.next_shot_only = true;
+  }
 
   DiagnosticEngine diag;
   std::string error;
@@ -153,7 +177,7 @@ int run_plan_command(std::vector<std::string> args) {
     return kExitUserError;
   }
   std::cout << fmt::format("planned scene: {}\n", request.output_path);
-  return outcome->plan.target_reached ? kExitOk : kExitUserError;
+  return outcome->plan.target_reached || arguments.next ? kExitOk : kExitUserError;
 }
 
 }  // namespace rigc::cli

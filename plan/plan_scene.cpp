@@ -44,10 +44,13 @@ std::string first_error(const DiagnosticEngine& diag) {
   return "no diagnostic";
 }
 
-PlanProblem make_problem(const CandidateSet& set, const ir::Scene& candidate_scene,
+PlanProblem make_problem(const CandidateSet& set, int kept, const ir::Scene& candidate_scene,
                          const analysis::CoverageResult& coverage) {
   PlanProblem problem;
   problem.coverage = &coverage;
+  problem.kept = kept;
+  problem.station.assign(kept, -1);
+  problem.angle_deg.assign(kept, 0);
   for (const Candidate& candidate : set.candidates) {
     problem.station.push_back(candidate.station);
     problem.angle_deg.push_back(candidate.angle_deg);
@@ -58,6 +61,8 @@ PlanProblem make_problem(const CandidateSet& set, const ir::Scene& candidate_sce
         station.kind == StationKind::kPose ? 1e9 : station.elevation_rad);
   }
   problem.cos_min_triangulation = std::cos(candidate_scene.coverage.min_triangulation_angle_rad);
+  problem.object_center =
+      (candidate_scene.object.bounds_min_object + candidate_scene.object.bounds_max_object) / 2;
   return problem;
 }
 
@@ -74,18 +79,27 @@ bool analyse_candidates(const std::string& text, const PlanRequest& request, Pla
   }
   DiagnosticEngine diag;
   diag.set_handler([](const Diagnostic&, const std::string&) {});
-  const auto candidate_scene = compile_scene_text(
-      *candidate_text, request.scene_path + " (candidates)", folder_of(request.scene_path), diag);
+  auto candidate_scene = compile_scene_text(*candidate_text, request.scene_path + " (candidates)",
+                                            folder_of(request.scene_path), diag);
   if (!candidate_scene || candidate_scene->shots.size() != outcome.candidates.candidates.size()) {
     *error = "the candidate poses do not compile: " + first_error(diag);
     return false;
+  }
+  if (request.keep_scene_shots) {
+    outcome.kept = static_cast<int>(outcome.scene.shots.size());
+    candidate_scene->shots.insert(candidate_scene->shots.begin(), outcome.scene.shots.begin(),
+                                  outcome.scene.shots.end());
+    for (size_t i = 0; i < candidate_scene->shots.size(); ++i) {
+      candidate_scene->shots[i].index = static_cast<int>(i);
+    }
   }
   const scene::StudioScene studio = scene::prepare_studio_scene(*candidate_scene);
   analysis::CoverageOptions options;
   options.visibility_scale = request.visibility_scale;
   options.keep_sights = true;
   outcome.candidate_coverage = analysis::analyse_coverage(*candidate_scene, studio, options);
-  outcome.problem = make_problem(outcome.candidates, *candidate_scene, outcome.candidate_coverage);
+  outcome.problem =
+      make_problem(outcome.candidates, outcome.kept, *candidate_scene, outcome.candidate_coverage);
   return true;
 }
 
@@ -101,9 +115,12 @@ std::optional<std::string> read_text(const std::string& path) {
 
 std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEngine& diag,
                                         std::string* error) {
-  auto scene = compile_scene_file(request.scene_path, diag);
+  auto scene = request.scene_text.empty()
+                   ? compile_scene_file(request.scene_path, diag)
+                   : compile_scene_text(request.scene_text, request.scene_path,
+                                        folder_of(request.scene_path), diag);
   if (!scene) return nullptr;
-  const auto text = read_text(request.scene_path);
+  const auto text = request.scene_text.empty() ? read_text(request.scene_path) : request.scene_text;
   const auto spec = text ? scene_spec(*text, request.scene_path) : std::nullopt;
   if (!spec) {
     *error = fmt::format("cannot read {} again", request.scene_path);
@@ -132,14 +149,20 @@ std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEn
 
   const auto search_start = std::chrono::steady_clock::now();
   outcome->options.target = request.target;
-  outcome->options.max_shots = request.max_shots;
+  outcome->options.max_shots = request.next_shot_only ? outcome->kept + 1 : request.max_shots;
+  outcome->next_shot_only = request.next_shot_only;
+  // The next shot adds the most reconstructable area; first views only break ties.
+  if (request.next_shot_only) outcome->options.first_view_weight = 1e-6;
   outcome->options.min_overlap = outcome->scene.coverage.min_overlap;
+  outcome->options.max_step_rad = request.max_step_rad;
   outcome->plan = plan_capture(outcome->problem, outcome->options);
   outcome->search_seconds = seconds_since(search_start);
 
   std::string replace_error;
   const auto planned =
-      replace_shots_section(*text, planned_shots_section(*outcome), &replace_error);
+      request.keep_scene_shots
+          ? append_to_shots_section(*text, planned_shots_text(*outcome), &replace_error)
+          : replace_shots_section(*text, planned_shots_text(*outcome), &replace_error);
   if (!planned) {
     *error = replace_error;
     return nullptr;
@@ -157,14 +180,33 @@ std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEn
   return outcome;
 }
 
-std::string planned_shots_section(const PlanOutcome& outcome) {
-  std::vector<int> order;
-  for (const PlannedShot& shot : outcome.plan.shots) order.push_back(shot.candidate);
-  const std::string header = fmt::format(
-      "# Planned by `rigc plan`: {} shots make {:.1f} % of the surface reconstructable (target "
-      "{:.1f} %).\n",
-      order.size(), outcome.plan.reconstructable * 100, outcome.options.target * 100);
-  return header + shots_yaml(outcome.candidates, order, true);
+const Candidate* planned_candidate(const PlanOutcome& outcome, const PlannedShot& shot) {
+  if (shot.candidate < outcome.kept) return nullptr;
+  return &outcome.candidates.candidates[shot.candidate - outcome.kept];
+}
+
+std::string planned_shots_text(const PlanOutcome& outcome) {
+  std::vector<int> added;
+  for (const PlannedShot& shot : outcome.plan.shots) {
+    if (shot.candidate >= outcome.kept) added.push_back(shot.candidate - outcome.kept);
+  }
+  const std::string figures = fmt::format(
+      "{} shots make {:.1f} % of the surface reconstructable (target {:.1f} %)",
+      outcome.plan.shots.size(), outcome.plan.reconstructable * 100, outcome.options.target * 100);
+  const std::string entries = shots_yaml(outcome.candidates, added, true);
+  if (outcome.next_shot_only) {
+    const double gain = outcome.plan.shots.empty() ? 0 : outcome.plan.shots.back().gain;
+    return fmt::format(
+               "  # Suggested by `rigc plan --next`: adds {:.1f} %; {} shots make {:.1f} % "
+               "reconstructable.\n",
+               gain * 100, outcome.plan.shots.size(), outcome.plan.reconstructable * 100) +
+           entries.substr(entries.find('\n') + 1);
+  }
+  if (outcome.kept > 0) {
+    return fmt::format("  # Added by `rigc plan`: with these, {}.\n", figures) +
+           entries.substr(entries.find('\n') + 1);
+  }
+  return fmt::format("# Planned by `rigc plan`: {}.\n", figures) + entries;
 }
 
 }  // namespace rigc::plan

@@ -66,7 +66,8 @@ int lower_bound_on_shots(const PlanOutcome& outcome, double target) {
 TEST(Plan, ACubeNeedsTheFourCornerViewsOnly) {
   TempDir dir;
   PlanRequest request;
-  request.target = 0.8;  // of 5/6: the bottom rests on the table
+  request.target = 0.8;                     // of 5/6: the bottom rests on the table
+  request.max_step_rad = std::numbers::pi;  // coverage alone
   request.candidates.ring_elevations_rad = {35.26 * kDegree};
   request.candidates.azimuth_step_rad = 15 * kDegree;
   const Planned planned = plan_text(
@@ -84,6 +85,8 @@ TEST(Plan, ASphereNeedsFewShotsMoreThanTheLowerBound) {
   TempDir dir;
   PlanRequest request;
   request.target = 0.7;
+  request.max_step_rad = std::numbers::pi;  // coverage alone
+  request.candidates.azimuth_step_rad = 20 * kDegree;
   const Planned planned = plan_text(
       dir, primitive_scene("primitive: {shape: sphere}\n  fit: {size: 20cm}", "{min_overlap: 0}"),
       request);
@@ -152,8 +155,9 @@ TEST(Plan, ABowlGetsShotsFromAbove) {
   EXPECT_GT(inside_reconstructable, 0.8 * inside);
   double highest = 0;
   for (const PlannedShot& shot : outcome.plan.shots) {
-    const Candidate& candidate = outcome.candidates.candidates[shot.candidate];
-    highest = std::max(highest, outcome.candidates.stations[candidate.station].elevation_rad);
+    const Candidate* candidate = planned_candidate(outcome, shot);
+    ASSERT_NE(candidate, nullptr);
+    highest = std::max(highest, outcome.candidates.stations[candidate->station].elevation_rad);
   }
   EXPECT_GE(highest, 40 * kDegree);
 }
@@ -190,6 +194,7 @@ TEST(Plan, ThePlannedSceneCompilesAndItsCoverageIsThePlans) {
   EXPECT_TRUE(outcome.plan.weak_links.empty());
   for (size_t i = 1; i < outcome.plan.shots.size(); ++i) {
     EXPECT_GE(outcome.plan.shots[i].overlap_with_previous, 0.6) << i;
+    EXPECT_LE(outcome.plan.shots[i].step_rad, 30 * kDegree + 1e-9) << i;
   }
   // The file keeps the rest of the scene and compiles to the plan's shots and coverage.
   EXPECT_NE(outcome.planned_text.find("fit: {height: 25cm}"), std::string::npos);
@@ -208,6 +213,41 @@ TEST(Plan, ThePlannedSceneCompilesAndItsCoverageIsThePlans) {
                 outcome.plan.shots[i].overlap_with_previous, 0.01)
         << i;
   }
+}
+
+TEST(Plan, KeptShotsComeFirstAndTheNextShotAddsMost) {
+  TempDir dir;
+  PlanRequest request;
+  request.keep_scene_shots = true;
+  request.next_shot_only = true;
+  request.target = 1;
+  const Planned planned = plan_text(dir, statue_scene(), request);
+  ASSERT_TRUE(planned.outcome) << planned.error << planned.diagnostics;
+  const PlanOutcome& outcome = *planned.outcome;
+  ASSERT_EQ(outcome.kept, 4);
+  ASSERT_EQ(outcome.plan.shots.size(), 5u);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(outcome.plan.shots[i].candidate, i);
+  const double scene_share = outcome.coverage.shots.back().reconstructable;
+  EXPECT_NEAR(outcome.plan.shots[3].reconstructable, scene_share, 0.002);
+  // No single candidate adds more reconstructable surface than the one suggested.
+  const double suggested = outcome.plan.shots.back().gain;
+  EXPECT_GT(suggested, 0);
+  std::vector<int> shots = {0, 1, 2, 3, 0};
+  for (int c = 4; c < static_cast<int>(outcome.candidate_coverage.sights.size()); ++c) {
+    shots.back() = c;
+    EXPECT_LE(reconstructable_share(outcome.problem, shots) - outcome.plan.shots[3].reconstructable,
+              suggested + 1e-6)
+        << c;
+  }
+  // The scene keeps its own shots entry; the suggestion is appended to it.
+  const std::string& text = outcome.planned_text;
+  EXPECT_NE(text.find("steps: 4, step: 90deg"), std::string::npos);
+  EXPECT_NE(text.find("# Suggested by `rigc plan --next`"), std::string::npos);
+  DiagnosticEngine diag;
+  const auto planned_scene =
+      compile_scene_text(text, request.output_path, dir.path().string(), diag);
+  ASSERT_TRUE(planned_scene);
+  EXPECT_EQ(planned_scene->shots.size(), 5u);
 }
 
 }  // namespace

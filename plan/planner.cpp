@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <queue>
 #include <span>
@@ -20,20 +22,25 @@ using Eigen::Vector3d;
 // them triangulate it.
 class SurfaceState {
  public:
-  explicit SurfaceState(const PlanProblem& problem)
+  SurfaceState(const PlanProblem& problem, double first_view_weight = 0.5)
       : problem_(problem),
+        first_view_weight_(first_view_weight),
         coverage_(*problem.coverage),
         views_(coverage_.face_area_m2.size()),
         reconstructable_(coverage_.face_area_m2.size(), 0) {}
 
-  // What adding candidate `c` is worth (m²): the area it makes reconstructable, plus half the area
-  // it gives a first usable view (half of what such a face needs).
+  // What adding candidate `c` is worth (m²) when a reconstructable face counts 1 and a face with a
+  // usable view `first_view_weight`.
   double gain(int c) const {
     double value = 0;
     const Vector3d& eye = coverage_.sights[c].eye;
     for (const std::uint32_t f : coverage_.sights[c].usable) {
       if (reconstructable_[f]) continue;
-      if (views_[f].empty() || triangulates(eye, f)) value += 0.5 * coverage_.face_area_m2[f];
+      if (views_[f].empty()) {
+        value += first_view_weight_ * coverage_.face_area_m2[f];
+      } else if (triangulates(eye, f)) {
+        value += (1 - first_view_weight_) * coverage_.face_area_m2[f];
+      }
     }
     return value;
   }
@@ -66,6 +73,7 @@ class SurfaceState {
   }
 
   const PlanProblem& problem_;
+  const double first_view_weight_;
   const analysis::CoverageResult& coverage_;
   std::vector<std::vector<int>> views_;
   std::vector<std::uint8_t> reconstructable_;
@@ -110,7 +118,10 @@ class Planner {
     // Short of an unreachable target, the plan stops near what the candidates can reach instead
     // of adding shots for slivers.
     goal_ = std::min(options_.target, reachable_share(*problem_.coverage) - kShortOfReachable);
-    std::vector<int> order = capture_order(choose_greedily());
+    std::vector<int> order(problem_.kept);
+    std::iota(order.begin(), order.end(), 0);
+    const std::vector<int> added = capture_order(choose_greedily());
+    order.insert(order.end(), added.begin(), added.end());
     bridge_weak_links(order);
     prune(order);
     return summarise(order);
@@ -130,6 +141,8 @@ class Planner {
     return options_.max_shots > 0 && static_cast<int>(order.size()) >= options_.max_shots;
   }
   double overlap(int earlier, int later) const;
+  double step(int a, int b) const;
+  double link(int earlier, int later) const;
 
   const PlanProblem& problem_;
   const PlanOptions& options_;
@@ -143,13 +156,18 @@ class Planner {
 // triangulate with a candidate that it could not before), so only the best stale entry is
 // re-evaluated each round.
 std::vector<int> Planner::choose_greedily() {
-  SurfaceState state(problem_);
+  SurfaceState state(problem_, options_.first_view_weight);
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry> heap;
-  for (int c = 0; c < candidate_count_; ++c) heap.push({state.gain(c), c});
-  evaluations_ += candidate_count_;
+  for (int c = 0; c < problem_.kept; ++c) state.add(c);
+  for (int c = problem_.kept; c < candidate_count_; ++c) heap.push({state.gain(c), c});
+  evaluations_ += candidate_count_ - problem_.kept;
   std::vector<int> chosen;
-  while (state.share() < goal_ && !full(chosen) && !heap.empty()) {
+  auto room = [&] {
+    return options_.max_shots == 0 ||
+           problem_.kept + static_cast<int>(chosen.size()) < options_.max_shots;
+  };
+  while (state.share() < goal_ && room() && !heap.empty()) {
     const int c = heap.top().second;
     heap.pop();
     const double gain = state.gain(c);
@@ -200,10 +218,29 @@ double Planner::overlap(int earlier, int later) const {
   return overlap_marked(problem_, earlier, later, scratch_);
 }
 
-// Between neighbours that overlap too little, the candidate that overlaps both best.
+double Planner::step(int a, int b) const {
+  const auto& sights = problem_.coverage->sights;
+  const Vector3d from_a = sights[a].eye - problem_.object_center;
+  const Vector3d from_b = sights[b].eye - problem_.object_center;
+  return std::acos(std::clamp(from_a.normalized().dot(from_b.normalized()), -1.0, 1.0));
+}
+
+// How well `later` chains to `earlier`: 1 or more when they overlap at least min_overlap and stand
+// at most max_step apart; otherwise the worse of the two ratios.
+double Planner::link(int earlier, int later) const {
+  const double by_overlap = options_.min_overlap > 0
+                                ? overlap(earlier, later) / options_.min_overlap
+                                : std::numeric_limits<double>::infinity();
+  const double angle = step(earlier, later);
+  const double by_step =
+      angle > 0 ? options_.max_step_rad / angle : std::numeric_limits<double>::infinity();
+  return std::min(by_overlap, by_step);
+}
+
+// Between neighbours that do not chain, the candidate that links to both best.
 void Planner::bridge_weak_links(std::vector<int>& order) {
-  for (size_t i = 1; i < order.size(); ++i) {
-    while (overlap(order[i - 1], order[i]) < options_.min_overlap && !full(order)) {
+  for (size_t i = std::max(1, problem_.kept); i < order.size(); ++i) {
+    while (link(order[i - 1], order[i]) < 1 && !full(order)) {
       const int bridge = best_bridge(order[i - 1], order[i], order);
       if (bridge < 0) break;
       order.insert(order.begin() + static_cast<std::ptrdiff_t>(i), bridge);
@@ -211,14 +248,14 @@ void Planner::bridge_weak_links(std::vector<int>& order) {
   }
 }
 
-// The candidate whose weaker overlap with `before` and `after` is best, if better than theirs:
-// from `after`'s station when one there overlaps both enough, so a ring stays one sequence.
+// The candidate whose weaker link with `before` and `after` is best, if better than theirs: from
+// `after`'s station when one there links both, so a ring stays one sequence.
 int Planner::best_bridge(int before, int after, const std::vector<int>& order) const {
   int best_candidate = -1, best_same_station = -1;
-  double best = overlap(before, after), best_on_station = options_.min_overlap - 1e-9;
-  for (int c = 0; c < candidate_count_; ++c) {
+  double best = link(before, after), best_on_station = 1 - 1e-9;
+  for (int c = problem_.kept; c < candidate_count_; ++c) {
     if (std::find(order.begin(), order.end(), c) != order.end()) continue;
-    const double weaker = std::min(overlap(before, c), overlap(c, after));
+    const double weaker = std::min(link(before, c), link(c, after));
     if (weaker > best + 1e-9) best = weaker, best_candidate = c;
     if (problem_.station[c] == problem_.station[after] && weaker > best_on_station) {
       best_on_station = weaker, best_same_station = c;
@@ -241,6 +278,7 @@ void Planner::prune(std::vector<int>& order) const {
                      [&](size_t a, size_t b) { return loss[a] < loss[b]; });
     for (const size_t i : by_loss) {
       if (share - loss[i] < needed - 1e-12) break;
+      if (static_cast<int>(i) < problem_.kept) continue;
       if (!can_remove(order, i)) continue;
       order.erase(order.begin() + static_cast<std::ptrdiff_t>(i));
       removed = true;
@@ -321,9 +359,9 @@ std::array<int, 2> Planner::critical_views(const std::vector<Vector3d>& rays) co
 // Whether the neighbours of shot `i` would still chain (or did not before either).
 bool Planner::can_remove(const std::vector<int>& order, size_t i) const {
   if (i == 0 || i + 1 == order.size()) return true;
-  const double joined = overlap(order[i - 1], order[i + 1]);
-  return joined >= options_.min_overlap ||
-         joined >= std::min(overlap(order[i - 1], order[i]), overlap(order[i], order[i + 1]));
+  const double joined = link(order[i - 1], order[i + 1]);
+  return joined >= 1 ||
+         joined >= std::min(link(order[i - 1], order[i]), link(order[i], order[i + 1]));
 }
 
 Plan Planner::summarise(const std::vector<int>& order) const {
@@ -337,7 +375,8 @@ Plan Planner::summarise(const std::vector<int>& order) const {
     shot.reconstructable = state.share();
     shot.gain = shot.reconstructable - before;
     shot.overlap_with_previous = i > 0 ? overlap(order[i - 1], order[i]) : 0;
-    if (i > 0 && shot.overlap_with_previous < options_.min_overlap) {
+    shot.step_rad = i > 0 ? step(order[i - 1], order[i]) : 0;
+    if (i > 0 && link(order[i - 1], order[i]) < 1) {
       plan.weak_links.push_back(static_cast<int>(i));
     }
     plan.shots.push_back(shot);

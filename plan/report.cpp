@@ -16,15 +16,18 @@ void print_shots(const PlanOutcome& outcome, std::ostream& out) {
                      "recon %", "overlap");
   for (size_t i = 0; i < outcome.plan.shots.size(); ++i) {
     const PlannedShot& shot = outcome.plan.shots[i];
-    const Candidate& candidate = outcome.candidates.candidates[shot.candidate];
-    const Station& station = outcome.candidates.stations[candidate.station];
-    const std::string angle =
-        station.kind == StationKind::kPose ? "" : fmt::format("{:g}°", candidate.angle_deg);
+    const Candidate* candidate = planned_candidate(outcome, shot);
+    const Station* station = candidate ? &outcome.candidates.stations[candidate->station] : nullptr;
+    const std::string where = station ? describe_station(*station)
+                                      : fmt::format("the scene's {}", outcome.scene.shots[i].name);
+    const std::string angle = !station || station->kind == StationKind::kPose
+                                  ? ""
+                                  : fmt::format("{:g}°", candidate->angle_deg);
     const std::string overlap =
         i == 0 ? "" : fmt::format("{:.0f} %", percent(shot.overlap_with_previous));
-    out << fmt::format("shot_{:03d} {:<46} {:>8} {:>7.1f} {:>8.1f} {:>8}\n", i,
-                       describe_station(station), angle, percent(shot.gain),
-                       percent(shot.reconstructable), overlap);
+    const std::string step = i == 0 ? "" : fmt::format("{:.0f}°", shot.step_rad / kDegree);
+    out << fmt::format("shot_{:03d} {:<46} {:>8} {:>7.1f} {:>8.1f} {:>8} {:>6}\n", i, where, angle,
+                       percent(shot.gain), percent(shot.reconstructable), overlap, step);
   }
 }
 
@@ -105,6 +108,13 @@ UnreachableSurface unreachable_surface(const PlanOutcome& outcome) {
 
 void print_plan_report(const PlanOutcome& outcome, std::ostream& out) {
   print_shots(outcome, out);
+  const bool added = static_cast<int>(outcome.plan.shots.size()) > outcome.kept;
+  if (outcome.next_shot_only) {
+    out << (added ? "the next shot:\n" + planned_shots_text(outcome)
+                  : std::string("no candidate pose adds to the scene's shots\n"));
+    return;
+  }
+  if (outcome.kept > 0 && added) out << "added shots:\n" << planned_shots_text(outcome);
   print_summary(outcome, out);
   if (!outcome.plan.target_reached) print_unreachable(outcome, out);
 }

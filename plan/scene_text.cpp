@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <sstream>
 #include <vector>
 
 namespace rigc::plan {
@@ -22,11 +23,14 @@ bool blank_or_comment(const std::string& text, size_t begin, size_t end) {
   return first >= end || text[first] == '\n' || text[first] == '#';
 }
 
-}  // namespace
+// Where the `shots:` section is: [begin, end) in bytes, from its key's line to the next top-level
+// key, comment lines just before that key left out.
+struct Section {
+  size_t begin = 0, end = 0;
+  bool last = false;  // no top-level key follows
+};
 
-std::optional<std::string> replace_shots_section(const std::string& text,
-                                                 const std::string& shots_section,
-                                                 std::string* error) {
+std::optional<Section> find_shots_section(const std::string& text, std::string* error) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -53,13 +57,53 @@ std::optional<std::string> replace_shots_section(const std::string& text,
   }
   const std::vector<size_t> starts = line_starts(text);
   int end_line = next_line >= 0 ? next_line : static_cast<int>(starts.size()) - 1;
-  while (next_line >= 0 && end_line - 1 > shots_line &&
+  while (end_line - 1 > shots_line &&
          blank_or_comment(text, starts[end_line - 1], starts[end_line])) {
     --end_line;
   }
-  std::string result = text.substr(0, starts[shots_line]) + shots_section;
-  if (next_line >= 0) result += text.substr(starts[end_line]);
+  return Section{starts[shots_line], starts[end_line], next_line < 0};
+}
+
+// The indentation of the section's first list item ("  " when it has none).
+std::string item_indent(const std::string& section) {
+  std::istringstream lines(section);
+  std::string line;
+  std::getline(lines, line);  // the key
+  while (std::getline(lines, line)) {
+    const size_t first = line.find_first_not_of(' ');
+    if (first != std::string::npos && line.compare(first, 2, "- ") == 0) {
+      return std::string(first, ' ');
+    }
+  }
+  return "  ";
+}
+
+}  // namespace
+
+std::optional<std::string> replace_shots_section(const std::string& text,
+                                                 const std::string& shots_section,
+                                                 std::string* error) {
+  const auto section = find_shots_section(text, error);
+  if (!section) return std::nullopt;
+  std::string result = text.substr(0, section->begin) + shots_section;
+  if (!section->last) result += text.substr(section->end);
   return result;
+}
+
+std::optional<std::string> append_to_shots_section(const std::string& text,
+                                                   const std::string& entries, std::string* error) {
+  const auto section = find_shots_section(text, error);
+  if (!section) return std::nullopt;
+  const std::string indent =
+      item_indent(text.substr(section->begin, section->end - section->begin));
+  std::istringstream lines(entries);
+  std::string indented;
+  for (std::string line; std::getline(lines, line);) {
+    indented += indent + line.substr(line.find_first_not_of(' ')) + '\n';
+  }
+  std::string before = text.substr(0, section->end);
+  if (!before.empty() && before.back() != '\n') before += '\n';
+  return before + indented + text.substr(section->end);
 }
 
 }  // namespace rigc::plan

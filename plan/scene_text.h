@@ -1,5 +1,5 @@
-// Scene text with its `shots:` section replaced: the rest of the file (comments, key order,
-// layout) stays as the user wrote it.
+// Scene text with its `shots:` section replaced or extended: the rest of the file (comments, key
+// order, layout) stays as the user wrote it.
 #pragma once
 
 #include <optional>
@@ -13,5 +13,10 @@ namespace rigc::plan {
 std::optional<std::string> replace_shots_section(const std::string& text,
                                                  const std::string& shots_section,
                                                  std::string* error);
+
+// `text` with `entries` (lines of list items, indented by two) added at the end of the `shots:`
+// list, indented as its items are.
+std::optional<std::string> append_to_shots_section(const std::string& text,
+                                                   const std::string& entries, std::string* error);
 
 }  // namespace rigc::plan

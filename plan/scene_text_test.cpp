@@ -49,5 +49,16 @@ TEST(PlanSceneText, RefusesTextWithoutABlockShotsKey) {
   EXPECT_FALSE(replace_shots_section("rigc: [1\n", "shots:\n", &error));
 }
 
+TEST(PlanSceneText, AppendsEntriesIndentedAsTheListIs) {
+  std::string error;
+  const auto text = append_to_shots_section(
+      "rigc: 1\nshots:\n- pose: {position: [1m, 0, 1m]}\n# trailing\n\ncoverage: {}\n",
+      "  # added\n  - pose: {position: [2m, 0, 1m]}\n", &error);
+  ASSERT_TRUE(text) << error;
+  EXPECT_EQ(*text,
+            "rigc: 1\nshots:\n- pose: {position: [1m, 0, 1m]}\n# added\n- pose: {position: [2m, "
+            "0, 1m]}\n# trailing\n\ncoverage: {}\n");
+}
+
 }  // namespace
 }  // namespace rigc::plan
