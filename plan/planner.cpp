@@ -255,6 +255,10 @@ int Planner::best_bridge(int before, int after, const std::vector<int>& order) c
   double best = link(before, after), best_on_station = 1 - 1e-9;
   for (int c = problem_.kept; c < candidate_count_; ++c) {
     if (std::find(order.begin(), order.end(), c) != order.end()) continue;
+    // The step bounds the link, and costs nothing next to an overlap.
+    const double step_bound =
+        options_.max_step_rad / std::max({step(before, c), step(c, after), 1e-12});
+    if (step_bound <= std::min(best, best_on_station)) continue;
     const double weaker = std::min(link(before, c), link(c, after));
     if (weaker > best + 1e-9) best = weaker, best_candidate = c;
     if (problem_.station[c] == problem_.station[after] && weaker > best_on_station) {
