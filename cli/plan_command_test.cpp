@@ -45,6 +45,7 @@ TEST(CliPlan, BadRequestsAreUserErrors) {
       {{"plan", scene, "--rings", "20,95deg"}, "--rings '95deg' is outside"},
       {{"plan", scene, "--distances", "1m,fast"}, "--distances 'fast'"},
       {{"plan", scene, "--azimuth-step", "0.1deg"}, "--azimuth-step"},
+      {{"plan", scene, "--max-step", "1deg"}, "--max-step '1deg'"},
       {{"plan", scene, "-o", scene}, "is the scene itself"},
       {{"plan", scene, "-o", dir.file("no/such/folder/p.yaml")}, "does not exist"},
       {{"plan", dir.file("missing.yaml")}, "cannot read the scene file"},
@@ -55,6 +56,22 @@ TEST(CliPlan, BadRequestsAreUserErrors) {
     EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
   }
   EXPECT_EQ(read_text(scene), small_paper_scene());
+}
+
+TEST(CliPlan, NextSuggestsOneShotAfterTheScenesOwn) {
+  TempDir dir;
+  write_text(dir.file("paper.yaml"), small_paper_scene());
+  const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--next", "--visibility-scale",
+                                "0.15", "-o", dir.file("next.yaml")});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("the next shot:"), std::string::npos) << result.out;
+  const std::string planned = read_text(dir.file("next.yaml"));
+  const size_t own = planned.find("  - turntable: {steps: 18, step: 20deg");
+  const size_t suggested = planned.find("  # Suggested by `rigc plan --next`");
+  ASSERT_NE(own, std::string::npos);
+  ASSERT_NE(suggested, std::string::npos);
+  EXPECT_LT(own, suggested);
+  EXPECT_EQ(run_rigc({"check", dir.file("next.yaml"), "--no-advice"}).exit_code, 0);
 }
 
 TEST(CliPlan, AnUnreachableTargetExitsOneAndExplains) {
