@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
 
 namespace rigc::eval {
@@ -72,8 +73,11 @@ std::pair<Vec3, double> robust_radius(const std::vector<Vec3>& points) {
 class Aligner {
  public:
   Aligner(const EvalOptions& o, const SparseModel& model, const GroundTruth& truth,
-          const Surface& surface)
+          const Surface& surface, AlignMethod method)
       : o_(o),
+        method_(method == AlignMethod::kAuto
+                    ? (truth.poses.empty() ? AlignMethod::kRegistration : AlignMethod::kCameras)
+                    : method),
         model_(model),
         truth_(truth),
         surface_(surface),
@@ -83,11 +87,14 @@ class Aligner {
   }
 
   Alignment align() {
-    const bool coarse = truth_.poses.empty() ? register_clouds() : fit_camera_centres();
+    const bool coarse = method_ == AlignMethod::kCameras        ? fit_camera_centres()
+                        : method_ == AlignMethod::kRegistration ? register_clouds()
+                                                                : keep_frame();
     if (!coarse) return std::move(a_);
     for (const auto& p : rec_points_) a_.points.push_back(a_.transform.apply(p));
     sample_visible_surface();
-    if (o_.icp) refine_with_icp();
+    if (o_.icp && method_ != AlignMethod::kNone) refine_with_icp();
+    measure_fitness();
     a_.report["status"] = "ok";
     a_.report["reconstruction_to_ground_truth"] = similarity_json(a_.transform);
     a_.ok = true;
@@ -100,18 +107,55 @@ class Aligner {
     return false;
   }
 
-  // A run: the similarity that takes the reconstructed camera centres to the planned ones.
-  bool fit_camera_centres() {
-    std::vector<Vec3> src, dst;
-    for (const auto& im : model_.images) {
-      auto it = truth_.poses.find(im.name);
-      if (it == truth_.poses.end()) continue;
-      src.push_back(camera_centre(im.camera_from_world));
-      dst.push_back(camera_centre(it->second));
-    }
+  // --no-align: the reconstruction is in the ground truth's frame already.
+  bool keep_frame() {
+    add_planned_views();
+    a_.report = {{"method", "none: the reconstruction is in the scene's frame (--no-align)"}};
+    return true;
+  }
+
+  void add_planned_views() {
+    if (!truth_.camera) return;
     for (const auto& [name, pose] : truth_.poses) {
       a_.views.push_back(view_camera(*truth_.camera, pose));
     }
+  }
+
+  // The share of the aligned points near the object that lie on its surface: what tells a
+  // reconstruction of this object from one of another.
+  void measure_fitness() {
+    std::vector<Vec3> inside;
+    const std::size_t stride = std::max<std::size_t>(1, a_.points.size() / 200000);
+    for (std::size_t i = 0; i < a_.points.size(); i += stride) {
+      if (crop_.contains(a_.points[i])) inside.push_back(a_.points[i]);
+    }
+    a_.fitness_distance = std::max(0.01 * diag_, 3e-3 * o_.tau_mm);
+    std::size_t close = 0;
+    for (double d : surface_.signed_distance(inside)) close += std::abs(d) <= a_.fitness_distance;
+    a_.fitness = inside.empty() ? 0 : static_cast<double>(close) / inside.size();
+    a_.report["fitness"] = {
+        {"value", a_.fitness},
+        {"distance_mm", a_.fitness_distance * 1000},
+        {"points_tested", inside.size()},
+        {"definition",
+         "share of the aligned points inside the object's bounds (grown by 5 %) within distance "
+         "of the ground-truth surface"}};
+  }
+
+  // A run: the similarity that takes the reconstructed camera centres to the planned ones.
+  bool fit_camera_centres() {
+    // In the order of the names, so that RANSAC's samples do not depend on the file's order.
+    std::map<std::string, const run::ColmapImage*> by_name;
+    for (const auto& im : model_.images) by_name.emplace(im.name, &im);
+    std::vector<Vec3> src, dst;
+    for (const auto& [name, pose] : truth_.poses) {
+      auto it = by_name.find(name);
+      if (it == by_name.end()) continue;
+      src.push_back(camera_centre(it->second->camera_from_world));
+      dst.push_back(camera_centre(pose));
+    }
+    if (!truth_.camera) return fail("cannot align on cameras: the ground truth has no camera");
+    add_planned_views();
     Vec3 centroid = Vec3::Zero();
     for (const auto& d : dst) centroid += d;
     if (!dst.empty()) centroid /= static_cast<double>(dst.size());
@@ -219,6 +263,7 @@ class Aligner {
   }
 
   const EvalOptions& o_;
+  const AlignMethod method_;
   const SparseModel& model_;
   const GroundTruth& truth_;
   const Surface& surface_;
@@ -231,8 +276,9 @@ class Aligner {
 }  // namespace
 
 Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& model,
-                                const GroundTruth& truth, const Surface& surface) {
-  return Aligner(options, model, truth, surface).align();
+                                const GroundTruth& truth, const Surface& surface,
+                                AlignMethod method) {
+  return Aligner(options, model, truth, surface, method).align();
 }
 
 }  // namespace rigc::eval

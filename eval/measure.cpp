@@ -36,8 +36,16 @@ struct Compared {
 class Measurer {
  public:
   Measurer(const EvalOptions& o, const SparseModel& model, const GroundTruth& truth,
-           const Surface& surface, const Alignment& a, const fs::path& out, json& report)
-      : o_(o), model_(model), truth_(truth), surface_(surface), a_(a), out_(out), report_(report) {}
+           const Surface& surface, const Alignment& a, const fs::path& out, json& report,
+           const Surface* reconstructed_mesh)
+      : o_(o),
+        model_(model),
+        truth_(truth),
+        surface_(surface),
+        a_(a),
+        out_(out),
+        report_(report),
+        reconstructed_mesh_(reconstructed_mesh) {}
 
   Measurements run() {
     keep_points_near_object();
@@ -46,14 +54,14 @@ class Measurer {
     json distances = stats_json(m_.stats);
     distances["cropped_points"] = a_.points.size() - m_.points.size();
     distances["crop"] = "ground-truth bounds grown by 5 % of their diagonal on every side";
-    report_["compared"] = "points";
+    report_["compared"] = reconstructed_mesh_ ? "mesh_samples" : "points";
     report_["signed_distance_mm"] = distances;
     report_["signed_distance_mm"]["convention"] =
         "nearest ground-truth triangle, positive on its normal's side (outside)";
     Compared compared{m_.distance_mm, m_.points};
-    if (o_.poisson) compare_poisson_mesh(compared);
+    if (o_.poisson && !reconstructed_mesh_) compare_poisson_mesh(compared);
     score(compared);
-    if (!truth_.poses.empty()) camera_errors();
+    if (!truth_.poses.empty() && !model_.images.empty()) camera_errors();
     return std::move(m_);
   }
 
@@ -113,10 +121,29 @@ class Measurer {
     m_.stats = ms;
   }
 
+  // Distances (mm) of the ground-truth samples `reference` to the reconstructed mesh: in its own
+  // frame, scaled back.
+  std::vector<double> distances_to_reconstructed_mesh(const std::vector<Vec3>& reference) const {
+    const Similarity inv = a_.transform.inverse();
+    std::vector<Vec3> in_mesh_frame;
+    in_mesh_frame.reserve(reference.size());
+    for (const auto& p : reference) in_mesh_frame.push_back(inv.apply(p));
+    std::vector<double> d = reconstructed_mesh_->signed_distance(in_mesh_frame);
+    for (auto& x : d) x = std::abs(x) * a_.transform.scale * 1000;
+    return d;
+  }
+
   void score(const Compared& compared) {
     const SurfaceSamples& s = a_.samples;
-    std::vector<double> truth_to_rec = nearest_distances(s.visible, compared.cloud);
-    for (auto& d : truth_to_rec) d *= 1000;
+    const bool all = s.visible.empty();
+    const std::vector<Vec3>& reference = all ? s.all : s.visible;
+    std::vector<double> truth_to_rec;
+    if (reconstructed_mesh_ && report_["compared"] == "mesh_samples") {
+      truth_to_rec = distances_to_reconstructed_mesh(reference);
+    } else {
+      truth_to_rec = nearest_distances(reference, compared.cloud);
+      for (auto& d : truth_to_rec) d *= 1000;
+    }
     m_.f = f_score(compared.distance_mm, truth_to_rec, o_.tau_mm);
     report_["fscore"] = {
         {"tau_mm", m_.f.tau},
@@ -125,6 +152,8 @@ class Measurer {
         {"fscore", m_.f.fscore},
         {"ground_truth_samples", s.all.size()},
         {"visible_ground_truth_samples", s.visible.size()},
+        {"recall_reference", all ? "all ground-truth samples (no camera to tell what was seen)"
+                                 : "the ground-truth samples a camera sees"},
         {"definition",
          "Tanks and Temples: precision = share of the compared geometry within tau of the "
          "ground-truth mesh; recall = share of visible ground-truth samples within tau of it"}};
@@ -158,6 +187,7 @@ class Measurer {
   const Alignment& a_;
   const fs::path& out_;
   json& report_;
+  const Surface* reconstructed_mesh_;
   std::vector<Vec3> view_points_;  // per kept point: where it was seen from
   Measurements m_;
 };
@@ -166,8 +196,8 @@ class Measurer {
 
 Measurements measure(const EvalOptions& options, const SparseModel& model, const GroundTruth& truth,
                      const Surface& surface, const Alignment& alignment, const fs::path& out,
-                     json& report) {
-  return Measurer(options, model, truth, surface, alignment, out, report).run();
+                     json& report, const Surface* reconstructed_mesh) {
+  return Measurer(options, model, truth, surface, alignment, out, report, reconstructed_mesh).run();
 }
 
 }  // namespace rigc::eval
