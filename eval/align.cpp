@@ -190,7 +190,9 @@ class Aligner {
     for (const auto& p : rec_points_) moved.push_back(pre.apply(p));
     auto global = global_registration(moved, samples, diag_ / 40);
     if (!global) {
-      return fail("global registration found no alignment of the reconstruction to the mesh");
+      return fail(
+          "global registration found no alignment of the reconstruction to the mesh (RANSAC "
+          "fitness 0: no feature correspondence agreed)");
     }
     Similarity g = Similarity::from_matrix(*global) * pre;
     for (auto& p : moved) p = Similarity::from_matrix(*global).apply(p);

@@ -21,7 +21,7 @@ using Eigen::Vector3f;
 class DepthBuffer {
  public:
   DepthBuffer(const OutputCamera& camera, const ir::Mat4& camera_from_object)
-      : scale_(std::min(0.25, 640.0 / std::max(1, camera.width))),
+      : scale_(std::min(1.0, 640.0 / std::max(1, camera.width))),
         width_(std::max(1, static_cast<int>(std::ceil(camera.width * scale_)))),
         height_(std::max(1, static_cast<int>(std::ceil(camera.height * scale_)))),
         camera_(camera),
@@ -41,15 +41,22 @@ class DepthBuffer {
     for (const auto& t : triangles) draw_triangle(screen[t[0]], screen[t[1]], screen[t[2]]);
   }
 
-  // Whether a surface point at `camera_point` (camera frame) is the nearest surface along its
-  // pixel, with a tolerance of 0.5 % of the depth and two buffer pixels' footprint.
+  // Whether a surface point at `camera_point` (camera frame) is nearer than the surface at the
+  // four pixel centres around it, within 0.1 % of the depth and one buffer pixel's footprint: an
+  // occluder's edge between a pixel centre and the point still hides it.
   bool unoccluded(const ir::Vec3& camera_point) const {
     const double z = camera_point.z();
-    const double u = (camera_.fx * camera_point.x() / z + camera_.cx) * scale_;
-    const double v = (camera_.fy * camera_point.y() / z + camera_.cy) * scale_;
-    if (!(u >= 0 && v >= 0 && u < width_ && v < height_)) return true;
-    const float nearest = depth_[static_cast<std::size_t>(v) * width_ + static_cast<int>(u)];
-    return z <= nearest + 0.005 * z + 2 * z / (camera_.fx * scale_);
+    const double u = (camera_.fx * camera_point.x() / z + camera_.cx) * scale_ - 0.5;
+    const double v = (camera_.fy * camera_point.y() / z + camera_.cy) * scale_ - 0.5;
+    if (!(u > -1 && v > -1 && u < width_ && v < height_)) return true;
+    const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+    float nearest = std::numeric_limits<float>::infinity();
+    for (int y = std::max(0, y0); y <= std::min(height_ - 1, y0 + 1); ++y) {
+      for (int x = std::max(0, x0); x <= std::min(width_ - 1, x0 + 1); ++x) {
+        nearest = std::min(nearest, depth_[static_cast<std::size_t>(y) * width_ + x]);
+      }
+    }
+    return z <= nearest + 0.001 * z + z / (camera_.fx * scale_);
   }
 
   ir::Vec3 to_camera(const ir::Vec3& p) const { return rotation_ * p + translation_; }

@@ -32,8 +32,8 @@ struct GroundTruthPoints {
 
 // `count` area-uniform samples of the object's surface (deterministic), kept when at least one of
 // `shots` (indices into scene.shots) sees them: in front, inside the image of `camera`, facing the
-// camera, and not hidden by the object (a depth buffer of the object per shot, a quarter of the
-// image's size at most 640 px wide). Colour: base colour x texture x surface pattern.
+// camera, and not hidden by the object (a depth buffer of the object per shot, the
+// image's size up to 640 px wide). Colour: base colour x texture x surface pattern.
 GroundTruthPoints sample_ground_truth_points(const ir::Scene& scene, const std::vector<int>& shots,
                                              const OutputCamera& camera, int count);
 
