@@ -255,5 +255,20 @@ TEST(EvalReconstruction, OptionsThatGoTogether) {
   EXPECT_FALSE(o.check(&error));
 }
 
+// rigc compare's rows of other tools' results: NAME=FILE, a name fit for a folder.
+TEST(EvalReconstruction, CompareRefusesMalformedReconstructionRows) {
+  using rigc::testing::run_rigc;
+  auto r = run_rigc({"compare", "scene.yaml", "--reconstruction", "no-equals-sign"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'no-equals-sign' is not NAME=FILE"), std::string::npos) << r.err;
+  r = run_rigc({"compare", "scene.yaml", "--reconstruction", "../x=a.ply"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("use letters, digits"), std::string::npos) << r.err;
+  r = run_rigc({"compare", "scene.yaml", "--reconstruction", "a=a.ply", "--reconstruction-cameras",
+                "b=b.out"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("which no --reconstruction does"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace rigc::eval
