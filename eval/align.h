@@ -41,9 +41,12 @@ struct Alignment {
   double fitness_distance = 0;  // meters
 };
 
+// `points`, when given, are the reconstruction's points instead of model.points' positions
+// (millions of points from a file need no COLMAP record each).
 Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& model,
                                 const GroundTruth& truth, const Surface& surface,
-                                AlignMethod method = AlignMethod::kAuto);
+                                AlignMethod method = AlignMethod::kAuto,
+                                const std::vector<Vec3>* points = nullptr);
 
 // The region compared: the ground truth's bounds grown by 5 % of their diagonal on every side
 // (reconstructed points beyond it are background).

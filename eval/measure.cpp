@@ -59,37 +59,47 @@ class Measurer {
     report_["signed_distance_mm"]["convention"] =
         "nearest ground-truth triangle, positive on its normal's side (outside)";
     Compared compared{m_.distance_mm, m_.points};
-    if (o_.poisson && !reconstructed_mesh_) compare_poisson_mesh(compared);
+    // Poisson needs the points' observers: COLMAP's points have them, a file's have not.
+    if (o_.poisson && view_points_.size() == m_.points.size() && !m_.points.empty()) {
+      compare_poisson_mesh(compared);
+    }
     score(compared);
     if (!truth_.poses.empty() && !model_.images.empty()) camera_errors();
     return std::move(m_);
   }
 
  private:
-  // The points inside object_crop, and for each the mean centre of the cameras observing it
-  // (Poisson orients its normals towards them).
+  // The points inside object_crop, and with --poisson for each the mean centre of the cameras
+  // observing it (Poisson orients its normals towards them).
   void keep_points_near_object() {
-    const Eigen::AlignedBox3d box = surface_.bounds();
-    const double diag = box.diagonal().norm();
     const Eigen::AlignedBox3d crop = object_crop(surface_);
-    std::map<int, Vec3> centre_gt;
-    for (const auto& im : model_.images) {
-      centre_gt[im.image_id] = a_.transform.apply(camera_centre(im.camera_from_world));
-    }
+    const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
     for (std::size_t i = 0; i < a_.points.size(); ++i) {
       if (!crop.contains(a_.points[i])) continue;
       m_.points.push_back(a_.points[i]);
-      Vec3 v = Vec3::Zero();
-      int n = 0;
-      for (int id : model_.points[i].track_images) {
-        auto it = centre_gt.find(id);
-        if (it != centre_gt.end()) {
-          v += it->second;
-          ++n;
-        }
-      }
-      view_points_.push_back(n ? Vec3(v / n) : Vec3(box.center() + Vec3(0, 0, diag)));
+      if (tracks) view_points_.push_back(mean_observer(model_.points[i]));
     }
+  }
+
+  // Where a point was seen from: the mean centre of its track's cameras (aligned), or above the
+  // object when it has none.
+  Vec3 mean_observer(const Point3D& point) {
+    if (centre_gt_.empty()) {
+      for (const auto& im : model_.images) {
+        centre_gt_[im.image_id] = a_.transform.apply(camera_centre(im.camera_from_world));
+      }
+    }
+    Vec3 v = Vec3::Zero();
+    int n = 0;
+    for (int id : point.track_images) {
+      auto it = centre_gt_.find(id);
+      if (it != centre_gt_.end()) {
+        v += it->second;
+        ++n;
+      }
+    }
+    const Eigen::AlignedBox3d box = surface_.bounds();
+    return n ? Vec3(v / n) : Vec3(box.center() + Vec3(0, 0, box.diagonal().norm()));
   }
 
   // --poisson: a screened Poisson mesh of the points, measured by its surface samples.
@@ -188,7 +198,8 @@ class Measurer {
   const fs::path& out_;
   json& report_;
   const Surface* reconstructed_mesh_;
-  std::vector<Vec3> view_points_;  // per kept point: where it was seen from
+  std::vector<Vec3> view_points_;  // per kept point: where it was seen from (--poisson)
+  std::map<int, Vec3> centre_gt_;  // camera centres by image id, aligned
   Measurements m_;
 };
 

@@ -212,13 +212,14 @@ TEST(EvalReconstruction, LoadsMeshesAndCloudsInEveryFormat) {
   open3d::io::WritePointCloudOption ascii;
   ascii.write_ascii = open3d::io::WritePointCloudOption::IsAscii::Ascii;
   ASSERT_TRUE(open3d::io::WritePointCloud(dir.file("rich.ply"), cloud, ascii));
+  ASSERT_TRUE(open3d::io::WritePointCloud(dir.file("rich_binary.ply"), cloud));
   std::string error;
   for (const char* name : {"m.obj", "m.stl", "m.glb", "m.gltf", "ascii.ply"}) {
     const auto g = load_reconstruction(dir.file(name), &error);
     ASSERT_TRUE(g) << name << ": " << error;
     EXPECT_EQ(g->triangles.size(), 12u) << name;
   }
-  for (const char* name : {"plain.ply", "plain.xyz", "rich.ply"}) {
+  for (const char* name : {"plain.ply", "plain.xyz", "rich.ply", "rich_binary.ply"}) {
     const auto g = load_reconstruction(dir.file(name), &error);
     ASSERT_TRUE(g) << name << ": " << error;
     EXPECT_FALSE(g->is_mesh());
@@ -227,7 +228,13 @@ TEST(EvalReconstruction, LoadsMeshesAndCloudsInEveryFormat) {
   }
   EXPECT_TRUE(load_reconstruction(dir.file("rich.ply"), &error)->has_colors);
   EXPECT_TRUE(load_reconstruction(dir.file("rich.ply"), &error)->has_normals);
+  EXPECT_TRUE(load_reconstruction(dir.file("rich_binary.ply"), &error)->has_colors);
   EXPECT_FALSE(load_reconstruction(dir.file("plain.ply"), &error)->has_colors);
+  // A binary cloud cut short.
+  const std::string whole = rigc::testing::read_text(dir.file("rich_binary.ply"));
+  rigc::testing::write_text(dir.file("cut.ply"), whole.substr(0, whole.size() - 100));
+  EXPECT_FALSE(load_reconstruction(dir.file("cut.ply"), &error));
+  EXPECT_NE(error.find("cut.ply: holds fewer than the 100 points"), std::string::npos) << error;
   // Bad files: named, never a crash.
   rigc::testing::write_text(dir.file("junk.ply"), "ply\nnot really\n");
   EXPECT_FALSE(load_reconstruction(dir.file("junk.ply"), &error));
