@@ -92,12 +92,11 @@ class Aligner {
         truth_(truth),
         surface_(surface),
         diag_(surface.bounds().diagonal().norm()),
-        crop_(object_crop(surface)) {
-    if (points) {
-      rec_points_ = *points;
-    } else {
-      rec_points_.reserve(model.points.size());
-      for (const auto& p : model.points) rec_points_.push_back(p.position);
+        crop_(object_crop(surface)),
+        rec_points_(points ? *points : own_points_) {
+    if (!points) {
+      own_points_.reserve(model.points.size());
+      for (const auto& p : model.points) own_points_.push_back(p.position);
     }
   }
 
@@ -284,7 +283,8 @@ class Aligner {
   const Surface& surface_;
   const double diag_;
   const Eigen::AlignedBox3d crop_;
-  std::vector<Vec3> rec_points_;
+  std::vector<Vec3> own_points_;  // model.points' positions, when no points were given
+  const std::vector<Vec3>& rec_points_;
   Alignment a_;
 };
 

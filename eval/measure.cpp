@@ -74,6 +74,7 @@ class Measurer {
   void keep_points_near_object() {
     const Eigen::AlignedBox3d crop = object_crop(surface_);
     const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
+    m_.points.reserve(a_.points.size());
     for (std::size_t i = 0; i < a_.points.size(); ++i) {
       if (!crop.contains(a_.points[i])) continue;
       m_.points.push_back(a_.points[i]);

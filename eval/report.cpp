@@ -102,8 +102,8 @@ void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& c
 void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
                                 const Alignment& alignment, const Measurements& m) {
   const std::vector<double>& d_mm = m.distance_mm;
-  const double range =
-      o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * distance_stats(d_mm).rms);
+  const DistanceStats stats = distance_stats(d_mm);
+  const double range = o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * stats.rms);
   json files;
   std::string why;
   if (write_colored_ply(out_ / "cloud_signed_distance.ply", m.points, d_mm, range, &why)) {
@@ -111,7 +111,7 @@ void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
   } else {
     log_ << "rigc eval: warning: " << why << "\n";
   }
-  if (write_histogram_png(out_ / "histogram.png", d_mm, range, distance_stats(d_mm), &why)) {
+  if (write_histogram_png(out_ / "histogram.png", d_mm, range, stats, &why)) {
     files["histogram_png"] = (out_ / "histogram.png").string();
     summary_.histogram_png = files["histogram_png"];
   } else {
