@@ -6,6 +6,7 @@
 //
 // Usage: reconstruction_table [POINTS] [DETAIL] [MODES]   (default 5000000, 8, nca: --no-align,
 // --cameras, registration)
+//        reconstruction_table 0 0 - SCENE   (the ground-truth points' cost in a full-size render)
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <open3d/geometry/PointCloud.h>
@@ -70,6 +71,27 @@ shots:
 int main(int argc, char** argv) {
   const long points = argc > 1 ? std::atol(argv[1]) : 5000000;
   const int detail = argc > 2 ? std::atoi(argv[2]) : 8;
+  if (argc > 4) {
+    // What the ground-truth points add to `rigc render` of SCENE at full size.
+    rigc::DiagnosticEngine diag;
+    auto scene = rigc::compile_scene_file(argv[4], diag);
+    if (!scene) return 2;
+    std::vector<int> shots;
+    for (const auto& s : scene->shots) shots.push_back(s.index);
+    std::string error;
+    const auto camera = rigc::run::output_camera(scene->camera, 1.0, &error);
+    for (int run = 0; run < 3; ++run) {
+      const auto t = Clock::now();
+      const double cpu0 = cpu_seconds();
+      const auto gt = rigc::run::sample_ground_truth_points(*scene, shots, *camera, 20000);
+      std::cout << fmt::format(
+          "{}: {} triangles, {} shots at {}x{}: ground-truth points {} in {:.3f} s ({:.3f} s "
+          "CPU)\n",
+          argv[4], scene->object.mesh.triangles.size(), shots.size(), camera->width, camera->height,
+          gt.points.size(), seconds_since(t), cpu_seconds() - cpu0);
+    }
+    return 0;
+  }
   const fs::path dir = fs::temp_directory_path() / fmt::format("rigc_recon_bench_{}", getpid());
   fs::create_directories(dir);
   auto t0 = Clock::now();
