@@ -341,6 +341,11 @@ class ReconstructionEval {
       section["points"] = points.size();
       section["non_finite_points_left_out"] = g->dropped;
     }
+    if (o_.poisson) {
+      section["poisson"] =
+          g->is_mesh() ? "not applied: the file is a mesh already"
+                       : "not applied: a file's points have no cameras to orient the normals by";
+    }
     if (points.size() < 3) {
       return report_.fail("reconstruction",
                           fmt::format("{} has fewer than 3 points", o_.reconstruction), 1);
