@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -26,14 +27,93 @@ namespace fs = std::filesystem;
 using eval::EvalOptions;
 using eval::EvalSummary;
 
-// One row of the table: a backend's run, or the photos.
+// One row of the table: a backend's run, the photos, or another tool's reconstruction.
 struct Row {
   std::string name;
   int render_status = 0, eval_status = 0;
   double render_s = 0;
   EvalSummary summary;
   fs::path run_dir;
+  bool reconstruction = false;  // measured from a file: no render, no COLMAP
 };
+
+// A --reconstruction NAME=FILE, with its --reconstruction-cameras NAME=FILE when given.
+struct ReconstructionArg {
+  std::string name, file, cameras;
+};
+
+// Splits the NAME=FILE options; nullopt after an error on standard error.
+std::optional<std::vector<ReconstructionArg>> reconstruction_args(
+    const std::vector<std::string>& files, const std::vector<std::string>& cameras) {
+  std::vector<ReconstructionArg> args;
+  auto split = [](const std::string& text, const char* option, std::string* name,
+                  std::string* value) {
+    const auto eq = text.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+      std::cerr << fmt::format("rigc compare: error: {} '{}' is not NAME=FILE\n", option, text);
+      return false;
+    }
+    *name = text.substr(0, eq);
+    *value = text.substr(eq + 1);
+    return true;
+  };
+  for (const auto& text : files) {
+    ReconstructionArg a;
+    if (!split(text, "--reconstruction", &a.name, &a.file)) return std::nullopt;
+    // The name names the output folder NAME_eval and a column: no path, no markdown.
+    const bool plain =
+        a.name.front() != '.' && std::all_of(a.name.begin(), a.name.end(), [](char c) {
+          return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+        });
+    if (!plain) {
+      std::cerr << fmt::format(
+          "rigc compare: error: reconstruction name '{}': use letters, digits, '-', '_' and '.'\n",
+          a.name);
+      return std::nullopt;
+    }
+    for (const auto& other : args) {
+      if (other.name == a.name) {
+        std::cerr << fmt::format("rigc compare: error: two reconstructions named '{}'\n", a.name);
+        return std::nullopt;
+      }
+    }
+    args.push_back(a);
+  }
+  for (const auto& text : cameras) {
+    std::string name, file;
+    if (!split(text, "--reconstruction-cameras", &name, &file)) return std::nullopt;
+    auto it = std::find_if(args.begin(), args.end(), [&](const auto& a) { return a.name == name; });
+    if (it == args.end()) {
+      std::cerr << fmt::format(
+          "rigc compare: error: --reconstruction-cameras names '{}', which no --reconstruction "
+          "does\n",
+          name);
+      return std::nullopt;
+    }
+    it->cameras = file;
+  }
+  return args;
+}
+
+// Another tool's reconstruction, measured against the scene with the run in `run_dir` (the first
+// backend's) as the ground-truth cameras.
+Row evaluate_reconstruction(const ReconstructionArg& arg, const fs::path& run_dir,
+                            const std::string& scene_path, const fs::path& out,
+                            const EvalOptions& base) {
+  Row row;
+  row.name = arg.name;
+  row.run_dir = run_dir;
+  row.reconstruction = true;
+  EvalOptions o = base;
+  o.run_dir = run_dir.string();
+  o.scene = scene_path;
+  o.reconstruction = arg.file;
+  o.cameras = arg.cameras;
+  o.output_dir = (out / (arg.name + "_eval")).string();
+  std::cerr << fmt::format("rigc compare: measuring {} ({}) ...\n", arg.name, arg.file);
+  row.eval_status = eval::evaluate(o, std::cerr, &row.summary);
+  return row;
+}
 
 // The registry entries `--backends` names, in its order. Null after an error on standard error.
 std::optional<std::vector<const backends::BackendEntry*>> chosen_backends(const std::string& list) {
@@ -112,7 +192,16 @@ std::string results_table(const std::vector<Row>& rows, double tau_mm) {
       tau_mm);
   for (const Row& r : rows) {
     const EvalSummary& s = r.summary;
-    if (r.render_status != 0) {
+    if (r.reconstruction) {
+      const bool measured = s.report.is_object() && s.report.contains("signed_distance_mm");
+      table += measured
+                   ? fmt::format("| {} | {} | - | {} | {} | {:+.3f} ± {:.3f} | {:.3f} | - |\n",
+                                 r.name, s.images,
+                                 s.registered ? std::to_string(s.registered) : std::string("-"),
+                                 s.points, s.mean_mm, s.std_mm, s.fscore)
+                   : fmt::format("| {} | {} | - | | {} | failed: {} | | - |\n", r.name, s.images,
+                                 s.points, s.failure);
+    } else if (r.render_status != 0) {
       table +=
           fmt::format("| {} | render failed (exit {}) | | | | | | |\n", r.name, r.render_status);
     } else if (!s.reconstructed || s.report.is_null() || !s.report.contains("signed_distance_mm")) {
@@ -169,7 +258,7 @@ std::string compare_markdown(const ir::Scene& scene, const std::string& scene_pa
   for (std::size_t i = 0; i < rows.size(); ++i) md += "---|";
   std::vector<std::string> firsts, heatmaps, histograms;
   for (const Row& r : rows) {
-    firsts.push_back(first_image(r.run_dir));
+    firsts.push_back(r.reconstruction ? "" : first_image(r.run_dir));
     heatmaps.push_back(r.summary.heatmap_png);
     histograms.push_back(r.summary.histogram_png);
   }
@@ -196,8 +285,17 @@ int run_compare_command(std::vector<std::string> args) {
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
   app.add_option("-o,--output", output, "output folder (default: out/<scene>/compare)");
+  std::vector<std::string> reconstruction_files, reconstruction_cameras;
+  app.add_option("--reconstruction", reconstruction_files,
+                 "NAME=FILE: another tool's point cloud or mesh of the first backend's images, "
+                 "measured as one more row (repeatable)");
+  app.add_option("--reconstruction-cameras", reconstruction_cameras,
+                 "NAME=FILE: that reconstruction's cameras (COLMAP, Bundler, Meshroom); without, "
+                 "global registration");
   add_eval_options(app, base);
   if (auto code = parse_options(app, args)) return *code;
+  const auto reconstructions = reconstruction_args(reconstruction_files, reconstruction_cameras);
+  if (!reconstructions) return 1;
 
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
@@ -206,6 +304,11 @@ int run_compare_command(std::vector<std::string> args) {
   if (!chosen) return 1;
   if (chosen->empty() && photos.empty()) {
     std::cerr << "rigc compare: error: no backend to compare (--backends preview,...)\n";
+    return 1;
+  }
+  if (chosen->empty() && !reconstructions->empty()) {
+    std::cerr << "rigc compare: error: --reconstruction is measured with a backend's run as the "
+                 "ground-truth cameras; name one with --backends\n";
     return 1;
   }
   const fs::path out =
@@ -218,6 +321,9 @@ int run_compare_command(std::vector<std::string> args) {
     rows.push_back(render_and_evaluate(*scene, scene_path, *entry, out, scale, base));
   }
   if (!photos.empty()) rows.push_back(evaluate_photos(photos, scene_path, out, base));
+  for (const ReconstructionArg& arg : *reconstructions) {
+    rows.push_back(evaluate_reconstruction(arg, rows.front().run_dir, scene_path, out, base));
+  }
   int worst = 0;
   for (const Row& r : rows) worst = std::max({worst, r.render_status, r.eval_status});
 

@@ -64,6 +64,25 @@ int run_eval_command(std::vector<std::string> args) {
                  "scene object in the object frame)");
   app.add_option("--scene", o.scene, "scene file for the ground truth (default: the run's)");
   app.add_option("-o,--output", o.output_dir, "output folder (default: RUN/eval)");
+  app.add_option("--reconstruction", o.reconstruction,
+                 "measure this point cloud or mesh from another tool (PLY, OBJ, STL, glTF/GLB) "
+                 "instead of running COLMAP");
+  app.add_option("--cameras", o.cameras,
+                 "--reconstruction: the tool's cameras (COLMAP model folder, Bundler .out with "
+                 "its list, Meshroom .sfm/.json), aligned to the ground-truth poses (default: "
+                 "global registration)");
+  app.add_flag("!--no-align", o.align,
+               "--reconstruction: the file is in the scene's object frame already");
+  app.add_option("--mesh-samples", o.mesh_samples,
+                 "--reconstruction: samples of a reconstructed mesh's surface")
+      ->check(CLI::Range(1000, 100000000))
+      ->capture_default_str();
+  app.add_option("--min-fitness", o.min_fitness,
+                 "--reconstruction: refuse a registration that puts fewer of the points near the "
+                 "ground truth (0..1)")
+      ->check(finite_number())
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   add_eval_options(app, o);
   if (auto code = parse_options(app, args)) return *code;
   if (o.run_dir.empty() == o.photos_dir.empty()) {

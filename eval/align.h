@@ -23,6 +23,10 @@ struct SurfaceSamples {
   std::vector<Vec3> visible, visible_normals;
 };
 
+// How the reconstruction reaches the ground-truth frame. kAuto: the cameras when the ground truth
+// has poses, else registration (what `rigc eval` does with COLMAP's model).
+enum class AlignMethod { kAuto, kCameras, kRegistration, kNone };
+
 struct Alignment {
   bool ok = false;
   std::string failure;
@@ -31,10 +35,18 @@ struct Alignment {
   std::vector<Vec3> points;       // the reconstructed points, aligned
   std::vector<ViewCamera> views;  // the cameras over the ground truth, planned or reconstructed
   SurfaceSamples samples;
+  // Share of the aligned points inside object_crop that lie within fitness_distance of the
+  // ground-truth surface (measured after the alignment, whichever method it used).
+  double fitness = 0;
+  double fitness_distance = 0;  // meters
 };
 
+// `points`, when given, are the reconstruction's points instead of model.points' positions
+// (millions of points from a file need no COLMAP record each).
 Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& model,
-                                const GroundTruth& truth, const Surface& surface);
+                                const GroundTruth& truth, const Surface& surface,
+                                AlignMethod method = AlignMethod::kAuto,
+                                const std::vector<Vec3>* points = nullptr);
 
 // The region compared: the ground truth's bounds grown by 5 % of their diagonal on every side
 // (reconstructed points beyond it are background).

@@ -11,6 +11,7 @@
 #include "eval/geometry.h"
 #include "eval/inputs.h"
 #include "eval/measure.h"
+#include "eval/reconstruction.h"
 #include "eval/report.h"
 
 namespace rigc::eval {
@@ -47,6 +48,16 @@ bool EvalOptions::check(std::string* error) const {
     return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
                               color_range_mm));
   }
+  if (reconstruction.empty() && (!cameras.empty() || !align)) {
+    return refuse("--cameras and --no-align go with --reconstruction FILE");
+  }
+  if (!cameras.empty() && !align) return refuse("give --cameras or --no-align, not both");
+  if (mesh_samples < 1000) {
+    return refuse(fmt::format("{} mesh samples; at least 1000 are needed", mesh_samples));
+  }
+  if (!(min_fitness >= 0 && min_fitness <= 1)) {
+    return refuse(fmt::format("the minimum fitness is {}; it must be in 0 .. 1", min_fitness));
+  }
   return true;
 }
 
@@ -71,6 +82,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const auto in = gather_inputs(o, log, sum);
   if (!in) return 1;
   EvalReport report(*in, log, sum);
+  if (!o.reconstruction.empty()) return evaluate_reconstruction(o, *in, report, log, sum, t_start);
 
   EvalTimes times;
   times.setup = seconds_since(t_start);

@@ -38,6 +38,13 @@ struct EvalOptions {
   int ground_truth_samples = 200000;  // surface samples before the visibility test
   double color_range_mm = 0;          // heat-map colour range; 0 = 3 x RMS of the distances
   bool quiet = false;
+  // --reconstruction: measure another tool's point cloud or mesh instead of running COLMAP
+  // (eval/reconstruction.h), aligned on its cameras, by registration, or not at all.
+  std::string reconstruction;
+  std::string cameras;         // the tool's camera poses (COLMAP, Bundler, Meshroom)
+  bool align = true;           // false: the reconstruction is in the scene's frame (--no-align)
+  int mesh_samples = 1000000;  // dense samples of a reconstructed mesh
+  double min_fitness = 0.5;    // a registration that fits worse is refused
 
   // False with a one-line `error` when a field is out of its range or the folders are not one
   // run folder or one photos folder. evaluate() checks it first.

@@ -36,8 +36,16 @@ struct Compared {
 class Measurer {
  public:
   Measurer(const EvalOptions& o, const SparseModel& model, const GroundTruth& truth,
-           const Surface& surface, const Alignment& a, const fs::path& out, json& report)
-      : o_(o), model_(model), truth_(truth), surface_(surface), a_(a), out_(out), report_(report) {}
+           const Surface& surface, const Alignment& a, const fs::path& out, json& report,
+           const Surface* reconstructed_mesh)
+      : o_(o),
+        model_(model),
+        truth_(truth),
+        surface_(surface),
+        a_(a),
+        out_(out),
+        report_(report),
+        reconstructed_mesh_(reconstructed_mesh) {}
 
   Measurements run() {
     keep_points_near_object();
@@ -46,42 +54,53 @@ class Measurer {
     json distances = stats_json(m_.stats);
     distances["cropped_points"] = a_.points.size() - m_.points.size();
     distances["crop"] = "ground-truth bounds grown by 5 % of their diagonal on every side";
-    report_["compared"] = "points";
+    report_["compared"] = reconstructed_mesh_ ? "mesh_samples" : "points";
     report_["signed_distance_mm"] = distances;
     report_["signed_distance_mm"]["convention"] =
         "nearest ground-truth triangle, positive on its normal's side (outside)";
     Compared compared{m_.distance_mm, m_.points};
-    if (o_.poisson) compare_poisson_mesh(compared);
+    // Poisson needs the points' observers: COLMAP's points have them, a file's have not.
+    if (o_.poisson && view_points_.size() == m_.points.size() && !m_.points.empty()) {
+      compare_poisson_mesh(compared);
+    }
     score(compared);
-    if (!truth_.poses.empty()) camera_errors();
+    if (!truth_.poses.empty() && !model_.images.empty()) camera_errors();
     return std::move(m_);
   }
 
  private:
-  // The points inside object_crop, and for each the mean centre of the cameras observing it
-  // (Poisson orients its normals towards them).
+  // The points inside object_crop, and with --poisson for each the mean centre of the cameras
+  // observing it (Poisson orients its normals towards them).
   void keep_points_near_object() {
-    const Eigen::AlignedBox3d box = surface_.bounds();
-    const double diag = box.diagonal().norm();
     const Eigen::AlignedBox3d crop = object_crop(surface_);
-    std::map<int, Vec3> centre_gt;
-    for (const auto& im : model_.images) {
-      centre_gt[im.image_id] = a_.transform.apply(camera_centre(im.camera_from_world));
-    }
+    const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
+    m_.points.reserve(a_.points.size());
     for (std::size_t i = 0; i < a_.points.size(); ++i) {
       if (!crop.contains(a_.points[i])) continue;
       m_.points.push_back(a_.points[i]);
-      Vec3 v = Vec3::Zero();
-      int n = 0;
-      for (int id : model_.points[i].track_images) {
-        auto it = centre_gt.find(id);
-        if (it != centre_gt.end()) {
-          v += it->second;
-          ++n;
-        }
-      }
-      view_points_.push_back(n ? Vec3(v / n) : Vec3(box.center() + Vec3(0, 0, diag)));
+      if (tracks) view_points_.push_back(mean_observer(model_.points[i]));
     }
+  }
+
+  // Where a point was seen from: the mean centre of its track's cameras (aligned), or above the
+  // object when it has none.
+  Vec3 mean_observer(const Point3D& point) {
+    if (centre_gt_.empty()) {
+      for (const auto& im : model_.images) {
+        centre_gt_[im.image_id] = a_.transform.apply(camera_centre(im.camera_from_world));
+      }
+    }
+    Vec3 v = Vec3::Zero();
+    int n = 0;
+    for (int id : point.track_images) {
+      auto it = centre_gt_.find(id);
+      if (it != centre_gt_.end()) {
+        v += it->second;
+        ++n;
+      }
+    }
+    const Eigen::AlignedBox3d box = surface_.bounds();
+    return n ? Vec3(v / n) : Vec3(box.center() + Vec3(0, 0, box.diagonal().norm()));
   }
 
   // --poisson: a screened Poisson mesh of the points, measured by its surface samples.
@@ -113,10 +132,29 @@ class Measurer {
     m_.stats = ms;
   }
 
+  // Distances (mm) of the ground-truth samples `reference` to the reconstructed mesh: in its own
+  // frame, scaled back.
+  std::vector<double> distances_to_reconstructed_mesh(const std::vector<Vec3>& reference) const {
+    const Similarity inv = a_.transform.inverse();
+    std::vector<Vec3> in_mesh_frame;
+    in_mesh_frame.reserve(reference.size());
+    for (const auto& p : reference) in_mesh_frame.push_back(inv.apply(p));
+    std::vector<double> d = reconstructed_mesh_->signed_distance(in_mesh_frame);
+    for (auto& x : d) x = std::abs(x) * a_.transform.scale * 1000;
+    return d;
+  }
+
   void score(const Compared& compared) {
     const SurfaceSamples& s = a_.samples;
-    std::vector<double> truth_to_rec = nearest_distances(s.visible, compared.cloud);
-    for (auto& d : truth_to_rec) d *= 1000;
+    const bool all = s.visible.empty();
+    const std::vector<Vec3>& reference = all ? s.all : s.visible;
+    std::vector<double> truth_to_rec;
+    if (reconstructed_mesh_ && report_["compared"] == "mesh_samples") {
+      truth_to_rec = distances_to_reconstructed_mesh(reference);
+    } else {
+      truth_to_rec = nearest_distances(reference, compared.cloud);
+      for (auto& d : truth_to_rec) d *= 1000;
+    }
     m_.f = f_score(compared.distance_mm, truth_to_rec, o_.tau_mm);
     report_["fscore"] = {
         {"tau_mm", m_.f.tau},
@@ -125,6 +163,8 @@ class Measurer {
         {"fscore", m_.f.fscore},
         {"ground_truth_samples", s.all.size()},
         {"visible_ground_truth_samples", s.visible.size()},
+        {"recall_reference", all ? "all ground-truth samples (no camera to tell what was seen)"
+                                 : "the ground-truth samples a camera sees"},
         {"definition",
          "Tanks and Temples: precision = share of the compared geometry within tau of the "
          "ground-truth mesh; recall = share of visible ground-truth samples within tau of it"}};
@@ -158,7 +198,9 @@ class Measurer {
   const Alignment& a_;
   const fs::path& out_;
   json& report_;
-  std::vector<Vec3> view_points_;  // per kept point: where it was seen from
+  const Surface* reconstructed_mesh_;
+  std::vector<Vec3> view_points_;  // per kept point: where it was seen from (--poisson)
+  std::map<int, Vec3> centre_gt_;  // camera centres by image id, aligned
   Measurements m_;
 };
 
@@ -166,8 +208,8 @@ class Measurer {
 
 Measurements measure(const EvalOptions& options, const SparseModel& model, const GroundTruth& truth,
                      const Surface& surface, const Alignment& alignment, const fs::path& out,
-                     json& report) {
-  return Measurer(options, model, truth, surface, alignment, out, report).run();
+                     json& report, const Surface* reconstructed_mesh) {
+  return Measurer(options, model, truth, surface, alignment, out, report, reconstructed_mesh).run();
 }
 
 }  // namespace rigc::eval

@@ -25,8 +25,13 @@ struct Measurements {
 
 // Fills eval.json's "compared", "signed_distance_mm", "poisson_mesh" (with --poisson, whose mesh
 // goes to out/poisson_mesh.ply), "fscore" and, with planned cameras, "cameras".
+// `reconstructed_mesh` (in the reconstruction's frame) is a mesh whose dense samples are
+// `model`'s points: recall then measures the ground-truth samples against the mesh itself
+// (CloudCompare's cloud-to-mesh both ways). The recall reference is the ground-truth samples the
+// cameras see, or all of them when there is no camera.
 Measurements measure(const EvalOptions& options, const SparseModel& model, const GroundTruth& truth,
                      const Surface& surface, const Alignment& alignment,
-                     const std::filesystem::path& out, nlohmann::json& report);
+                     const std::filesystem::path& out, nlohmann::json& report,
+                     const Surface* reconstructed_mesh = nullptr);
 
 }  // namespace rigc::eval

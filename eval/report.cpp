@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "eval/metrics.h"
 #include "io/files.h"
@@ -11,6 +12,35 @@ namespace rigc::eval {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+namespace {
+
+// A camera that sees the whole ground truth from the front, above: the heat map's view when the
+// reconstruction came without cameras.
+ViewCamera overview_camera(const Surface& surface) {
+  const Eigen::AlignedBox3d box = surface.bounds();
+  const Vec3 centre = box.center();
+  const double radius = std::max(box.diagonal().norm() / 2, 1e-9);
+  constexpr double kHalfFovDeg = 20;
+  const Vec3 eye = centre + Vec3(0.45, -0.8, 0.4).normalized() * radius * 1.15 /
+                                std::sin(kHalfFovDeg * M_PI / 180);
+  const Vec3 forward = (centre - eye).normalized();
+  const Vec3 right = forward.cross(Vec3::UnitZ()).normalized();
+  const Vec3 down = forward.cross(right);
+  ViewCamera v;
+  v.camera_from_world.topLeftCorner<3, 3>().row(0) = right.transpose();
+  v.camera_from_world.topLeftCorner<3, 3>().row(1) = down.transpose();
+  v.camera_from_world.topLeftCorner<3, 3>().row(2) = forward.transpose();
+  v.camera_from_world.topRightCorner<3, 1>() = -v.camera_from_world.topLeftCorner<3, 3>() * eye;
+  v.width = 1280;
+  v.height = 960;
+  v.fx = v.fy = (v.height / 2.0) / std::tan(kHalfFovDeg * M_PI / 180);
+  v.cx = v.width / 2.0;
+  v.cy = v.height / 2.0;
+  return v;
+}
+
+}  // namespace
 
 EvalReport::EvalReport(const EvalInputs& in, std::ostream& log, EvalSummary& summary)
     : out_(in.out), image_count_(in.images.names.size()), log_(log), summary_(summary) {
@@ -72,8 +102,8 @@ void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& c
 void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
                                 const Alignment& alignment, const Measurements& m) {
   const std::vector<double>& d_mm = m.distance_mm;
-  const double range =
-      o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * distance_stats(d_mm).rms);
+  const DistanceStats stats = distance_stats(d_mm);
+  const double range = o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * stats.rms);
   json files;
   std::string why;
   if (write_colored_ply(out_ / "cloud_signed_distance.ply", m.points, d_mm, range, &why)) {
@@ -81,20 +111,19 @@ void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
   } else {
     log_ << "rigc eval: warning: " << why << "\n";
   }
-  if (write_histogram_png(out_ / "histogram.png", d_mm, range, distance_stats(d_mm), &why)) {
+  if (write_histogram_png(out_ / "histogram.png", d_mm, range, stats, &why)) {
     files["histogram_png"] = (out_ / "histogram.png").string();
     summary_.histogram_png = files["histogram_png"];
   } else {
     log_ << "rigc eval: warning: " << why << "\n";
   }
-  if (!alignment.views.empty()) {
-    if (write_heatmap_png(out_ / "heatmap.png", surface, alignment.views.front(), m.points, d_mm,
-                          range, 1280, &why)) {
-      files["heatmap_png"] = (out_ / "heatmap.png").string();
-      summary_.heatmap_png = files["heatmap_png"];
-    } else {
-      log_ << "rigc eval: warning: " << why << "\n";
-    }
+  const ViewCamera view =
+      alignment.views.empty() ? overview_camera(surface) : alignment.views.front();
+  if (write_heatmap_png(out_ / "heatmap.png", surface, view, m.points, d_mm, range, 1280, &why)) {
+    files["heatmap_png"] = (out_ / "heatmap.png").string();
+    summary_.heatmap_png = files["heatmap_png"];
+  } else {
+    log_ << "rigc eval: warning: " << why << "\n";
   }
   files["color_range_mm"] = range;
   report_["files"] = files;
@@ -106,15 +135,26 @@ void EvalReport::add_timing(const ColmapRun& colmap, const EvalTimes& t) {
                          {"rigc_total", t.rigc},         {"total", t.total}};
 }
 
-void EvalReport::print_summary(const EvalOptions& o, const ColmapRun& colmap, const Measurements& m,
-                               const EvalTimes& t) const {
+void EvalReport::print_measurements(const EvalOptions& o, const Measurements& m) const {
   const DistanceStats& stats = m.stats;
+  const std::string compared = report_.value("compared", "points");
   log_ << fmt::format(
       "rigc eval: signed distance {:.3f} ± {:.3f} mm (median {:.3f}, p90 |d| {:.3f}) over {} "
       "{}; F-score {:.3f} at {} mm (P {:.3f}, R {:.3f})\n",
       stats.mean, stats.stddev, stats.median, stats.p90_abs, stats.count,
-      report_["compared"].get<std::string>() == "points" ? "points" : "Poisson-mesh samples",
+      compared == "points"         ? "points"
+      : compared == "mesh_samples" ? "mesh samples"
+                                   : "Poisson-mesh samples",
       m.f.fscore, o.tau_mm, m.f.precision, m.f.recall);
+}
+
+void EvalReport::print_written() const {
+  log_ << fmt::format("rigc eval: wrote {}\n", (out_ / "eval.json").string());
+}
+
+void EvalReport::print_summary(const EvalOptions& o, const ColmapRun& colmap, const Measurements& m,
+                               const EvalTimes& t) const {
+  print_measurements(o, m);
   // The time split: COLMAP's steps, then RigC's own parts.
   std::string colmap_split;
   for (const auto& step : colmap.steps) {
@@ -131,7 +171,7 @@ void EvalReport::print_summary(const EvalOptions& o, const ColmapRun& colmap, co
       t.total, colmap.seconds, colmap.reused ? " (reused: the earlier run's)" : "",
       colmap_split.empty() ? "" : " (" + colmap_split.substr(2) + ")", t.setup + t.rigc, t.setup,
       t.metrics, t.rigc - t.metrics);
-  log_ << fmt::format("rigc eval: wrote {}\n", (out_ / "eval.json").string());
+  print_written();
 }
 
 }  // namespace rigc::eval

@@ -49,6 +49,9 @@ class EvalReport {
   // The result and the time split, on the log.
   void print_summary(const EvalOptions& options, const ColmapRun& colmap, const Measurements& m,
                      const EvalTimes& times) const;
+  // The result line alone (signed distance and F-score).
+  void print_measurements(const EvalOptions& options, const Measurements& m) const;
+  void print_written() const;
 
  private:
   std::filesystem::path out_;

@@ -16,6 +16,7 @@
 
 #include "dslr/lens.h"
 #include "io/files.h"
+#include "run/ground_truth_points.h"
 
 namespace rigc::run {
 namespace fs = std::filesystem;
@@ -93,8 +94,50 @@ ir::Mat4 camera_from_object(const ir::Shot& shot) {
   return inverse;
 }
 
+namespace {
+
+double mean_observations(const GroundTruthPoints& points) {
+  std::size_t n = 0;
+  for (const auto& image : points.per_image) n += image.size();
+  return points.per_image.empty() ? 0.0 : static_cast<double>(n) / points.per_image.size();
+}
+
+// An image's POINTS2D line: X Y POINT3D_ID per observation, without the newline.
+std::string observations_line(const GroundTruthPoints& points, std::size_t image) {
+  std::string line;
+  for (const auto& [p, entry] : points.per_image[image]) {
+    const GroundTruthObservation& o = points.points[p].track[entry];
+    line += fmt::format("{}{:.3f} {:.3f} {}", line.empty() ? "" : " ", o.x, o.y, p + 1);
+  }
+  return line;
+}
+
+std::string points3d_text(const std::vector<int>& shots, const GroundTruthPoints* points) {
+  std::size_t observations = 0;
+  if (points) {
+    for (const auto& p : points->points) observations += p.track.size();
+  }
+  const std::size_t count = points ? points->points.size() : 0;
+  std::string text = fmt::format(
+      "# 3D point list with one line of data per point:\n"
+      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+      "# Number of points: {}, mean track length: {}\n",
+      count, count ? tidy(static_cast<double>(observations) / count) : 0.0);
+  for (std::size_t i = 0; i < count; ++i) {
+    const GroundTruthPoint& p = points->points[i];
+    text += fmt::format("{} {} {} {} {} {} {} 0", i + 1, tidy(p.position.x()), tidy(p.position.y()),
+                        tidy(p.position.z()), p.rgb[0], p.rgb[1], p.rgb[2]);
+    for (const auto& o : p.track) text += fmt::format(" {} {}", shots[o.shot] + 1, o.point2d);
+    text += '\n';
+  }
+  return text;
+}
+
+}  // namespace
+
 bool write_colmap_sparse(const fs::path& sparse_dir, const ir::Scene& scene,
-                         const std::vector<int>& shots, double scale, std::string* error) {
+                         const std::vector<int>& shots, double scale, std::string* error,
+                         const GroundTruthPoints* points) {
   const auto camera = output_camera(scene.camera, scale, error);
   if (!camera) return false;
   std::set<int> seen;
@@ -135,28 +178,26 @@ bool write_colmap_sparse(const fs::path& sparse_dir, const ir::Scene& scene,
       "# Image list with two lines of data per image:\n"
       "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
       "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
-      "# Number of images: {}, mean observations per image: 0\n",
-      shots.size());
-  for (int index : shots) {
+      "# Number of images: {}, mean observations per image: {}\n",
+      shots.size(), points ? tidy(mean_observations(*points)) : 0.0);
+  for (std::size_t k = 0; k < shots.size(); ++k) {
+    const int index = shots[k];
     const ir::Shot& shot = scene.shots[index];
     const ir::Mat4 pose = camera_from_object(shot);
     Eigen::Quaterniond q(Eigen::Matrix3d(pose.block<3, 3>(0, 0)));
     q.normalize();
     if (q.w() < 0) q.coeffs() *= -1;
     const ir::Vec3 t = pose.block<3, 1>(0, 3);
-    images += fmt::format("{} {} {} {} {} {} {} {} 1 {}\n\n", index + 1, tidy(q.w()), tidy(q.x()),
+    images += fmt::format("{} {} {} {} {} {} {} {} 1 {}\n", index + 1, tidy(q.w()), tidy(q.x()),
                           tidy(q.y()), tidy(q.z()), tidy(t.x()), tidy(t.y()), tidy(t.z()),
                           image_file_name(scene.camera, shot));
+    images += points ? observations_line(*points, k) : "";
+    images += '\n';
   }
-
-  const std::string points =
-      "# 3D point list with one line of data per point:\n"
-      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
-      "# Number of points: 0, mean track length: 0\n";
 
   return write_file_atomically(sparse_dir / "cameras.txt", cameras, error) &&
          write_file_atomically(sparse_dir / "images.txt", images, error) &&
-         write_file_atomically(sparse_dir / "points3D.txt", points, error);
+         write_file_atomically(sparse_dir / "points3D.txt", points3d_text(shots, points), error);
 }
 
 namespace {

@@ -44,11 +44,16 @@ std::optional<OutputCamera> output_camera(const ir::Camera& camera, double scale
 // The rigid inverse of shot.object_from_camera: COLMAP's camera_from_world.
 ir::Mat4 camera_from_object(const ir::Shot& shot);
 
+struct GroundTruthPoints;  // run/ground_truth_points.h
+
 // Writes sparse_dir/{cameras,images,points3D}.txt (creating sparse_dir) for `shots`, indices
-// into scene.shots: one camera (CAMERA_ID 1), IMAGE_ID = shot index + 1, NAME = image_file_name,
-// an empty POINTS2D line per image, no 3D points. Atomic writes; false with a one-line `error`.
+// into scene.shots: one camera (CAMERA_ID 1), IMAGE_ID = shot index + 1, NAME = image_file_name.
+// With `points` (sampled for these `shots`), points3D.txt holds them (POINT3D_ID = index + 1) with
+// their tracks and each image's POINTS2D line their observations; without, both are empty.
+// Atomic writes; false with a one-line `error`.
 bool write_colmap_sparse(const std::filesystem::path& sparse_dir, const ir::Scene& scene,
-                         const std::vector<int>& shots, double scale, std::string* error);
+                         const std::vector<int>& shots, double scale, std::string* error,
+                         const GroundTruthPoints* points = nullptr);
 
 struct ColmapImage {
   int image_id = 0;

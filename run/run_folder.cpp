@@ -12,12 +12,18 @@
 #include <system_error>
 
 #include "io/atomic_file.h"
+#include "run/bundler.h"
+#include "run/camera_csv.h"
 #include "run/colmap_text.h"
+#include "run/ground_truth_points.h"
 #include "run/transforms_json.h"
 
 namespace rigc::run {
 
 namespace fs = std::filesystem;
+
+// Surface samples tested against the shots for points3D.txt and bundle.out.
+constexpr int kGroundTruthSamples = 20000;
 
 std::string progress_line(int done, int total, const std::string& name, double seconds) {
   constexpr int kWidth = 30;
@@ -131,8 +137,15 @@ int finish_run(const ir::Scene& scene, const Manifest& manifest, const fs::path&
     }
   }
   std::string error;
-  if (!write_colmap_sparse(run_dir / "sparse", scene, present, scale, &error) ||
-      !write_transforms_json(run_dir / "transforms.json", scene, present, scale, &error)) {
+  const auto camera = output_camera(scene.camera, scale, &error);
+  const GroundTruthPoints points =
+      camera ? sample_ground_truth_points(scene, present, *camera, kGroundTruthSamples)
+             : GroundTruthPoints{};
+  if (!camera || !write_colmap_sparse(run_dir / "sparse", scene, present, scale, &error, &points) ||
+      !write_transforms_json(run_dir / "transforms.json", scene, present, scale, &error) ||
+      !write_bundler(run_dir / "bundle.out", run_dir / "bundle.list.txt", scene, present, scale,
+                     points, &error) ||
+      !write_camera_csv(run_dir / "cameras.csv", scene, present, &error)) {
     log << fmt::format("rigc: error: {}\n", error);
     return 2;
   }

@@ -46,8 +46,10 @@ bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene,
 // "\r[#####     ] 5/18 shot_004 0.42 s": the progress bar a run redraws on a terminal.
 std::string progress_line(int done, int total, const std::string& name, double seconds);
 
-// Writes sparse/ and transforms.json for every shot that has its image in the run folder, and
-// the closing line. Returns the run's exit code: 2 if anything failed, else 0.
+// Writes the ground truth for every shot that has its image in the run folder: sparse/ (with
+// points on the surface the shots see, run/ground_truth_points.h), transforms.json, bundle.out
+// with bundle.list.txt, and cameras.csv; then the closing line. Returns the run's exit code: 2 if
+// anything failed, else 0.
 int finish_run(const ir::Scene& scene, const Manifest& manifest,
                const std::filesystem::path& run_dir, double scale, int failures, size_t shots,
                std::ostream& log);

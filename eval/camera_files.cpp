@@ -1,0 +1,317 @@
+#include "eval/camera_files.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace rigc::eval {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Little-endian binary reader over a whole file; `ok` turns false on a short read.
+class BinaryReader {
+ public:
+  explicit BinaryReader(const fs::path& path) : in_(path, std::ios::binary) {}
+  bool opened() const { return static_cast<bool>(in_); }
+  template <typename T>
+  T read() {
+    T value{};
+    if (!in_.read(reinterpret_cast<char*>(&value), sizeof(T))) ok = false;
+    return value;
+  }
+  std::string read_name() {
+    std::string name;
+    char c = 0;
+    while (in_.get(c) && c != '\0') name.push_back(c);
+    if (!in_) ok = false;
+    return name;
+  }
+  void skip(std::uint64_t bytes) {
+    if (!in_.seekg(static_cast<std::streamoff>(bytes), std::ios::cur)) ok = false;
+  }
+  bool ok = true;
+
+ private:
+  std::ifstream in_;
+};
+
+// The parameter count of a COLMAP camera model id (colmap/sensor/models.h).
+struct ModelInfo {
+  const char* name;
+  int params;
+};
+std::optional<ModelInfo> colmap_model(int id) {
+  static const ModelInfo models[] = {{"SIMPLE_PINHOLE", 3},
+                                     {"PINHOLE", 4},
+                                     {"SIMPLE_RADIAL", 4},
+                                     {"RADIAL", 5},
+                                     {"OPENCV", 8},
+                                     {"OPENCV_FISHEYE", 8},
+                                     {"FULL_OPENCV", 12},
+                                     {"FOV", 5},
+                                     {"SIMPLE_RADIAL_FISHEYE", 4},
+                                     {"RADIAL_FISHEYE", 5},
+                                     {"THIN_PRISM_FISHEYE", 12}};
+  if (id < 0 || id >= static_cast<int>(std::size(models))) return std::nullopt;
+  return models[id];
+}
+
+bool bad_file(const fs::path& path, const std::string& why, std::string* error) {
+  *error = fmt::format("{}: {}", path.string(), why);
+  return false;
+}
+
+ir::Mat4 pose_from(const Eigen::Matrix3d& r, const ir::Vec3& t) {
+  ir::Mat4 m = ir::Mat4::Identity();
+  m.topLeftCorner<3, 3>() = r;
+  m.topRightCorner<3, 1>() = t;
+  return m;
+}
+
+std::string file_name_of(const std::string& path_text) {
+  const std::string name = fs::path(path_text).filename().string();
+  return name.empty() ? path_text : name;
+}
+
+// A number of a Meshroom file: written as a string ("0.5"), or a plain JSON number.
+bool json_number(const json& j, double* value) {
+  try {
+    *value = j.is_string() ? std::stod(j.get<std::string>()) : j.get<double>();
+  } catch (const std::exception&) {
+    return false;
+  }
+  return std::isfinite(*value);
+}
+
+std::string json_id(const json& j) {
+  return j.is_string() ? j.get<std::string>() : j.dump();
+}
+
+std::optional<fs::path> bundler_list(const fs::path& out_path) {
+  const fs::path dir = out_path.parent_path();
+  const std::string stem = out_path.stem().string();
+  for (const fs::path& candidate : {dir / (stem + ".list.txt"), dir / (stem + "_list.txt"),
+                                    dir / "list.txt", dir / "bundle.list.txt"}) {
+    if (fs::is_regular_file(candidate)) return candidate;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::vector<run::ColmapCamera>> read_colmap_cameras_bin(const fs::path& path,
+                                                                      std::string* error) {
+  BinaryReader in(path);
+  if (!in.opened()) return bad_file(path, "cannot open", error), std::nullopt;
+  std::vector<run::ColmapCamera> cameras;
+  const auto count = in.read<std::uint64_t>();
+  for (std::uint64_t i = 0; in.ok && i < count; ++i) {
+    run::ColmapCamera c;
+    c.camera_id = static_cast<int>(in.read<std::uint32_t>());
+    const auto info = colmap_model(in.read<std::int32_t>());
+    c.width = static_cast<int>(in.read<std::uint64_t>());
+    c.height = static_cast<int>(in.read<std::uint64_t>());
+    if (!in.ok || !info) return bad_file(path, "unknown camera model", error), std::nullopt;
+    c.model = info->name;
+    for (int p = 0; p < info->params; ++p) c.params.push_back(in.read<double>());
+    cameras.push_back(std::move(c));
+  }
+  if (!in.ok) return bad_file(path, "ends early (not a COLMAP cameras.bin)", error), std::nullopt;
+  return cameras;
+}
+
+std::optional<std::vector<run::ColmapImage>> read_colmap_images_bin(const fs::path& path,
+                                                                    std::string* error) {
+  BinaryReader in(path);
+  if (!in.opened()) return bad_file(path, "cannot open", error), std::nullopt;
+  std::vector<run::ColmapImage> images;
+  const auto count = in.read<std::uint64_t>();
+  for (std::uint64_t i = 0; in.ok && i < count; ++i) {
+    run::ColmapImage im;
+    im.image_id = static_cast<int>(in.read<std::uint32_t>());
+    double v[7];
+    for (double& x : v) x = in.read<double>();
+    im.camera_id = static_cast<int>(in.read<std::uint32_t>());
+    im.name = in.read_name();
+    const auto points2d = in.read<std::uint64_t>();
+    in.skip(points2d * (2 * sizeof(double) + sizeof(std::uint64_t)));
+    Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
+    if (!in.ok) break;
+    if (!(q.norm() > 0) || !std::isfinite(q.norm())) {
+      return bad_file(path, fmt::format("image '{}' has no valid rotation", im.name), error),
+             std::nullopt;
+    }
+    im.camera_from_world = pose_from(q.normalized().toRotationMatrix(), ir::Vec3(v[4], v[5], v[6]));
+    images.push_back(std::move(im));
+  }
+  if (!in.ok) return bad_file(path, "ends early (not a COLMAP images.bin)", error), std::nullopt;
+  return images;
+}
+
+std::optional<std::vector<run::ColmapImage>> read_bundler(const fs::path& out_path,
+                                                          const fs::path& list_path,
+                                                          std::string* error) {
+  std::ifstream out(out_path), list(list_path);
+  if (!out) return bad_file(out_path, "cannot open", error), std::nullopt;
+  if (!list) return bad_file(list_path, "cannot open", error), std::nullopt;
+  std::string header;
+  std::getline(out, header);
+  if (!header.starts_with("# Bundle file")) {
+    return bad_file(out_path, "does not start with '# Bundle file' (not a Bundler .out)", error),
+           std::nullopt;
+  }
+  long cameras = -1, points = -1;
+  out >> cameras >> points;
+  if (!out || cameras < 0 || points < 0) {
+    return bad_file(out_path, "expected the camera and point counts", error), std::nullopt;
+  }
+  std::vector<std::string> names;
+  for (std::string line; std::getline(list, line);) {
+    std::istringstream words(line);
+    std::string first;
+    if (words >> first) names.push_back(first);
+  }
+  if (static_cast<long>(names.size()) != cameras) {
+    return bad_file(list_path,
+                    fmt::format("lists {} images but {} has {} cameras", names.size(),
+                                out_path.string(), cameras),
+                    error),
+           std::nullopt;
+  }
+  // Bundler's camera looks down -Z with +Y up: OpenCV's axes are its Y and Z negated.
+  const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  std::vector<run::ColmapImage> images;
+  for (long i = 0; i < cameras; ++i) {
+    double v[15];
+    for (double& x : v) out >> x;
+    if (!out) {
+      return bad_file(out_path, fmt::format("camera {} is incomplete", i), error), std::nullopt;
+    }
+    if (!std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) {
+      return bad_file(out_path, fmt::format("camera {} holds a non-finite number", i), error),
+             std::nullopt;
+    }
+    if (v[0] == 0) continue;  // not registered
+    Eigen::Matrix3d r;
+    r << v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11];
+    run::ColmapImage im;
+    im.image_id = static_cast<int>(i + 1);
+    im.camera_id = 1;
+    im.name = file_name_of(names[i]);
+    im.camera_from_world = pose_from(flip * r, flip * ir::Vec3(v[12], v[13], v[14]));
+    images.push_back(std::move(im));
+  }
+  return images;
+}
+
+std::optional<std::vector<run::ColmapImage>> read_meshroom_sfm(const fs::path& path,
+                                                               std::string* error) {
+  const json doc = json::parse(std::ifstream(path, std::ios::binary), nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("views") || !doc.contains("poses") ||
+      !doc["views"].is_array() || !doc["poses"].is_array()) {
+    return bad_file(path, "is not a Meshroom SfMData JSON (views and poses)", error), std::nullopt;
+  }
+  std::map<std::string, ir::Mat4> pose_by_id;
+  for (const json& p : doc["poses"]) {
+    const json* transform = p.is_object() && p.contains("pose") && p["pose"].is_object() &&
+                                    p["pose"].contains("transform")
+                                ? &p["pose"]["transform"]
+                                : nullptr;
+    if (!transform || !p.contains("poseId") || !transform->contains("rotation") ||
+        !transform->contains("center") || (*transform)["rotation"].size() != 9 ||
+        (*transform)["center"].size() != 3) {
+      return bad_file(path, "a pose lacks poseId, rotation (9) or center (3)", error), std::nullopt;
+    }
+    Eigen::Matrix3d r;
+    ir::Vec3 c;
+    bool good = true;
+    for (int k = 0; k < 9; ++k) good = good && json_number((*transform)["rotation"][k], &r(k));
+    for (int k = 0; k < 3; ++k) good = good && json_number((*transform)["center"][k], &c(k));
+    if (!good) return bad_file(path, "a pose holds a value that is no number", error), std::nullopt;
+    pose_by_id[json_id(p["poseId"])] = pose_from(r, -r * c);
+  }
+  std::vector<run::ColmapImage> images;
+  int id = 0;
+  for (const json& v : doc["views"]) {
+    if (!v.is_object() || !v.contains("path") || !v["path"].is_string() || !v.contains("poseId")) {
+      return bad_file(path, "a view lacks its path or poseId", error), std::nullopt;
+    }
+    const auto pose = pose_by_id.find(json_id(v["poseId"]));
+    if (pose == pose_by_id.end()) continue;  // a view Meshroom did not reconstruct
+    run::ColmapImage im;
+    im.image_id = ++id;
+    im.camera_id = 1;
+    im.name = file_name_of(v["path"].get<std::string>());
+    im.camera_from_world = pose->second;
+    images.push_back(std::move(im));
+  }
+  return images;
+}
+
+std::optional<CameraFile> read_camera_file(const fs::path& path, std::string* error) {
+  CameraFile file;
+  file.path = path;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    *error = fmt::format("{} does not exist", path.string());
+    return std::nullopt;
+  }
+  const fs::path dir = fs::is_directory(path, ec) ? path : path.parent_path();
+  const std::string ext = path.extension().string();
+  std::optional<std::vector<run::ColmapImage>> images;
+  if (fs::is_directory(path, ec) || path.filename() == "images.txt" ||
+      path.filename() == "images.bin") {
+    if (fs::exists(dir / "images.txt")) {
+      file.format = "COLMAP text";
+      images = run::read_colmap_images(dir / "images.txt", error);
+      auto cameras = run::read_colmap_cameras(dir / "cameras.txt", error);
+      if (!cameras) return std::nullopt;
+      file.cameras = std::move(*cameras);
+    } else if (fs::exists(dir / "images.bin")) {
+      file.format = "COLMAP binary";
+      images = read_colmap_images_bin(dir / "images.bin", error);
+      auto cameras = read_colmap_cameras_bin(dir / "cameras.bin", error);
+      if (!cameras) return std::nullopt;
+      file.cameras = std::move(*cameras);
+    } else {
+      *error = fmt::format("{} holds no COLMAP model (images.txt or images.bin)", dir.string());
+      return std::nullopt;
+    }
+    if (images) {
+      for (auto& im : *images) im.name = file_name_of(im.name);
+    }
+  } else if (ext == ".out") {
+    file.format = "Bundler";
+    const auto list = bundler_list(path);
+    if (!list) {
+      *error = fmt::format("{}: no image list beside it ({}.list.txt, {}_list.txt or list.txt)",
+                           path.string(), path.stem().string(), path.stem().string());
+      return std::nullopt;
+    }
+    file.list = *list;
+    images = read_bundler(path, *list, error);
+  } else if (ext == ".sfm" || ext == ".json") {
+    file.format = "Meshroom SfMData";
+    images = read_meshroom_sfm(path, error);
+  } else {
+    *error = fmt::format(
+        "{}: unknown camera file (a COLMAP model folder, a Bundler .out, a Meshroom .sfm/.json)",
+        path.string());
+    return std::nullopt;
+  }
+  if (!images) return std::nullopt;
+  file.images = std::move(*images);
+  return file;
+}
+
+}  // namespace rigc::eval

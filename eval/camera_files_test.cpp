@@ -1,0 +1,105 @@
+#include "eval/camera_files.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "eval/reconstruction_test_support.h"
+
+namespace rigc::eval {
+namespace {
+
+using nlohmann::json;
+
+// A Meshroom SfMData of the statue run's poses, as AliceVision writes it: numbers as strings, the
+// world-to-camera rotation column by column, the centre; one view without a pose.
+json meshroom_sfm(const test_inputs::StatueRun& r) {
+  json views = json::array(), poses = json::array();
+  for (int index : r.shots) {
+    const ir::Shot& shot = r.scene.shots[index];
+    const ir::Mat4 pose = run::camera_from_object(shot);
+    const std::string id = std::to_string(1000 + index);
+    views.push_back({{"viewId", id},
+                     {"poseId", id},
+                     {"path", "/data/photos/" + run::image_file_name(r.scene.camera, shot)}});
+    json rotation = json::array(), centre = json::array();
+    for (int k = 0; k < 9; ++k) rotation.push_back(fmt::format("{:.17g}", pose(k % 3, k / 3)));
+    const ir::Vec3 c = shot.object_from_camera.topRightCorner<3, 1>();
+    for (int k = 0; k < 3; ++k) centre.push_back(fmt::format("{:.17g}", c(k)));
+    poses.push_back(
+        {{"poseId", id}, {"pose", {{"transform", {{"rotation", rotation}, {"center", centre}}}}}});
+  }
+  views.push_back({{"viewId", "7"}, {"poseId", "7"}, {"path", "/data/photos/lost.jpg"}});
+  return {{"version", {"1", "2", "0"}}, {"views", views}, {"poses", poses}};
+}
+
+TEST(CameraFiles, MeshroomSfmGivesThePoses) {
+  rigc::testing::TempDir dir;
+  const auto r = test_inputs::make_statue_run(dir.path(), 100);
+  ASSERT_TRUE(r);
+  rigc::testing::write_text(dir.file("cameras.sfm"), meshroom_sfm(*r).dump(2));
+  std::string error;
+  const auto file = read_camera_file(dir.file("cameras.sfm"), &error);
+  ASSERT_TRUE(file) << error;
+  EXPECT_EQ(file->format, "Meshroom SfMData");
+  ASSERT_EQ(file->images.size(), r->shots.size());  // the view without a pose is left out
+  for (std::size_t i = 0; i < r->shots.size(); ++i) {
+    const ir::Shot& shot = r->scene.shots[r->shots[i]];
+    EXPECT_EQ(file->images[i].name, run::image_file_name(r->scene.camera, shot));
+    EXPECT_LT((file->images[i].camera_from_world - run::camera_from_object(shot)).norm(), 1e-9);
+  }
+}
+
+TEST(CameraFiles, BrokenFilesAreNamed) {
+  rigc::testing::TempDir dir;
+  std::string error;
+  rigc::testing::write_text(dir.file("a.sfm"), "{\"views\": []}");
+  EXPECT_FALSE(read_camera_file(dir.file("a.sfm"), &error));
+  EXPECT_NE(error.find("a.sfm: is not a Meshroom SfMData"), std::string::npos) << error;
+  rigc::testing::write_text(dir.file("b.out"), "# Bundle file v0.3\n1 0\n");
+  EXPECT_FALSE(read_camera_file(dir.file("b.out"), &error));
+  EXPECT_NE(error.find("no image list"), std::string::npos) << error;
+  rigc::testing::write_text(dir.file("b.list.txt"), "x.jpg\n");
+  EXPECT_FALSE(read_camera_file(dir.file("b.out"), &error));
+  EXPECT_NE(error.find("camera 0 is incomplete"), std::string::npos) << error;
+  rigc::testing::write_text(dir.file("images.bin"), "xx");
+  rigc::testing::write_text(dir.file("cameras.bin"), "xx");
+  EXPECT_FALSE(read_camera_file(dir.path(), &error));
+  EXPECT_NE(error.find("ends early"), std::string::npos) << error;
+  EXPECT_FALSE(read_camera_file(dir.file("c.xyz"), &error));
+  EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+}
+
+// COLMAP's binary model (written by COLMAP itself from the text one) reads as the text one.
+TEST(CameraFiles, ColmapBinaryModelReadsAsTheTextOne) {
+  RIGC_REQUIRE_TOOL(std::system("colmap -h > /dev/null 2>&1") == 0, "colmap");
+  rigc::testing::TempDir dir;
+  const auto r = test_inputs::make_statue_run(dir.path(), 500);
+  ASSERT_TRUE(r);
+  std::filesystem::create_directories(dir.path() / "bin");
+  const auto result = rigc::testing::run_process({"colmap", "model_converter", "--input_path",
+                                                  (r->dir / "sparse").string(), "--output_path",
+                                                  dir.file("bin"), "--output_type", "BIN"});
+  ASSERT_EQ(result.exit_code, 0) << result.out << result.err;
+  std::string error;
+  const auto text = read_camera_file(r->dir / "sparse", &error);
+  ASSERT_TRUE(text) << error;
+  const auto binary = read_camera_file(dir.path() / "bin" / "images.bin", &error);
+  ASSERT_TRUE(binary) << error;
+  EXPECT_EQ(binary->format, "COLMAP binary");
+  ASSERT_EQ(binary->cameras.size(), 1u);
+  EXPECT_EQ(binary->cameras[0].model, text->cameras[0].model);
+  EXPECT_EQ(binary->cameras[0].params, text->cameras[0].params);
+  ASSERT_EQ(binary->images.size(), text->images.size());
+  std::map<std::string, ir::Mat4> by_name;
+  for (const auto& im : text->images) by_name[im.name] = im.camera_from_world;
+  for (const auto& im : binary->images) {
+    ASSERT_TRUE(by_name.count(im.name)) << im.name;
+    EXPECT_LT((im.camera_from_world - by_name[im.name]).norm(), 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace rigc::eval
