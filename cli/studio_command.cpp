@@ -38,6 +38,8 @@ int run_studio_command(std::vector<std::string> args) {
   app.add_option("--port", options.port, "port (default: any free one)")
       ->check(CLI::Range(0, 65535));
   if (auto code = parse_options(app, args)) return *code;
+  // Before any thread starts (the compiler's and the renderer's workers inherit the mask).
+  const sigset_t signals = block_stop_signals();
 
   std::string error;
   const auto session = studio::Session::open(scene_path, &error);
@@ -51,7 +53,6 @@ int run_studio_command(std::vector<std::string> args) {
         "token can change and save {}\n",
         options.host, scene_path);
   }
-  const sigset_t signals = block_stop_signals();
   studio::StudioServer server(*session, options);
   if (server.bind(&error) < 0) {
     std::cerr << "rigc: error: " << error << '\n';

@@ -215,6 +215,12 @@ void StudioServer::add_page_routes() {
     res.set_header("X-Rigc-Clipped", fmt::format("{:.5f}", frame->histogram.clipped));
     res.set_header("X-Rigc-Mean", fmt::format("{:.3f}", frame->histogram.mean_luma));
     res.set_header("X-Rigc-Render-Ms", fmt::format("{:.1f}", frame->render_ms));
+    std::string stages;
+    for (const auto& [stage, ms] : frame->stage_ms) {
+      stages += fmt::format("{}{}={:.1f}", stages.empty() ? "" : ",", stage, ms);
+    }
+    res.set_header("X-Rigc-Stages", stages);
+    res.set_header("X-Rigc-Encode-Ms", fmt::format("{:.1f}", frame->encode_ms));
     res.set_header("Cache-Control", "no-store");
     res.set_content(frame->jpeg, "image/jpeg");
   });

@@ -338,8 +338,9 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   run::RenderedShot rendered;
   if (!preview_->render(*scene, *studio, shot, settings, {}, &rendered, error)) return std::nullopt;
   error->clear();
+  std::map<std::string, double> stages = rendered.stage_ms;
   dslr::DevelopResult developed =
-      run::develop_shot(*scene, shot, std::move(rendered), settings, false, error);
+      run::develop_shot(*scene, shot, std::move(rendered), settings, false, error, &stages);
   if (developed.encoded_bytes.empty()) {
     developed.encoded_bytes.assign(developed.encoded.begin(), developed.encoded.end());
   }
@@ -351,6 +352,7 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   frame.width = developed.width;
   frame.height = developed.height;
   frame.render_ms = ms_since(start);
+  frame.stage_ms = std::move(stages);
   const auto encode_start = Clock::now();
   frame.jpeg = encode_jpeg(developed.encoded_bytes, frame.width, frame.height, 90, error);
   if (frame.jpeg.empty()) return std::nullopt;

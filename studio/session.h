@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -42,7 +43,8 @@ struct Frame {
   std::string jpeg;
   int width = 0, height = 0;
   Histogram histogram;
-  double render_ms = 0;  // render and development
+  double render_ms = 0;                    // render and development
+  std::map<std::string, double> stage_ms;  // the renderer's and the DSLR model's stages
   double encode_ms = 0;
 };
 
