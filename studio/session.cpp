@@ -371,7 +371,7 @@ nlohmann::json Session::coverage() {
     scene = scene_;
     studio = studio_;
   }
-  std::lock_guard render_lock(render_mutex_);
+  std::lock_guard analysis_lock(analysis_mutex_);
   const auto start = Clock::now();
   analysis::CoverageResult result = analysis::analyse_coverage(*scene, *studio);
   const double ms = ms_since(start);
@@ -407,7 +407,7 @@ nlohmann::json Session::advice() {
     scene = scene_;
     studio = studio_;
   }
-  std::lock_guard render_lock(render_mutex_);
+  std::lock_guard analysis_lock(analysis_mutex_);
   DiagnosticEngine diag;
   diag.add_source(file_.string(), text_snapshot(scene));
   nlohmann::json out = nlohmann::json::array();

@@ -85,7 +85,9 @@ class Session {
   std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
 
   std::mutex mutex_;
-  std::mutex render_mutex_;  // one frame or analysis at a time: the machine's cores are few
+  // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
+  // takes seconds) does not hold up the live view.
+  std::mutex render_mutex_, analysis_mutex_;
   std::filesystem::path file_;
   std::string disk_text_;  // the file as last read or saved
   std::string text_;       // the scene as the user changed it

@@ -411,8 +411,13 @@ const PAPER = [[1, 1, 1], [0.85, 0.05, 0.05], [0.05, 0.7, 0.1]];
 
 async function refreshCoverage() {
   const coverage = await (await api('api/coverage')).json();
-  $('coverage-table').textContent = coverage.table + `\nreconstructable ${(100 * coverage.reconstructable).toFixed(1)} %` +
-    ` of the surface, seen twice ${(100 * coverage.seen_2).toFixed(1)} %, ${coverage.shots} shots`;
+  $('coverage-summary').textContent = `${coverage.shots} shots: ` +
+    `${(100 * coverage.reconstructable).toFixed(1)} % reconstructable, ` +
+    `${(100 * coverage.seen_2).toFixed(1)} % seen twice; last shot new ${(100 * coverage.new).toFixed(1)} %, ` +
+    `overlap ${(100 * coverage.overlap).toFixed(0)} %`;
+  const table = $('coverage-table');
+  table.textContent = coverage.table;
+  table.scrollTop = table.scrollHeight;  // the latest shots
   window.rigcCoverage = coverage;
   if (!coverageView.geometry) return;
   const colors = coverageView.geometry.attributes.color;
