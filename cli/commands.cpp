@@ -266,6 +266,7 @@ const std::vector<Command>& commands() {
       {"compare", "render with several backends and compare reconstruction accuracy",
        run_compare_command},
       {"plan", "plan the fewest shots that reach a coverage target", run_plan_command},
+      {"studio", "the interactive capture studio in a browser", run_studio_command},
       {"version", "print the version", run_version},
   };
   return table;

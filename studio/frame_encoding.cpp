@@ -1,0 +1,55 @@
+#include "studio/frame_encoding.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+
+namespace rigc::studio {
+
+std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int height, int quality,
+                        std::string* error) {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  auto out = OIIO::ImageOutput::create("frame.jpg");
+  if (!out) {
+    *error = "OpenImageIO has no JPEG writer";
+    return {};
+  }
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("Compression", "jpeg:" + std::to_string(std::clamp(quality, 1, 100)));
+  void* proxy_pointer = &proxy;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+  if (!out->open("frame.jpg", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
+      !out->close()) {
+    *error = "cannot encode the frame: " + out->geterror();
+    return {};
+  }
+  return std::string(bytes.begin(), bytes.end());
+}
+
+Histogram histogram_of(const std::vector<std::uint8_t>& rgb) {
+  Histogram h;
+  h.bins.assign(4 * Histogram::kBins, 0);
+  const size_t pixels = rgb.size() / 3;
+  size_t clipped = 0;
+  double luma_sum = 0;
+  constexpr int kShift = 2;  // 256 codes into 64 bins
+  for (size_t i = 0; i < pixels; ++i) {
+    const std::uint8_t r = rgb[3 * i], g = rgb[3 * i + 1], b = rgb[3 * i + 2];
+    const double luma = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    ++h.bins[r >> kShift];
+    ++h.bins[Histogram::kBins + (g >> kShift)];
+    ++h.bins[2 * Histogram::kBins + (b >> kShift)];
+    ++h.bins[3 * Histogram::kBins + std::min(63, static_cast<int>(luma) >> kShift)];
+    clipped += (r == 255 || g == 255 || b == 255);
+    luma_sum += luma;
+  }
+  if (pixels > 0) {
+    h.clipped = static_cast<double>(clipped) / pixels;
+    h.mean_luma = luma_sum / pixels;
+  }
+  return h;
+}
+
+}  // namespace rigc::studio

@@ -1,0 +1,24 @@
+// A developed frame as the page shows it: a JPEG in memory, and the histogram under it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rigc::studio {
+
+// 8-bit RGB, `width` x `height`, as a baseline JPEG of `quality` (1..100); empty on failure with
+// `error` set.
+std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int height, int quality,
+                        std::string* error);
+
+struct Histogram {
+  static constexpr int kBins = 64;
+  std::vector<int> bins;  // 4 x kBins: red, green, blue, then luma (Rec. 709 weights on codes)
+  double clipped = 0;     // share of pixels with some channel at 255
+  double mean_luma = 0;   // of the codes, 0..255
+};
+
+Histogram histogram_of(const std::vector<std::uint8_t>& rgb);
+
+}  // namespace rigc::studio

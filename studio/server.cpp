@@ -1,0 +1,299 @@
+#include "studio/server.h"
+
+#include <fmt/format.h>
+#include <httplib.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "studio/page_files.h"
+
+namespace rigc::studio {
+namespace {
+
+// Debian's libjs-three: three.js r111 and the two examples the page uses.
+constexpr const char* kThreeDir = "/usr/share/javascript/three/";
+
+void send_error(httplib::Response& res, int status, const std::string& message) {
+  res.status = status;
+  res.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
+}
+
+void send_json(httplib::Response& res, const nlohmann::json& body) {
+  res.set_content(body.dump(), "application/json");
+}
+
+void send_outcome(httplib::Response& res, const Outcome& outcome) {
+  if (outcome.ok) {
+    send_json(res, {{"ok", true}});
+  } else {
+    send_error(res, 422, outcome.message);
+  }
+}
+
+// The request's body as a JSON object; nullopt after a 400 when it is not one.
+std::optional<nlohmann::json> json_body(const httplib::Request& req, httplib::Response& res) {
+  nlohmann::json body = nlohmann::json::parse(req.body, nullptr, false);
+  if (body.is_discarded() || !body.is_object()) {
+    send_error(res, 400, "the request's body is not a JSON object");
+    return std::nullopt;
+  }
+  return body;
+}
+
+std::optional<Eigen::Vector3d> vec3(const nlohmann::json& value) {
+  if (!value.is_array() || value.size() != 3) return std::nullopt;
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    if (!value[i].is_number()) return std::nullopt;
+    v[i] = value[i].get<double>();
+  }
+  return v;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Timing-safe comparison of the token.
+bool same_token(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+}  // namespace
+
+std::string random_token() {
+  std::random_device device;
+  std::string token;
+  for (int i = 0; i < 4; ++i) token += fmt::format("{:08x}", device());
+  return token;
+}
+
+StudioServer::StudioServer(Session& session, ServerOptions options)
+    : session_(session), options_(std::move(options)), server_(new httplib::Server()) {
+  if (options_.token.empty()) options_.token = random_token();
+  server_->set_payload_max_length(1 << 20);
+  add_routes();
+}
+
+StudioServer::~StudioServer() = default;
+
+int StudioServer::bind(std::string* error) {
+  port_ = options_.port == 0
+              ? server_->bind_to_any_port(options_.host)
+              : (server_->bind_to_port(options_.host, options_.port) ? options_.port : -1);
+  if (port_ < 0) *error = fmt::format("cannot listen on {}:{}", options_.host, options_.port);
+  return port_;
+}
+
+bool StudioServer::run() {
+  return server_->listen_after_bind();
+}
+void StudioServer::stop() {
+  server_->stop();
+}
+bool StudioServer::is_running() const {
+  return server_->is_running();
+}
+
+std::string StudioServer::url() const {
+  const bool v6 = options_.host.find(':') != std::string::npos;
+  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", options_.host, v6 ? "]" : "",
+                     port_, options_.token);
+}
+
+// The names this server answers to: its own address, and localhost's when it listens there.
+bool StudioServer::allowed_host(const std::string& host) const {
+  const std::string port = ":" + std::to_string(port_);
+  std::vector<std::string> names = {options_.host};
+  if (options_.host == "127.0.0.1" || options_.host == "localhost" || options_.host == "::1") {
+    names = {"127.0.0.1", "localhost", "[::1]"};
+  } else if (options_.host.find(':') != std::string::npos) {
+    names = {"[" + options_.host + "]"};
+  }
+  for (const auto& name : names) {
+    if (host == name + port) return true;
+  }
+  return false;
+}
+
+void StudioServer::add_routes() {
+  server_->set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (!allowed_host(req.get_header_value("Host"))) {
+      send_error(res, 403, "this server answers only to its own address (Host header)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    const std::string origin = req.get_header_value("Origin");
+    if (!origin.empty() && (origin.rfind("http://", 0) != 0 || !allowed_host(origin.substr(7)))) {
+      send_error(res, 403, "requests from other sites are refused (Origin header)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    const std::string token = req.has_param("token") ? req.get_param_value("token")
+                                                     : req.get_header_value("X-Rigc-Token");
+    if (!same_token(token, options_.token)) {
+      send_error(res, 403, "a valid token is required: open the address `rigc studio` printed");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  server_->set_exception_handler(
+      [](const httplib::Request&, httplib::Response& res, std::exception_ptr error) {
+        std::string message = "internal error";
+        try {
+          std::rethrow_exception(error);
+        } catch (const std::exception& e) {
+          message = std::string("internal error: ") + e.what();
+        } catch (...) {
+        }
+        send_error(res, 500, message);
+      });
+  server_->set_error_handler([](const httplib::Request&, httplib::Response& res) {
+    if (res.body.empty()) send_error(res, res.status, "no such request");
+  });
+  add_page_routes();
+  add_edit_routes();
+}
+
+void StudioServer::add_page_routes() {
+  auto serve = [this](const char* route, std::string_view body, const char* type) {
+    server_->Get(route, [body, type](const httplib::Request&, httplib::Response& res) {
+      res.set_content(std::string(body), type);
+      res.set_header("Cache-Control", "no-store");
+    });
+  };
+  server_->Get("/", [this](const httplib::Request&, httplib::Response& res) {
+    std::string html(page::k_index_html);
+    for (size_t at; (at = html.find("@TOKEN@")) != std::string::npos;) {
+      html.replace(at, 7, options_.token);
+    }
+    res.set_content(html, "text/html; charset=utf-8");
+    res.set_header("Cache-Control", "no-store");
+  });
+  serve("/studio.js", page::k_studio_js, "text/javascript");
+  serve("/studio.css", page::k_studio_css, "text/css");
+  auto three = [this](const char* route, std::string file) {
+    server_->Get(route, [file](const httplib::Request&, httplib::Response& res) {
+      const std::string body = read_file(kThreeDir + file);
+      if (body.empty()) {
+        return send_error(res, 404, "install libjs-three (Debian) for the 3D coverage view");
+      }
+      res.set_content(body, "text/javascript");
+    });
+  };
+  three("/three/three.min.js", "build/three.min.js");
+  three("/three/OrbitControls.js", "examples/js/controls/OrbitControls.js");
+
+  server_->Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
+    session_.reload_if_changed();
+    send_json(res, session_.state());
+  });
+  server_->Get("/api/frame", [this](const httplib::Request& req, httplib::Response& res) {
+    const int full_width = session_.sensor_width_px();
+    double width = 1280;
+    if (req.has_param("width")) {
+      width = std::strtod(req.get_param_value("width").c_str(), nullptr);
+      if (!(width >= 64 && width <= 4096)) {
+        return send_error(res, 400, "width must be 64..4096 pixels");
+      }
+    }
+    std::string error;
+    const auto frame = session_.frame(std::min(1.0, width / full_width), &error);
+    if (!frame) return send_error(res, 500, error);
+    std::string bins;
+    for (const int count : frame->histogram.bins)
+      bins += (bins.empty() ? "" : ",") + std::to_string(count);
+    res.set_header("X-Rigc-Histogram", bins);
+    res.set_header("X-Rigc-Clipped", fmt::format("{:.5f}", frame->histogram.clipped));
+    res.set_header("X-Rigc-Mean", fmt::format("{:.3f}", frame->histogram.mean_luma));
+    res.set_header("X-Rigc-Render-Ms", fmt::format("{:.1f}", frame->render_ms));
+    std::string stages;
+    for (const auto& [stage, ms] : frame->stage_ms) {
+      stages += fmt::format("{}{}={:.1f}", stages.empty() ? "" : ",", stage, ms);
+    }
+    res.set_header("X-Rigc-Stages", stages);
+    res.set_header("X-Rigc-Encode-Ms", fmt::format("{:.1f}", frame->encode_ms));
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(frame->jpeg, "image/jpeg");
+  });
+  server_->Get("/api/coverage", [this](const httplib::Request&, httplib::Response& res) {
+    send_json(res, session_.coverage());
+  });
+  server_->Get("/api/advice", [this](const httplib::Request&, httplib::Response& res) {
+    send_json(res, session_.advice());
+  });
+  server_->Get("/api/mesh", [this](const httplib::Request&, httplib::Response& res) {
+    send_json(res, session_.mesh());
+  });
+}
+
+void StudioServer::add_edit_routes() {
+  server_->Post("/api/set", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto body = json_body(req, res);
+    if (!body) return;
+    if (!body->contains("path") || !(*body)["path"].is_string() || !body->contains("value") ||
+        !(*body)["value"].is_string()) {
+      return send_error(res, 400,
+                        "set takes {\"path\": \"camera.lens.focal_length\", "
+                        "\"value\": \"35mm\"}");
+    }
+    ScenePath path;
+    std::stringstream parts((*body)["path"].get<std::string>());
+    for (std::string part; std::getline(parts, part, '.');) path.push_back(part);
+    send_outcome(res, session_.set_value(path, (*body)["value"]));
+  });
+  server_->Post("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto body = json_body(req, res);
+    if (!body) return;
+    const auto position = vec3(body->value("position", nlohmann::json()));
+    const auto look_at = vec3(body->value("look_at", nlohmann::json()));
+    const nlohmann::json angle = body->value("turntable_deg", nlohmann::json(0.0));
+    if (!position || !look_at || !angle.is_number()) {
+      return send_error(res, 400,
+                        "view takes position and look_at ([x, y, z] in metres) and "
+                        "turntable_deg");
+    }
+    send_outcome(res, session_.set_view(
+                          {*position, *look_at, angle.get<double>() * std::numbers::pi / 180}));
+  });
+  server_->Post("/api/lights/add", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto body = json_body(req, res);
+    if (!body) return;
+    std::string entry;
+    for (const auto& [key, value] : body->items()) {
+      const bool word =
+          !key.empty() && key.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") == std::string::npos;
+      if (!word || !value.is_string() || !is_safe_value_text(value.get<std::string>())) {
+        return send_error(res, 400, "a light is a map of scene-language values");
+      }
+      entry += (entry.empty() ? "" : ", ") + key + ": " + value.get<std::string>();
+    }
+    send_outcome(res, session_.add_light("{" + entry + "}"));
+  });
+  server_->Post("/api/lights/remove", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto body = json_body(req, res);
+    if (!body) return;
+    if (!body->contains("index") || !(*body)["index"].is_number_unsigned()) {
+      return send_error(res, 400, "remove takes {\"index\": N}");
+    }
+    send_outcome(res, session_.remove_light((*body)["index"].get<size_t>()));
+  });
+  auto action = [this](const char* route, Outcome (Session::*method)()) {
+    server_->Post(route, [this, method](const httplib::Request&, httplib::Response& res) {
+      send_outcome(res, (session_.*method)());
+    });
+  };
+  action("/api/capture", &Session::capture);
+  action("/api/undo", &Session::undo);
+  action("/api/save", &Session::save);
+}
+
+}  // namespace rigc::studio

@@ -1,0 +1,231 @@
+// The studio's HTTP API, through a real server on an ephemeral port and httplib's client.
+#include "studio/server.h"
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <thread>
+
+#include "compiler/frontend.h"
+#include "studio/studio_test_scene.h"
+#include "tests/test_support.h"
+
+namespace rigc::studio {
+namespace {
+
+std::string read(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class StudioApi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_file_ = dir_.path() / "scene.yaml";
+    std::ofstream(scene_file_) << kStudioTestScene;
+    std::string error;
+    session_ = Session::open(scene_file_, &error);
+    ASSERT_TRUE(session_) << error;
+    server_ = std::make_unique<StudioServer>(*session_, ServerOptions{});
+    const int port = server_->bind(&error);
+    ASSERT_GT(port, 0) << error;
+    thread_ = std::thread([this] { server_->run(); });
+    while (!server_->is_running()) std::this_thread::yield();
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port);
+    client_->set_read_timeout(60);
+    client_->set_default_headers({{"X-Rigc-Token", server_->token()}});
+  }
+  void TearDown() override {
+    if (server_) server_->stop();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  nlohmann::json state() {
+    const auto res = client_->Get("/api/state");
+    EXPECT_TRUE(res && res->status == 200);
+    return nlohmann::json::parse(res->body);
+  }
+  httplib::Result post(const std::string& path, const nlohmann::json& body) {
+    return client_->Post(path.c_str(), body.dump(), "application/json");
+  }
+  double frame_mean(int width = 320) {
+    const auto res = client_->Get(("/api/frame?width=" + std::to_string(width)).c_str());
+    EXPECT_TRUE(res && res->status == 200);
+    return std::stod(res->get_header_value("X-Rigc-Mean"));
+  }
+
+  testing::TempDir dir_;
+  std::filesystem::path scene_file_;
+  std::unique_ptr<Session> session_;
+  std::unique_ptr<StudioServer> server_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(StudioApi, FrameIsAJpegOfTheRequestedWidthWithItsHistogram) {
+  const auto res = client_->Get("/api/frame?width=320");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "image/jpeg");
+  ASSERT_GT(res->body.size(), 1000u);
+  EXPECT_EQ(static_cast<unsigned char>(res->body[0]), 0xFF);
+  EXPECT_EQ(static_cast<unsigned char>(res->body[1]), 0xD8);
+  std::vector<long> bins;
+  std::stringstream parts(res->get_header_value("X-Rigc-Histogram"));
+  for (std::string part; std::getline(parts, part, ',');) bins.push_back(std::stol(part));
+  ASSERT_EQ(bins.size(), 256u);
+  const long pixels = std::accumulate(bins.begin() + 192, bins.end(), 0L);
+  EXPECT_EQ(pixels, 320L * 213);  // the canon-6d's 3:2 sensor at 320 px across
+  EXPECT_GT(std::stod(res->get_header_value("X-Rigc-Mean")), 5);
+}
+
+TEST_F(StudioApi, ALongerShutterBrightensTheFrameAndChangesTheState) {
+  const double before = frame_mean();
+  const auto res = post("/api/set", {{"path", "camera.exposure.shutter"}, {"value", "1/30"}});
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_NEAR(state()["camera"]["shutter_s"].get<double>(), 1.0 / 30, 1e-9);
+  EXPECT_TRUE(state()["unsaved"].get<bool>());
+  EXPECT_GT(frame_mean(), before * 1.3);
+}
+
+TEST_F(StudioApi, AnOutOfRangeValueIsRefusedWithTheCompilersMessage) {
+  const auto res = post("/api/set", {{"path", "camera.exposure.aperture"}, {"value", "f/0.8"}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 422);
+  const std::string message = nlohmann::json::parse(res->body)["error"];
+  EXPECT_NE(message.find("scene.yaml:"), std::string::npos) << message;
+  EXPECT_NE(message.find("error: aperture f/0.8 is outside"), std::string::npos) << message;
+  EXPECT_NE(message.find("aperture: f/0.8"), std::string::npos) << "the source line: " << message;
+  EXPECT_DOUBLE_EQ(state()["camera"]["aperture"].get<double>(), 11);  // the last good scene
+}
+
+TEST_F(StudioApi, ACameraBelowTheFloorOrInTheTableIsRefused) {
+  auto res = post("/api/view", {{"position", {0.5, -0.5, -0.2}}, {"look_at", {0, 0, 0.8}}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 422);
+  EXPECT_NE(res->body.find("below the floor"), std::string::npos) << res->body;
+  res = post("/api/view", {{"position", {0.05, 0, 0.74}}, {"look_at", {0, 0, 0.9}}});
+  EXPECT_EQ(res->status, 422);
+  EXPECT_NE(res->body.find("inside the turntable"), std::string::npos) << res->body;
+  res = post("/api/view",
+             {{"position", {0.6, -0.6, 1.1}}, {"look_at", {0, 0, 0.85}}, {"turntable_deg", 30}});
+  EXPECT_EQ(res->status, 200) << res->body;
+  EXPECT_NEAR(state()["view"]["turntable_deg"].get<double>(), 30, 1e-9);
+}
+
+TEST_F(StudioApi, CaptureAddsAShotToTheCoverageAndUndoTakesItBack) {
+  const int shots = state()["shots"];
+  auto coverage = nlohmann::json::parse(client_->Get("/api/coverage")->body);
+  EXPECT_EQ(coverage["shots"].get<int>(), shots);
+  const double seen_before = coverage["seen_1"];
+  ASSERT_EQ(post("/api/view", {{"position", {0, -0.8, 1.0}}, {"look_at", {0, 0, 0.85}}})->status,
+            200);
+  ASSERT_EQ(post("/api/capture", {})->status, 200);
+  EXPECT_EQ(state()["shots"].get<int>(), shots + 1);
+  coverage = nlohmann::json::parse(client_->Get("/api/coverage")->body);
+  EXPECT_EQ(coverage["shots"].get<int>(), shots + 1);
+  EXPECT_GT(coverage["seen_1"].get<double>(), seen_before + 0.1);
+  EXPECT_NE(coverage["table"].get<std::string>().find("shot_001"), std::string::npos);
+  ASSERT_EQ(post("/api/undo", {})->status, 200);
+  EXPECT_EQ(state()["shots"].get<int>(), shots);
+  EXPECT_EQ(post("/api/undo", {})->status, 422);  // nothing left to undo
+}
+
+TEST_F(StudioApi, SaveWritesTheEditsAndCapturesAndKeepsTheComments) {
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.aperture"}, {"value", "f/8"}})->status,
+            200);
+  ASSERT_EQ(post("/api/capture", {})->status, 200);
+  EXPECT_EQ(read(scene_file_), kStudioTestScene);  // nothing written before the save
+  ASSERT_EQ(post("/api/save", {})->status, 200);
+  const std::string saved = read(scene_file_);
+  EXPECT_NE(saved.find("# The studio's test scene"), std::string::npos);
+  EXPECT_NE(saved.find("    # the key light, left of the camera\n"), std::string::npos);
+  EXPECT_NE(saved.find("exposure: {aperture: f/8, shutter: 1/125, iso: 200}  # daylight"),
+            std::string::npos)
+      << saved;
+  EXPECT_NE(saved.find("\n  - pose: {position: ["), std::string::npos) << saved;
+  DiagnosticEngine diag;
+  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  const auto scene = compile_scene_file(scene_file_.string(), diag);
+  ASSERT_TRUE(scene);
+  EXPECT_EQ(scene->shots.size(), 2u);
+  EXPECT_DOUBLE_EQ(scene->camera.aperture_f_number, 8);
+  EXPECT_FALSE(state()["unsaved"].get<bool>());
+}
+
+TEST_F(StudioApi, ReloadsTheFileAndShowsItsErrorsKeepingTheLastGoodScene) {
+  std::string text = kStudioTestScene;
+  text.replace(text.find("iso: 200"), 8, "iso: 400");
+  std::ofstream(scene_file_) << text;
+  EXPECT_DOUBLE_EQ(state()["camera"]["iso"].get<double>(), 400);
+  text.replace(text.find("iso: 400"), 8, "iso: -3");
+  std::ofstream(scene_file_) << text;
+  const nlohmann::json broken = state();
+  const std::string error = broken["file_error"];
+  EXPECT_NE(error.find("scene.yaml:"), std::string::npos) << error;
+  EXPECT_NE(error.find(": error: "), std::string::npos) << error;
+  EXPECT_NE(error.find("iso: -3"), std::string::npos) << "the source line: " << error;
+  EXPECT_DOUBLE_EQ(broken["camera"]["iso"].get<double>(), 400);
+  EXPECT_EQ(client_->Get("/api/frame?width=200")->status, 200);
+}
+
+TEST_F(StudioApi, BadRequestsGetA4xxAndTheServerStaysUp) {
+  httplib::Client bare("127.0.0.1", server_->port());
+  EXPECT_EQ(bare.Get("/api/state")->status, 403);
+  EXPECT_EQ(bare.Get("/?token=0123")->status, 403);
+  EXPECT_EQ(bare.Get(("/?token=" + server_->token()).c_str())->status, 200);
+  const std::string port = std::to_string(server_->port());
+  EXPECT_EQ(client_->Get("/api/state", {{"Host", "evil.example:" + port}})->status, 403);
+  EXPECT_EQ(client_->Get("/api/state", {{"Origin", "http://evil.example"}})->status, 403);
+  EXPECT_EQ(client_->Get("/api/state", {{"Origin", "http://localhost:" + port}})->status, 200);
+  EXPECT_EQ(client_->Post("/api/set", "{not json", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post("/api/set", "[1, 2]", "application/json")->status, 400);
+  EXPECT_EQ(post("/api/set", {{"path", "object.mesh"}, {"value", "/etc/passwd"}})->status, 422);
+  EXPECT_EQ(post("/api/set", {{"path", "camera.body"}, {"value", "x}\nobject: {"}})->status, 422);
+  EXPECT_EQ(post("/api/view", {{"position", "up"}})->status, 400);
+  EXPECT_EQ(post("/api/lights/remove", {{"index", 99}})->status, 422);
+  EXPECT_EQ(post("/api/lights/add", {{"type", "point"}, {"position: [1", "2]"}})->status, 400);
+  EXPECT_EQ(client_->Get("/api/frame?width=5")->status, 400);
+  EXPECT_EQ(client_->Get("/api/nothing")->status, 404);
+  EXPECT_EQ(client_->Get("/api/state")->status, 200);
+}
+
+TEST_F(StudioApi, LightsAreAddedChangedAndRemoved) {
+  const size_t lights = state()["studio"]["lights"].size();
+  ASSERT_EQ(post("/api/lights/add",
+                 {{"type", "point"}, {"position", "[1m, -1m, 1.5m]"}, {"power", "150W"}})
+                ->status,
+            200);
+  EXPECT_EQ(state()["studio"]["lights"].size(), lights + 1);
+  ASSERT_EQ(post("/api/set", {{"path", "studio.lights." + std::to_string(lights) + ".power"},
+                              {"value", "250W"}})
+                ->status,
+            200);
+  EXPECT_DOUBLE_EQ(state()["studio"]["lights"][lights]["power_w"].get<double>(), 250);
+  ASSERT_EQ(post("/api/lights/remove", {{"index", 0}})->status, 200);
+  EXPECT_EQ(state()["studio"]["lights"].size(), lights);
+  ASSERT_EQ(
+      post("/api/set", {{"path", "studio.backdrop.green_screen"}, {"value", "false"}})->status,
+      200);
+  EXPECT_FALSE(state()["studio"]["green_screen"].get<bool>());
+}
+
+TEST_F(StudioApi, AdviceComesAtTheScenesLines) {
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.shutter"}, {"value", "2s"}})->status, 200);
+  const auto advice = nlohmann::json::parse(client_->Get("/api/advice")->body);
+  ASSERT_TRUE(advice.is_array());
+  bool exposure_line = false;
+  for (const auto& d : advice) {
+    exposure_line = exposure_line || d["line"].get<int>() == kStudioTestSceneExposureLine;
+  }
+  EXPECT_TRUE(exposure_line) << advice.dump(1);
+}
+
+}  // namespace
+}  // namespace rigc::studio

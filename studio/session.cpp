@@ -1,0 +1,456 @@
+#include "studio/session.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "analysis/advice.h"
+#include "analysis/coverage_output.h"
+#include "backends/registry.h"
+#include "compiler/diagnostics.h"
+#include "compiler/frontend.h"
+#include "compiler/presets.h"
+#include "io/atomic_file.h"
+#include "plan/scene_text.h"
+#include "run/run_loop.h"
+#include "studio/frame_encoding.h"
+
+namespace rigc::studio {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Compiled {
+  std::optional<ir::Scene> scene;
+  std::string diagnostics;  // rendered errors, each with its source line
+};
+
+Compiled compile_text(const std::string& text, const fs::path& file) {
+  Compiled out;
+  DiagnosticEngine diag;
+  diag.set_handler([&](const Diagnostic& d, const std::string& rendered) {
+    if (d.severity == Severity::kError) out.diagnostics += rendered;
+  });
+  out.scene = compile_scene_text(text, file.string(), file.parent_path().string(), diag);
+  if (!out.scene && out.diagnostics.empty()) out.diagnostics = "the scene does not compile\n";
+  return out;
+}
+
+// A number in metres as scene text, to the tenth of a millimetre.
+std::string metres(double value) {
+  return fmt::format("{:.4f}m", value);
+}
+
+std::string point_text(const Eigen::Vector3d& p) {
+  return fmt::format("[{}, {}, {}]", metres(p.x()), metres(p.y()), metres(p.z()));
+}
+
+// Whether the scene's focus is `auto` (the IR keeps only the distances it gave each shot).
+bool scene_focus_auto(const std::string& text) {
+  try {
+    const YAML::Node focus = YAML::Load(text)["camera"]["focus"];
+    return !focus || (focus.IsScalar() && focus.Scalar() == "auto");
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* error) {
+  std::unique_ptr<Session> session(new Session());
+  session->file_ = scene_file;
+  session->disk_text_ = session->read_disk(error);
+  if (!error->empty()) return nullptr;
+  const Outcome outcome = session->apply_text(session->disk_text_);
+  if (!outcome.ok) {
+    *error = outcome.message;
+    return nullptr;
+  }
+  // The first view: the scene's first shot.
+  const ir::Shot& first = session->scene_->shots.front();
+  View view;
+  view.position = first.world_from_camera.block<3, 1>(0, 3);
+  view.look_at = view.position + first.focus_distance_m * first.world_from_camera.block<3, 1>(0, 2);
+  view.turntable_rad = first.turntable_angle_rad;
+  const Outcome viewed = session->compile_view(view);
+  if (!viewed.ok) {
+    *error = viewed.message;
+    return nullptr;
+  }
+  session->preview_ = backends::find_backend("preview")->make();
+  return session;
+}
+
+std::string Session::read_disk(std::string* error) const {
+  std::ifstream in(file_, std::ios::binary);
+  if (!in) {
+    *error = fmt::format("rigc: error: cannot read {}\n", file_.string());
+    return {};
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  error->clear();
+  return text.str();
+}
+
+// Compiles `text`; when it compiles it becomes the session's scene (the view is recompiled on
+// it), otherwise the last good scene stays and the diagnostics are the message.
+Outcome Session::apply_text(std::string text) {
+  Compiled compiled = compile_text(text, file_);
+  if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+  auto scene = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
+  auto studio = std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
+  const std::string previous = text_;
+  auto previous_scene = scene_;
+  auto previous_studio = studio_;
+  text_ = std::move(text);
+  scene_ = scene;
+  studio_ = studio;
+  if (view_scene_) {
+    const Outcome viewed = compile_view(view_);
+    if (!viewed.ok) {
+      text_ = previous;
+      scene_ = previous_scene;
+      studio_ = previous_studio;
+      return viewed;
+    }
+  }
+  coverage_.reset();
+  ++revision_;
+  return {};
+}
+
+std::string Session::view_pose_text(const View& view) const {
+  return fmt::format("{{pose: {{position: {}, look_at: {}, turntable: {:.3f}deg}}}}",
+                     point_text(view.position), point_text(view.look_at),
+                     view.turntable_rad * 180 / std::numbers::pi);
+}
+
+// The view is compiled as the scene's only shot, so the compiler places it, focuses it and
+// refuses it (below the floor, inside the table) with its own message.
+Outcome Session::compile_view(const View& view) {
+  std::string error;
+  std::string pose = view_pose_text(view);
+  pose = pose.substr(1, pose.size() - 2);  // the entry without its braces
+  const auto text = plan::replace_shots_section(text_, "shots:\n  - " + pose + "\n", &error);
+  if (!text) return Outcome::fail(error);
+  Compiled compiled = compile_text(*text, file_);
+  if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+  view_scene_ = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
+  view_ = view;
+  ++revision_;
+  return {};
+}
+
+Outcome Session::set_value(const ScenePath& path, const std::string& value) {
+  std::lock_guard lock(mutex_);
+  if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
+    return Outcome::fail("only camera.* and studio.* values can be set");
+  }
+  std::string error;
+  const auto text = studio::set_value(text_, path, value, &error);
+  if (!text) return Outcome::fail(error);
+  return push_text(*text);
+}
+
+Outcome Session::add_light(const std::string& entry) {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  const auto text = append_to_list(text_, {"studio", "lights"}, entry, &error);
+  if (!text) return Outcome::fail(error);
+  return push_text(*text);
+}
+
+Outcome Session::remove_light(size_t index) {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  const auto text = remove_from_list(text_, {"studio", "lights"}, index, &error);
+  if (!text) return Outcome::fail(error);
+  return push_text(*text);
+}
+
+// A change the user can undo.
+Outcome Session::push_text(const std::string& text) {
+  const std::string before = text_;
+  const Outcome outcome = apply_text(text);
+  if (outcome.ok) undo_texts_.push_back(before);
+  return outcome;
+}
+
+Outcome Session::set_view(const View& view) {
+  std::lock_guard lock(mutex_);
+  if (!view.position.allFinite() || !view.look_at.allFinite() ||
+      !std::isfinite(view.turntable_rad)) {
+    return Outcome::fail("the view's numbers must be finite");
+  }
+  return compile_view(view);
+}
+
+Outcome Session::capture() {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  std::string entry = view_pose_text(view_);
+  entry = entry.substr(1, entry.size() - 2);
+  const auto text = append_to_list(text_, {"shots"}, entry, &error);
+  if (!text) return Outcome::fail(error);
+  const Outcome outcome = push_text(*text);
+  if (outcome.ok) ++captures_;
+  return outcome;
+}
+
+Outcome Session::undo() {
+  std::lock_guard lock(mutex_);
+  if (undo_texts_.empty()) return Outcome::fail("nothing to undo");
+  const std::string text = undo_texts_.back();
+  const Outcome outcome = apply_text(text);
+  if (outcome.ok) undo_texts_.pop_back();
+  return outcome;
+}
+
+// The session's text compiled when it was applied, so the file written always compiles; the
+// write is atomic.
+Outcome Session::save() {
+  std::lock_guard lock(mutex_);
+  const Compiled compiled = compile_text(text_, file_);
+  if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+  std::string error;
+  if (!write_file_atomically(file_, text_, &error)) return Outcome::fail("rigc: error: " + error);
+  disk_text_ = text_;
+  file_error_.clear();
+  return {};
+}
+
+void Session::reload_if_changed() {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  const std::string text = read_disk(&error);
+  if (!error.empty() || text == disk_text_) return;
+  disk_text_ = text;
+  const std::string before = text_;
+  const Outcome outcome = apply_text(text);
+  file_error_ = outcome.ok ? "" : outcome.message;
+  ++revision_;
+  if (outcome.ok && before != text) undo_texts_.push_back(before);
+}
+
+namespace {
+
+nlohmann::json vec_json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+nlohmann::json camera_json(const ir::Camera& c) {
+  const double ev100 =
+      std::log2(c.aperture_f_number * c.aperture_f_number / c.shutter_s) - std::log2(c.iso / 100);
+  return {{"body", c.body},
+          {"make", c.make},
+          {"model", c.model},
+          {"sensor_mm", {c.sensor_width_m * 1000, c.sensor_height_m * 1000}},
+          {"pixels", {c.width_px, c.height_px}},
+          {"focal_length_mm", c.focal_length_m * 1000},
+          {"aperture", c.aperture_f_number},
+          {"shutter_s", c.shutter_s},
+          {"iso", c.iso},
+          {"white_balance_auto", c.white_balance == ir::WhiteBalanceMode::kAuto},
+          {"white_balance_k", c.white_balance_k},
+          {"ev100", ev100}};
+}
+
+nlohmann::json lights_json(const std::vector<ir::Light>& lights) {
+  static const char* kTypes[] = {"point", "spot", "directional", "area"};
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& light : lights) {
+    out.push_back({{"type", kTypes[static_cast<int>(light.type)]},
+                   {"position", vec_json(light.position)},
+                   {"power_w", light.power_w},
+                   {"illuminance_lx", light.illuminance_lx},
+                   {"temperature_k", light.temperature_k},
+                   {"size_m", {light.size_m.x(), light.size_m.y()}},
+                   {"line", light.loc.line}});
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json Session::state() {
+  std::lock_guard lock(mutex_);
+  const ir::Scene& scene = *scene_;
+  const ir::Shot& view_shot = view_scene_->shots.front();
+  const auto focus = scene_focus_auto(text_);
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const auto& preset : body_presets()) bodies.push_back(preset.name);
+  const Eigen::Vector3d center =
+      (ir::world_from_object(scene, view_.turntable_rad) *
+       ((scene.object.bounds_min_object + scene.object.bounds_max_object) / 2).homogeneous())
+          .head<3>();
+  return {{"file", file_.filename().string()},
+          {"name", scene.name},
+          {"unsaved", text_ != disk_text_},
+          {"file_error", file_error_},
+          {"captures", captures_},
+          {"revision", revision_},
+          {"can_undo", !undo_texts_.empty()},
+          {"shots", scene.shots.size()},
+          {"camera", camera_json(scene.camera)},
+          {"focus_auto", focus},
+          {"view",
+           {{"position", vec_json(view_.position)},
+            {"look_at", vec_json(view_.look_at)},
+            {"turntable_deg", view_.turntable_rad * 180 / std::numbers::pi},
+            {"focus_distance_m", view_shot.focus_distance_m}}},
+          {"object_center", vec_json(center)},
+          {"studio",
+           {{"turntable_diameter_m", scene.studio.turntable.diameter_m},
+            {"turntable_height_m", scene.studio.turntable.height_m},
+            {"green_screen", scene.studio.backdrop.green_screen},
+            {"ambient_lx", scene.studio.ambient_lx},
+            {"lights", lights_json(scene.studio.lights)}}},
+          {"bodies", bodies}};
+}
+
+std::optional<Frame> Session::frame(double scale, std::string* error) {
+  std::shared_ptr<const ir::Scene> scene, view;
+  std::shared_ptr<const scene::StudioScene> studio;
+  {
+    std::lock_guard lock(mutex_);
+    scene = scene_;
+    view = view_scene_;
+    studio = studio_;
+  }
+  std::lock_guard render_lock(render_mutex_);
+  const auto start = Clock::now();
+  const ir::Shot& shot = view->shots.front();
+  run::RenderSettings settings;
+  settings.scale = scale;
+  if (!settings.check(error)) return std::nullopt;
+  run::RenderedShot rendered;
+  if (!preview_->render(*scene, *studio, shot, settings, {}, &rendered, error)) return std::nullopt;
+  error->clear();
+  std::map<std::string, double> stages = rendered.stage_ms;
+  dslr::DevelopResult developed =
+      run::develop_shot(*scene, shot, std::move(rendered), settings, false, error, &stages);
+  if (developed.encoded_bytes.empty()) {
+    developed.encoded_bytes.assign(developed.encoded.begin(), developed.encoded.end());
+  }
+  if (developed.encoded_bytes.empty()) {
+    if (error->empty()) *error = "the DSLR model produced no image";
+    return std::nullopt;
+  }
+  Frame frame;
+  frame.width = developed.width;
+  frame.height = developed.height;
+  frame.render_ms = ms_since(start);
+  frame.stage_ms = std::move(stages);
+  const auto encode_start = Clock::now();
+  frame.jpeg = encode_jpeg(developed.encoded_bytes, frame.width, frame.height, 90, error);
+  if (frame.jpeg.empty()) return std::nullopt;
+  frame.histogram = histogram_of(developed.encoded_bytes);
+  frame.encode_ms = ms_since(encode_start);
+  return frame;
+}
+
+// The coverage `rigc coverage` computes (its default options), kept until the scene changes.
+nlohmann::json Session::coverage() {
+  std::shared_ptr<const ir::Scene> scene;
+  std::shared_ptr<const scene::StudioScene> studio;
+  {
+    std::lock_guard lock(mutex_);
+    if (coverage_) return coverage_json(*scene_, *coverage_);
+    scene = scene_;
+    studio = studio_;
+  }
+  std::lock_guard analysis_lock(analysis_mutex_);
+  const auto start = Clock::now();
+  analysis::CoverageResult result = analysis::analyse_coverage(*scene, *studio);
+  const double ms = ms_since(start);
+  std::lock_guard lock(mutex_);
+  nlohmann::json out = coverage_json(*scene, result);
+  out["analysis_ms"] = ms;
+  if (scene == scene_) coverage_ = std::move(result);
+  return out;
+}
+
+nlohmann::json Session::coverage_json(const ir::Scene& scene,
+                                      const analysis::CoverageResult& coverage) const {
+  std::ostringstream table;
+  analysis::print_coverage_table(scene, coverage, table);
+  const analysis::ShotCoverage& last = coverage.shots.back();
+  return {{"views", coverage.views},
+          {"reconstructable_faces", coverage.reconstructable},
+          {"table", table.str()},
+          {"shots", coverage.shots.size()},
+          {"seen_1", last.seen_1},
+          {"seen_2", last.seen_2},
+          {"reconstructable", last.reconstructable},
+          {"new", last.new_area_m2 / coverage.total_area_m2},
+          {"overlap", last.overlap_with_previous}};
+}
+
+// The warnings `rigc check` prints, at the same reduced resolution.
+nlohmann::json Session::advice() {
+  std::shared_ptr<const ir::Scene> scene;
+  std::shared_ptr<const scene::StudioScene> studio;
+  {
+    std::lock_guard lock(mutex_);
+    scene = scene_;
+    studio = studio_;
+  }
+  std::lock_guard analysis_lock(analysis_mutex_);
+  DiagnosticEngine diag;
+  diag.add_source(file_.string(), text_snapshot(scene));
+  nlohmann::json out = nlohmann::json::array();
+  diag.set_handler([&](const Diagnostic& d, const std::string& rendered) {
+    out.push_back({{"line", d.loc.line},
+                   {"col", d.loc.col},
+                   {"severity", d.severity == Severity::kError ? "error" : "warning"},
+                   {"message", d.message},
+                   {"rendered", rendered}});
+  });
+  analysis::CoverageOptions options;
+  options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
+  const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, *studio, options);
+  analysis::report_capture_advice(*scene, *studio, coverage, diag);
+  return out;
+}
+
+std::string Session::text_snapshot(const std::shared_ptr<const ir::Scene>& scene) {
+  std::lock_guard lock(mutex_);
+  return scene == scene_ ? text_ : std::string();
+}
+
+// The object's mesh in the object frame, for the page's coverage view.
+nlohmann::json Session::mesh() {
+  std::shared_ptr<const ir::Scene> scene;
+  {
+    std::lock_guard lock(mutex_);
+    scene = scene_;
+  }
+  const std::vector<Eigen::Vector3f> positions = ir::object_frame_positions(scene->object);
+  std::vector<float> flat;
+  flat.reserve(positions.size() * 3);
+  for (const auto& p : positions) flat.insert(flat.end(), {p.x(), p.y(), p.z()});
+  std::vector<std::uint32_t> indices;
+  indices.reserve(scene->object.mesh.triangles.size() * 3);
+  for (const auto& t : scene->object.mesh.triangles)
+    indices.insert(indices.end(), t.begin(), t.end());
+  return {{"positions", flat}, {"triangles", indices}};
+}
+
+int Session::sensor_width_px() {
+  std::lock_guard lock(mutex_);
+  return scene_->camera.width_px;
+}
+
+}  // namespace rigc::studio

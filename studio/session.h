@@ -1,0 +1,106 @@
+// One studio session: the scene file's text as the user is changing it, its compiled IR and
+// renderable studio, the camera the user moves, and the captures. Every change is an edit of the
+// scene TEXT at the changed value's source span followed by a compile, so that out-of-range
+// values are refused with the compiler's own message and the last good scene stays.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/coverage.h"
+#include "ir/ir.h"
+#include "run/backend.h"
+#include "scene/studio_scene.h"
+#include "studio/frame_encoding.h"
+#include "studio/scene_edit.h"
+
+namespace rigc::studio {
+
+// The camera the user moves: a pose in the world, aimed at a point, with the turntable's angle.
+struct View {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d look_at = Eigen::Vector3d::Zero();
+  double turntable_rad = 0;
+};
+
+// What a request gets back: ok, or a message (with the compiler's diagnostics rendered as
+// `file:line:col: error: ...` and the source line) for a 4xx.
+struct Outcome {
+  bool ok = true;
+  std::string message;
+  static Outcome fail(std::string message) { return {false, std::move(message)}; }
+};
+
+// A developed frame of the current view.
+struct Frame {
+  std::string jpeg;
+  int width = 0, height = 0;
+  Histogram histogram;
+  double render_ms = 0;                    // render and development
+  std::map<std::string, double> stage_ms;  // the renderer's and the DSLR model's stages
+  double encode_ms = 0;
+};
+
+class Session {
+ public:
+  // Compiles the scene file; nullopt with the diagnostics in `error` when it does not compile.
+  static std::unique_ptr<Session> open(const std::filesystem::path& scene_file, std::string* error);
+
+  nlohmann::json state();
+  // Sets the value at `path` (camera.* or studio.* only) to scene-language text.
+  Outcome set_value(const ScenePath& path, const std::string& value);
+  Outcome add_light(const std::string& entry);
+  Outcome remove_light(size_t index);
+  Outcome set_view(const View& view);
+  Outcome capture();
+  Outcome undo();
+  Outcome save();
+  // Re-reads the file when it changed on disk: a good file replaces the scene (and the unsaved
+  // changes); a broken one is kept as `file_error` and the last good scene stays.
+  void reload_if_changed();
+
+  // The current view through the preview backend and the DSLR model; `scale` of the sensor.
+  std::optional<Frame> frame(double scale, std::string* error);
+  nlohmann::json coverage();
+  nlohmann::json advice();
+  nlohmann::json mesh();
+  int sensor_width_px();
+
+ private:
+  Session() = default;
+  Outcome apply_text(std::string text);
+  Outcome push_text(const std::string& text);
+  Outcome compile_view(const View& view);
+  std::string view_pose_text(const View& view) const;
+  std::string read_disk(std::string* error) const;
+  nlohmann::json coverage_json(const ir::Scene& scene,
+                               const analysis::CoverageResult& coverage) const;
+  std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
+
+  std::mutex mutex_;
+  // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
+  // takes seconds) does not hold up the live view.
+  std::mutex render_mutex_, analysis_mutex_;
+  std::filesystem::path file_;
+  std::string disk_text_;  // the file as last read or saved
+  std::string text_;       // the scene as the user changed it
+  std::vector<std::string> undo_texts_;
+  std::string file_error_;                  // the file on disk does not compile: its diagnostics
+  std::shared_ptr<const ir::Scene> scene_;  // text_ compiled, with every shot
+  std::shared_ptr<const scene::StudioScene> studio_;
+  std::shared_ptr<const ir::Scene> view_scene_;  // text_ with the view as its only shot
+  View view_;
+  int captures_ = 0;
+  int revision_ = 0;  // counts the changes, so the page knows when to refresh
+  std::optional<analysis::CoverageResult> coverage_;
+  std::unique_ptr<run::Backend> preview_;
+};
+
+}  // namespace rigc::studio
