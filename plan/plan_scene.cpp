@@ -100,6 +100,7 @@ bool analyse_candidates(const std::string& text, const PlanRequest& request, Pla
   outcome.candidate_coverage = analysis::analyse_coverage(*candidate_scene, studio, options);
   outcome.problem =
       make_problem(outcome.candidates, outcome.kept, *candidate_scene, outcome.candidate_coverage);
+  outcome.candidate_shots = candidate_scene->shots;
   return true;
 }
 

@@ -32,6 +32,7 @@ struct PlanOutcome {
   analysis::CoverageResult coverage;  // of the scene's own shots
   CandidateSet candidates;
   analysis::CoverageResult candidate_coverage;  // of every candidate, with sights
+  std::vector<ir::Shot> candidate_shots;        // as compiled: kept shots first, then candidates
   PlanProblem problem;
   PlanOptions options;
   Plan plan;

@@ -291,6 +291,15 @@ void StudioServer::add_edit_routes() {
       send_outcome(res, (session_.*method)());
     });
   };
+  server_->Post("/api/suggest", [this](const httplib::Request&, httplib::Response& res) {
+    Suggestion suggestion;
+    const Outcome outcome = session_.suggest_next_shot(&suggestion);
+    if (!outcome.ok) return send_error(res, 422, outcome.message);
+    send_json(res, {{"ok", true},
+                    {"gain", suggestion.gain},
+                    {"reconstructable", suggestion.reconstructable},
+                    {"entry", suggestion.entry}});
+  });
   action("/api/capture", &Session::capture);
   action("/api/undo", &Session::undo);
   action("/api/save", &Session::save);

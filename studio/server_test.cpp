@@ -137,6 +137,24 @@ TEST_F(StudioApi, CaptureAddsAShotToTheCoverageAndUndoTakesItBack) {
   EXPECT_EQ(post("/api/undo", {})->status, 422);  // nothing left to undo
 }
 
+TEST_F(StudioApi, SuggestMovesTheViewToThePlannersNextShot) {
+  const auto view_before = state()["view"];
+  const auto res = post("/api/suggest", {});
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto suggestion = nlohmann::json::parse(res->body);
+  EXPECT_GT(suggestion["gain"].get<double>(), 0.05);
+  EXPECT_NE(suggestion["entry"].get<std::string>().find("# Suggested by `rigc plan --next`"),
+            std::string::npos);
+  EXPECT_NE(state()["view"], view_before);
+  // Captured, the suggestion brings the coverage the planner promised.
+  ASSERT_EQ(post("/api/capture", {})->status, 200);
+  const auto coverage = nlohmann::json::parse(client_->Get("/api/coverage")->body);
+  EXPECT_EQ(coverage["shots"].get<int>(), 2);
+  EXPECT_NEAR(coverage["reconstructable"].get<double>(),
+              suggestion["reconstructable"].get<double>(), 0.01);
+}
+
 TEST_F(StudioApi, SaveWritesTheEditsAndCapturesAndKeepsTheComments) {
   ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.aperture"}, {"value", "f/8"}})->status,
             200);

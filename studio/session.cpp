@@ -16,6 +16,7 @@
 #include "compiler/frontend.h"
 #include "compiler/presets.h"
 #include "io/atomic_file.h"
+#include "plan/plan_scene.h"
 #include "plan/scene_text.h"
 #include "run/run_loop.h"
 #include "studio/frame_encoding.h"
@@ -207,6 +208,40 @@ Outcome Session::capture() {
   const Outcome outcome = push_text(*text);
   if (outcome.ok) ++captures_;
   return outcome;
+}
+
+Outcome Session::suggest_next_shot(Suggestion* suggestion) {
+  std::lock_guard analysing(analysis_mutex_);
+  plan::PlanRequest request;
+  {
+    std::lock_guard lock(mutex_);
+    request.scene_text = text_;
+  }
+  request.scene_path = request.output_path = file_.string();
+  request.keep_scene_shots = request.next_shot_only = true;
+  request.target = 1;
+  request.candidates.azimuth_step_rad = 20 * std::numbers::pi / 180;  // seconds, not tens
+  DiagnosticEngine diag;
+  std::ostringstream diagnostics;
+  diag.set_handler(
+      [&](const Diagnostic&, const std::string& rendered) { diagnostics << rendered; });
+  std::string error;
+  const auto outcome = plan::plan_scene(request, diag, &error);
+  if (!outcome) return Outcome::fail(error.empty() ? diagnostics.str() : error);
+  if (static_cast<int>(outcome->plan.shots.size()) <= outcome->kept) {
+    return Outcome::fail("no candidate pose adds reconstructable surface to the shots so far");
+  }
+  const plan::PlannedShot& next = outcome->plan.shots.back();
+  const ir::Shot& shot = outcome->candidate_shots[next.candidate];
+  View view;
+  view.position = shot.world_from_camera.block<3, 1>(0, 3);
+  view.look_at = view.position + shot.world_from_camera.block<3, 1>(0, 2) * shot.focus_distance_m;
+  view.turntable_rad = shot.turntable_angle_rad;
+  suggestion->gain = next.gain;
+  suggestion->reconstructable = next.reconstructable;
+  suggestion->entry = plan::planned_shots_text(*outcome);
+  std::lock_guard lock(mutex_);
+  return compile_view(view);
 }
 
 Outcome Session::undo() {

@@ -38,6 +38,13 @@ struct Outcome {
   static Outcome fail(std::string message) { return {false, std::move(message)}; }
 };
 
+// The shot the planner suggests next (`rigc plan --next`), now the current view.
+struct Suggestion {
+  double gain = 0;             // share of the surface it makes reconstructable
+  double reconstructable = 0;  // share with it and every shot before it
+  std::string entry;           // the shot as scene text, as `rigc plan --next` writes it
+};
+
 // A developed frame of the current view.
 struct Frame {
   std::string jpeg;
@@ -60,6 +67,8 @@ class Session {
   Outcome remove_light(size_t index);
   Outcome set_view(const View& view);
   Outcome capture();
+  // Moves the view to the pose that adds the most reconstructable surface to the shots so far.
+  Outcome suggest_next_shot(Suggestion* suggestion);
   Outcome undo();
   Outcome save();
   // Re-reads the file when it changed on disk: a good file replaces the scene (and the unsaved

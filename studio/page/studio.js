@@ -277,6 +277,7 @@ function bindPanels() {
     if (await post('api/lights/add', light)) changed();
   });
   $('capture').addEventListener('click', capture);
+  $('suggest').addEventListener('click', suggest);
   $('undo').addEventListener('click', async () => { if (await post('api/undo')) changed(); });
   $('save').addEventListener('click', async () => {
     if (await post('api/save')) { showStatus('saved'); await refreshState(); }
@@ -367,6 +368,18 @@ async function capture() {
   window.rigcBench.capture.push(performance.now() - started);
   await refreshState();
   scheduleAnalysis();
+}
+
+// The planner's next shot becomes the current view; capture takes it.
+async function suggest() {
+  showStatus('planning the next shot ...');
+  const res = await api('api/suggest', { method: 'POST', body: '{}',
+    headers: { 'Content-Type': 'application/json' } });
+  const reply = await res.json();
+  if (!res.ok) { showStatus(reply.error, true); return; }
+  await changed();
+  showStatus(`suggested: adds ${(100 * reply.gain).toFixed(1)} %, ` +
+    `${(100 * reply.reconstructable).toFixed(1)} % reconstructable with it; press Capture to take it`);
 }
 
 const coverageView = {};
