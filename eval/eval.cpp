@@ -11,6 +11,7 @@
 #include "eval/geometry.h"
 #include "eval/inputs.h"
 #include "eval/measure.h"
+#include "eval/photos.h"
 #include "eval/report.h"
 
 namespace rigc::eval {
@@ -43,6 +44,13 @@ bool EvalOptions::check(std::string* error) const {
     return refuse(
         fmt::format("{} ground-truth samples; at least 1 is needed", ground_truth_samples));
   }
+  if (!(std::isfinite(key_tolerance) && key_tolerance > 0 && key_tolerance <= 1)) {
+    return refuse(fmt::format(
+        "the key tolerance is {}; it must be in (0, 1] (a chromaticity distance)", key_tolerance));
+  }
+  if (photos_dir.empty() && (!masks_dir.empty() || !camera.empty())) {
+    return refuse("--masks and --camera are for photos (--photos DIR)");
+  }
   if (!(std::isfinite(color_range_mm) && color_range_mm >= 0)) {
     return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
                               color_range_mm));
@@ -70,11 +78,20 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   }
   const auto in = gather_inputs(o, log, sum);
   if (!in) return 1;
+  std::optional<PhotoSetup> photos;
+  if (in->photos) {
+    photos = prepare_photos(o, *in, log, &error);
+    if (!photos) {
+      log << "rigc eval: error: " << error << "\n";
+      return 1;
+    }
+  }
   EvalReport report(*in, log, sum);
+  if (photos) report.add_photos(*photos);
 
   EvalTimes times;
   times.setup = seconds_since(t_start);
-  const ColmapRun colmap = run_colmap(o, *in, log);
+  const ColmapRun colmap = run_colmap(o, *in, log, photos ? &*photos : nullptr);
   report.add_colmap(colmap);
   if (!colmap.ok) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);

@@ -38,6 +38,13 @@ struct EvalOptions {
   int ground_truth_samples = 200000;  // surface samples before the visibility test
   double color_range_mm = 0;          // heat-map colour range; 0 = 3 x RMS of the distances
   bool quiet = false;
+  // Photos (eval/photos.h): masks made elsewhere (same stems, any common format) instead of the
+  // chroma key; the key's tolerance (chromaticity distance); the camera when EXIF has none
+  // ("canon-6d,50mm"); accept a reconstruction of fewer than half of the photos.
+  std::string masks_dir;
+  double key_tolerance = 0.12;
+  std::string camera;
+  bool allow_partial = false;
 
   // False with a one-line `error` when a field is out of its range or the folders are not one
   // run folder or one photos folder. evaluate() checks it first.
