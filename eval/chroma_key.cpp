@@ -40,7 +40,7 @@ constexpr double kDarkestKeyed = 0.01;
 std::optional<KeyImage> read_key_image(const fs::path& path, int max_side, std::string* error) {
   OIIO::ImageBuf in(path.string());
   if (!in.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
-    *error = fmt::format("cannot read {}: {}", path.string(), in.geterror());
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), in.geterror());
     return std::nullopt;
   }
   const OIIO::ImageSpec& spec = in.spec();

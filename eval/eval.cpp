@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <ostream>
+#include <set>
 
 #include "eval/align.h"
 #include "eval/colmap.h"
@@ -65,6 +66,18 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// Photos of which fewer than half registered: the numbers describe a part of the object. An
+// error unless --allow-partial.
+bool too_few_registered(const EvalOptions& o, const EvalInputs& in, std::size_t registered,
+                        std::ostream& log) {
+  if (!in.photos || o.allow_partial || 2 * registered >= in.images.names.size()) return false;
+  log << fmt::format(
+      "rigc eval: error: only {} of the {} photos registered (fewer than half): the numbers "
+      "above describe part of the object (see the causes above; --allow-partial accepts it)\n",
+      registered, in.images.names.size());
+  return true;
+}
+
 }  // namespace
 
 int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
@@ -93,6 +106,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   times.setup = seconds_since(t_start);
   const ColmapRun colmap = run_colmap(o, *in, log, photos ? &*photos : nullptr);
   report.add_colmap(colmap);
+  const bool masked = colmap.prior.is_object() && colmap.prior.contains("masks");
+  if (!colmap.ok && photos && colmap.exit_code != 1) {
+    report.sections()["unregistered"] = report_unregistered(*in, &*photos, {}, masked, log);
+  }
   if (!colmap.ok) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);
   }
@@ -100,6 +117,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const auto model = read_sparse_model(colmap.model_txt, &error);
   if (!model) return report.fail("reconstruction", error, 2);
   report.add_reconstruction(*model, colmap, o.quiet);
+  std::set<std::string> registered;
+  for (const auto& image : model->images) registered.insert(image.name);
+  report.sections()["unregistered"] =
+      report_unregistered(*in, photos ? &*photos : nullptr, registered, masked, log);
   if (model->points.size() < 3) {
     return report.fail("reconstruction", "the reconstruction has fewer than 3 points", 2);
   }
@@ -121,7 +142,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   report.add_timing(colmap, times);
   if (!report.write()) return 2;
   if (!o.quiet) report.print_summary(o, colmap, m, times);
-  return 0;
+  return too_few_registered(o, *in, registered.size(), log) ? 2 : 0;
 }
 
 }  // namespace rigc::eval

@@ -42,9 +42,11 @@ bool write_full_size_mask(const fs::path& path, const std::vector<std::uint8_t>&
 
 // The still background of each working size that at least five photos share.
 std::map<std::pair<int, int>, StillBackground> still_backgrounds(
-    const std::vector<KeyImage>& pictures) {
+    const std::vector<std::optional<KeyImage>>& pictures) {
   std::map<std::pair<int, int>, std::vector<const KeyImage*>> by_size;
-  for (const auto& p : pictures) by_size[{p.width, p.height}].push_back(&p);
+  for (const auto& p : pictures) {
+    if (p) by_size[{p->width, p->height}].push_back(&*p);
+  }
   std::map<std::pair<int, int>, StillBackground> still;
   for (const auto& [size, group] : by_size) {
     if (auto s = still_background(group)) still[size] = std::move(*s);
@@ -72,11 +74,11 @@ std::vector<std::uint8_t> key_one(const KeyImage& picture, const std::optional<C
 
 bool key_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::path& dir, json& report,
                std::string* error) {
-  std::vector<KeyImage> pictures;
-  for (const auto& name : images.names) {
-    auto picture = read_key_image(images.dir / name, kKeySide, error);
-    if (!picture) return false;
-    pictures.push_back(std::move(*picture));
+  // A photo whose pixels cannot be read gets no mask; the COLMAP stage names it.
+  std::vector<std::optional<KeyImage>> pictures;
+  std::vector<std::string> unreadable(images.names.size());
+  for (std::size_t k = 0; k < images.names.size(); ++k) {
+    pictures.push_back(read_key_image(images.dir / images.names[k], kKeySide, &unreadable[k]));
   }
   std::optional<Chroma> hint;
   if (o.backdrop_color) hint = chroma_of_linear(*o.backdrop_color);
@@ -86,7 +88,11 @@ bool key_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::path
   report["tolerance"] = o.tolerance;
   json& by_photo = report["photos"];
   for (std::size_t k = 0; k < pictures.size(); ++k) {
-    const KeyImage& p = pictures[k];
+    if (!pictures[k]) {
+      by_photo[images.names[k]] = {{"mask", nullptr}, {"why_none", unreadable[k]}};
+      continue;
+    }
+    const KeyImage& p = *pictures[k];
     const auto s = still.find({p.width, p.height});
     if (s != still.end()) report["still_fraction"] = s->second.still_fraction;
     json entry;

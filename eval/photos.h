@@ -3,8 +3,10 @@
 // the order the photos were taken in, for sequential matching.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,5 +28,12 @@ struct PhotoSetup {
 // OUT. nullopt with `error` for a user error (a bad --camera or --masks).
 std::optional<PhotoSetup> prepare_photos(const EvalOptions& options, const EvalInputs& inputs,
                                          std::ostream& log, std::string* error);
+
+// The images that did not register and their probable causes (eval/photo_diagnosis.h), one line
+// each on the log: eval.json's "unregistered" section (an empty object when all registered).
+// `setup` is null for a run folder; `masked` says whether COLMAP had object masks.
+nlohmann::json report_unregistered(const EvalInputs& inputs, const PhotoSetup* setup,
+                                   const std::set<std::string>& registered, bool masked,
+                                   std::ostream& log);
 
 }  // namespace rigc::eval
