@@ -377,7 +377,6 @@ class ColmapPipeline {
       argv.push_back(flags_.extraction_gpu);
       argv.push_back("0");
     }
-    add_masks(argv);
     return argv;
   }
 
@@ -387,6 +386,7 @@ class ColmapPipeline {
     if (!photos_ || photos_->cameras.empty()) {
       Argv argv = feature_extractor_args(in_.images.one_size());
       add_intrinsics_prior(argv);
+      add_masks(argv);
       return {{"feature_extractor", argv}};
     }
     std::vector<Step> steps;
@@ -403,6 +403,7 @@ class ColmapPipeline {
       Argv argv = feature_extractor_args(true);
       argv.insert(argv.end(), {"--image_list_path", list.string()});
       add_photo_prior(argv, camera);
+      add_masks(argv);
       steps.push_back(
           {k == 0 ? "feature_extractor" : fmt::format("feature_extractor_{}", k + 1), argv});
     }

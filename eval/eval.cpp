@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ostream>
@@ -107,7 +108,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const ColmapRun colmap = run_colmap(o, *in, log, photos ? &*photos : nullptr);
   report.add_colmap(colmap);
   const bool masked = colmap.prior.is_object() && colmap.prior.contains("masks");
-  if (!colmap.ok && photos && colmap.exit_code != 1) {
+  const bool mapped = std::any_of(colmap.steps.begin(), colmap.steps.end(), [](const auto& step) {
+    return step.is_object() && step.value("name", "") == "mapper";
+  });
+  if (!colmap.ok && photos && mapped) {
     report.sections()["unregistered"] = report_unregistered(*in, &*photos, {}, masked, log);
   }
   if (!colmap.ok) {

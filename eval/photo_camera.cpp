@@ -85,7 +85,10 @@ std::optional<BodyPreset> preset_for_exif(const std::string& make, const std::st
   const std::string m = normalised(model);
   if (m.empty()) return std::nullopt;
   for (const auto& p : body_presets()) {
-    if (normalised(p.model) == m && (make.empty() || normalised(p.make) == normalised(make))) {
+    // LibRaw drops the make from the model ("EOS 6D"); cameras write it in both.
+    const bool model_matches =
+        normalised(p.model) == m || normalised(p.model) == normalised(make + " " + model);
+    if (model_matches && (make.empty() || normalised(p.make) == normalised(make))) {
       return p;
     }
   }

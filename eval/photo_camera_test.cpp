@@ -55,6 +55,7 @@ TEST(PhotoCamera, ExifMakeAndModelFindThePresetAndItsSensorGivesPixels) {
   const auto p = preset_for_exif("Canon", "  Canon EOS 6D ");
   ASSERT_TRUE(p.has_value());
   EXPECT_EQ(p->name, "canon-6d");
+  EXPECT_EQ(preset_for_exif("Canon", "EOS 6D")->name, "canon-6d") << "as LibRaw gives it";
   EXPECT_FALSE(preset_for_exif("Canon", "Canon EOS R5").has_value());
   EXPECT_FALSE(preset_for_exif("SONY", "Canon EOS 6D").has_value());
   // Full size: 50 mm on a 35.8 mm wide sensor of 5472 px; a portrait photo uses its long side.
