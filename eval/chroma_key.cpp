@@ -37,12 +37,27 @@ constexpr double kDarkestKeyed = 0.01;
 
 }  // namespace
 
-std::optional<KeyImage> read_key_image(const fs::path& path, int max_side, std::string* error) {
-  OIIO::ImageBuf in(path.string());
-  if (!in.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
-    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), in.geterror());
-    return std::nullopt;
+bool read_uint8_image(const fs::path& path, OIIO::ImageBuf& image, std::string* error) {
+  // Through ImageInput, not ImageBuf's shared cache: a file rewritten under the same name
+  // (a mask redone, a photo replaced) is read again.
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) {
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), OIIO::geterror());
+    return false;
   }
+  OIIO::ImageSpec spec = input->spec();
+  spec.set_format(OIIO::TypeDesc::UINT8);
+  image.reset(spec);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, image.localpixels())) {
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), input->geterror());
+    return false;
+  }
+  return true;
+}
+
+std::optional<KeyImage> read_key_image(const fs::path& path, int max_side, std::string* error) {
+  OIIO::ImageBuf in;
+  if (!read_uint8_image(path, in, error)) return std::nullopt;
   const OIIO::ImageSpec& spec = in.spec();
   const int long_side = std::max(spec.width, spec.height);
   OIIO::ImageBuf work = in;

@@ -5,6 +5,8 @@
 // spill on them. What is left is the object, cleaned of specks and holes.
 #pragma once
 
+#include <OpenImageIO/imagebuf.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -21,6 +23,9 @@ struct KeyImage {
   std::vector<std::uint8_t> srgb;
   std::size_t pixels() const { return static_cast<std::size_t>(width) * height; }
 };
+
+// Reads an image's first subimage as 8 bits a channel into `image`; false with `error`.
+bool read_uint8_image(const std::filesystem::path& path, OIIO::ImageBuf& image, std::string* error);
 
 // Reads any image OpenImageIO reads (its first three channels, grey repeated) scaled so that
 // its long side is at most max_side. nullopt with `error` when it cannot.

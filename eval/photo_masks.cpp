@@ -135,11 +135,8 @@ std::optional<fs::path> mask_file_for(const fs::path& masks_dir, const std::stri
 std::optional<std::vector<std::uint8_t>> read_mask_made_elsewhere(const fs::path& path,
                                                                   std::pair<int, int> size,
                                                                   std::string* error) {
-  OIIO::ImageBuf in(path.string());
-  if (!in.read(0, 0, true, OIIO::TypeDesc::UINT8)) {
-    *error = fmt::format("cannot read the mask {}: {}", path.string(), in.geterror());
-    return std::nullopt;
-  }
+  OIIO::ImageBuf in;
+  if (!read_uint8_image(path, in, error)) return std::nullopt;
   const OIIO::ImageSpec& spec = in.spec();
   if (spec.width != size.first || spec.height != size.second) {
     *error = fmt::format("the mask {} is {}x{} pixels, its photo {}x{}", path.string(), spec.width,
