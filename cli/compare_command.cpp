@@ -165,6 +165,8 @@ Row render_and_evaluate(const ir::Scene& scene, const std::string& scene_path,
   if (row.render_status == 0) {
     EvalOptions o = base;
     o.run_dir = row.run_dir.string();
+    o.masks_dir.clear();  // the photos' options
+    o.camera.clear();
     o.scene = scene_path;
     o.output_dir = (row.run_dir / "eval").string();
     row.eval_status = eval::evaluate(o, std::cerr, &row.summary);

@@ -14,12 +14,34 @@ using eval::EvalOptions;
 using eval::EvalSummary;
 using eval::evaluate;
 
+namespace {
+
+// The options for a folder of photos (eval/photos.h).
+void add_photo_options(CLI::App& app, eval::EvalOptions& o) {
+  app.add_option("--masks", o.masks_dir,
+                 "photos: object masks made elsewhere (same names, any common image format; "
+                 "default: a chroma key on the backdrop and the still background)");
+  app.add_option("--key-tolerance", o.key_tolerance,
+                 "photos: the chroma key's tolerance (chromaticity distance to the backdrop)")
+      ->check(finite_number())
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  app.add_option("--camera", o.camera,
+                 "photos: the camera, BODY,FOCAL (e.g. canon-6d,50mm), for photos without EXIF "
+                 "(it overrides their EXIF)");
+  app.add_flag("--allow-partial", o.allow_partial,
+               "exit 0 even when fewer than half of the images register");
+}
+
+}  // namespace
+
 void add_eval_options(CLI::App& app, eval::EvalOptions& o) {
   app.add_option("--colmap", o.colmap, "COLMAP executable")->capture_default_str();
   app.add_option("--matcher", o.matcher,
                  "feature matching: exhaustive, sequential, neighbours (views whose planned "
                  "optical axes are close, from the run's sparse/images.txt), or auto (neighbours "
-                 "for a run folder, else exhaustive; sequential above 100 images)")
+                 "for a run folder; for photos sequential in capture order with the loop closed, "
+                 "exhaustive up to 10; else exhaustive, sequential above 100 images)")
       ->check(CLI::IsMember({"auto", "exhaustive", "sequential", "neighbours"}))
       ->capture_default_str();
   app.add_option("--neighbour-angle", o.neighbour_angle_deg,
@@ -48,6 +70,7 @@ void add_eval_options(CLI::App& app, eval::EvalOptions& o) {
   app.add_option("--color-range", o.color_range_mm,
                  "heat-map range in mm, ± (default: 3 x the RMS distance)")
       ->check(positive_number());
+  add_photo_options(app, o);
 }
 
 int run_eval_command(std::vector<std::string> args) {

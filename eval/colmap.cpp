@@ -145,6 +145,19 @@ bool write_pair_list(const fs::path& path, const std::vector<std::string>& names
   return rigc::write_file_atomically(path, text, error);
 }
 
+std::vector<std::pair<int, int>> sequential_ring_pairs(int n, int overlap) {
+  std::vector<std::pair<int, int>> pairs;
+  for (int i = 0; i < n; ++i) {
+    for (int d = 1; d <= overlap && d < n; ++d) {
+      const int j = (i + d) % n;
+      pairs.emplace_back(std::min(i, j), std::max(i, j));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
 double SparseModel::mean_track_length() const {
   if (points.empty()) return 0;
   double sum = 0;
@@ -267,9 +280,11 @@ using Argv = std::vector<std::string>;
 // One run_colmap: its folders, the probed COLMAP, and the ColmapRun it fills in step by step.
 class ColmapPipeline {
  public:
-  ColmapPipeline(const EvalOptions& o, const EvalInputs& in, std::ostream& log)
+  ColmapPipeline(const EvalOptions& o, const EvalInputs& in, std::ostream& log,
+                 const PhotoSetup* photos)
       : o_(o),
         in_(in),
+        photos_(photos),
         log_(log),
         work_(in.out / "colmap"),
         logs_(in.out / "logs"),
@@ -287,11 +302,12 @@ class ColmapPipeline {
     fs::create_directories(work_ / "sparse", ec);
     fs::create_directories(logs_, ec);
     if (!prepare_images() || !probe()) return r_;
-    const Argv extract = feature_extractor_args();
+    std::vector<Step> steps = extraction_steps();
+    if (steps.empty()) return r_;
     std::optional<Argv> match = matcher_args();
     if (!match) return r_;
-    const std::vector<Step> steps = {
-        {"feature_extractor", extract}, {(*match)[1], *match}, {"mapper", mapper_args()}};
+    steps.push_back({(*match)[1], *match});
+    steps.push_back({"mapper", mapper_args()});
     if (run_steps(steps)) keep_largest_model();
     return r_;
   }
@@ -351,19 +367,66 @@ class ColmapPipeline {
     return true;
   }
 
-  Argv feature_extractor_args() {
+  Argv feature_extractor_args(bool one_camera) {
     Argv argv = {o_.colmap, "feature_extractor", "--database_path", db_.string(), "--image_path",
                  images_dir_.string(), "--ImageReader.single_camera",
                  // One camera for photos of one size; COLMAP refuses a single camera over
                  // images of different sizes.
-                 in_.images.one_size() ? "1" : "0"};
+                 one_camera ? "1" : "0"};
     if (!flags_.extraction_gpu.empty()) {
       argv.push_back(flags_.extraction_gpu);
       argv.push_back("0");
     }
-    add_intrinsics_prior(argv);
-    add_masks(argv);
     return argv;
+  }
+
+  // One feature extraction for a run folder; for photos one per camera (each over its list of
+  // photos, with its own prior), so that each body, zoom setting and size gets a camera.
+  std::vector<Step> extraction_steps() {
+    if (!photos_ || photos_->cameras.empty()) {
+      Argv argv = feature_extractor_args(in_.images.one_size());
+      add_intrinsics_prior(argv);
+      add_masks(argv);
+      return {{"feature_extractor", argv}};
+    }
+    std::vector<Step> steps;
+    r_.prior = {{"source", "the photos' cameras"}, {"cameras", json::array()}};
+    for (std::size_t k = 0; k < photos_->cameras.size(); ++k) {
+      const PhotoCamera& camera = photos_->cameras[k];
+      const fs::path list = work_ / fmt::format("images_camera_{}.txt", k + 1);
+      std::string text, error;
+      for (const auto& name : camera.images) text += name + "\n";
+      if (!rigc::write_file_atomically(list, text, &error)) {
+        fail(2, error);
+        return {};
+      }
+      Argv argv = feature_extractor_args(true);
+      argv.insert(argv.end(), {"--image_list_path", list.string()});
+      add_photo_prior(argv, camera);
+      add_masks(argv);
+      steps.push_back(
+          {k == 0 ? "feature_extractor" : fmt::format("feature_extractor_{}", k + 1), argv});
+    }
+    return steps;
+  }
+
+  // A photo camera's prior: SIMPLE_RADIAL (one focal length, the centre, k1), its focal length
+  // from the body preset's sensor when known, else COLMAP's guess from EXIF.
+  void add_photo_prior(Argv& argv, const PhotoCamera& camera) {
+    argv.insert(argv.end(), {"--ImageReader.camera_model", "SIMPLE_RADIAL"});
+    json entry = camera.to_json();
+    if (camera.focal_px > 0) {
+      const std::string params = fmt::format("{:.17g},{:.17g},{:.17g},0", camera.focal_px,
+                                             camera.width / 2.0, camera.height / 2.0);
+      argv.insert(argv.end(), {"--ImageReader.camera_params", params});
+      entry["params"] = params;
+    }
+    if (!camera.sensor_known) photo_focal_unknown_ = true;
+    r_.prior["model"] = "SIMPLE_RADIAL";
+    r_.prior["cameras"].push_back(entry);
+    r_.prior["refined_by_colmap"] = photo_focal_unknown_ || o_.refine_intrinsics
+                                        ? "focal length and k1"
+                                        : "k1 (the focal length from the sensor is kept)";
   }
 
   // The intrinsics prior: the run's ground-truth camera (exact), else COLMAP reads EXIF.
@@ -390,10 +453,15 @@ class ColmapPipeline {
     }
   }
 
-  // The run's object masks: COLMAP wants masks/<image name>.png and ignores zero pixels.
+  // The object masks (the run's, or the photos' from eval/photo_masks.h): COLMAP wants
+  // masks/<image name>.png and ignores zero pixels.
   void add_masks(Argv& argv) {
-    const fs::path masks = in_.run_dir / "masks";
-    if (!o_.use_masks || !fs::is_directory(masks)) return;
+    const fs::path masks = photos_ ? photos_->masks.dir : in_.run_dir / "masks";
+    if (masks.empty() || (!photos_ && !o_.use_masks) || !fs::is_directory(masks)) return;
+    if (mask_dir_ready_) {
+      argv.insert(argv.end(), {"--ImageReader.mask_path", (work_ / "masks").string()});
+      return;
+    }
     const fs::path mask_dir = work_ / "masks";
     std::error_code ec;
     fs::create_directories(mask_dir, ec);
@@ -405,6 +473,7 @@ class ColmapPipeline {
       if (!ec) ++linked;
     }
     if (linked > 0) {
+      mask_dir_ready_ = true;
       argv.insert(argv.end(), {"--ImageReader.mask_path", mask_dir.string()});
       r_.prior["masks"] = masks.string();
     }
@@ -415,7 +484,10 @@ class ColmapPipeline {
   std::optional<Argv> matcher_args() {
     const int image_count = static_cast<int>(in_.images.names.size());
     std::string matcher = o_.matcher;
-    if (matcher == "auto") {
+    if (matcher == "auto" && photos_) {
+      matcher = image_count <= kExhaustivePhotos || !flags_.imports_pair_lists ? "exhaustive"
+                                                                               : "sequential";
+    } else if (matcher == "auto") {
       const bool planned = every_image_planned(in_.images.names, in_.truth.poses);
       matcher = planned && flags_.imports_pair_lists ? "neighbours"
                 : image_count > 100                  ? "sequential"
@@ -424,7 +496,11 @@ class ColmapPipeline {
     const long all_pairs = static_cast<long>(image_count) * (image_count - 1) / 2;
     r_.matching = {{"matcher", matcher}, {"all_pairs", all_pairs}};
     Argv argv;
-    if (matcher == "neighbours") {
+    if (matcher == "sequential" && photos_ && flags_.imports_pair_lists) {
+      auto importer = sequential_photo_matching_args();
+      if (!importer) return std::nullopt;
+      argv = std::move(*importer);
+    } else if (matcher == "neighbours") {
       auto importer = neighbour_matching_args();
       if (!importer) return std::nullopt;
       argv = std::move(*importer);
@@ -473,6 +549,25 @@ class ColmapPipeline {
                 "--match_list_path", pair_list.string(), "--match_type",    "pairs"};
   }
 
+  // matches_importer on the photos in capture order, each with the next kOverlap and the loop
+  // closed (a turntable comes back to its first view).
+  std::optional<Argv> sequential_photo_matching_args() {
+    const auto pairs = sequential_ring_pairs(static_cast<int>(photos_->order.size()), kOverlap);
+    const fs::path pair_list = work_ / "pairs.txt";
+    std::string error;
+    if (!write_pair_list(pair_list, photos_->order, pairs, &error)) {
+      fail(2, error);
+      return std::nullopt;
+    }
+    r_.matching["pairs"] = pairs.size();
+    r_.matching["pair_list"] = pair_list.string();
+    r_.matching["rule"] = fmt::format(
+        "capture order ({}): each photo with the next {}, the last with the first (loop closure)",
+        photos_->order_basis, kOverlap);
+    return Argv{o_.colmap,           "matches_importer", "--database_path", db_.string(),
+                "--match_list_path", pair_list.string(), "--match_type",    "pairs"};
+  }
+
   Argv mapper_args() const {
     Argv argv = {o_.colmap, "mapper", "--database_path", db_.string(), "--image_path",
                  images_dir_.string(), "--output_path", (work_ / "sparse").string(),
@@ -480,6 +575,11 @@ class ColmapPipeline {
                  // ring with one photo lost registers in parts, which would be reported as
                  // nothing reconstructed.
                  "--Mapper.min_model_size", "3"};
+    if (photos_ && !photo_focal_unknown_ && !o_.refine_intrinsics) {
+      // Focal lengths from the bodies' sensors: refining them from a turntable's narrow views
+      // is ill-conditioned; the lens's k1 is unknown and refined.
+      argv.insert(argv.end(), {"--Mapper.ba_refine_focal_length", "0"});
+    }
     if (exact_prior_ && !o_.refine_intrinsics) {
       // A known camera: refining focal length and distortion from two narrow-angle views of a
       // small object is ill-conditioned and can stop the reconstruction at its first pair.
@@ -576,18 +676,25 @@ class ColmapPipeline {
 
   const EvalOptions& o_;
   const EvalInputs& in_;
+  const PhotoSetup* photos_;  // null for a run folder
   std::ostream& log_;
   const fs::path work_, logs_, txt_, db_;
   fs::path images_dir_;  // the images COLMAP reads: the inputs, or their 8-bit copies
   ColmapFlags flags_;
-  bool exact_prior_ = false;  // the run's own camera is the intrinsics prior
+  bool exact_prior_ = false;          // the run's own camera is the intrinsics prior
+  bool photo_focal_unknown_ = false;  // a photo camera's focal length is COLMAP's guess
+  bool mask_dir_ready_ = false;       // OUT/colmap/masks holds the links
+  // Photos: up to this many are matched exhaustively; more in capture order, with this overlap.
+  static constexpr int kExhaustivePhotos = 10;
+  static constexpr int kOverlap = 3;
   ColmapRun r_;
 };
 
 }  // namespace
 
-ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log) {
-  return ColmapPipeline(options, inputs, log).run();
+ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log,
+                     const PhotoSetup* photos) {
+  return ColmapPipeline(options, inputs, log, photos).run();
 }
 
 }  // namespace rigc::eval

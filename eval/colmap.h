@@ -13,6 +13,7 @@
 
 #include "eval/eval.h"
 #include "eval/inputs.h"
+#include "eval/photos.h"
 #include "ir/ir.h"
 #include "run/colmap_text.h"
 
@@ -93,8 +94,14 @@ struct ColmapRun {
   bool reused = false;  // --reuse-colmap found a model: the times are the earlier run's
 };
 
+// Pairs (i < j, sorted, unique) of a sequence of n views taken in order around a turntable: each
+// with the next `overlap`, the last ones with the first (the loop closes).
+std::vector<std::pair<int, int>> sequential_ring_pairs(int n, int overlap);
+
 // Features (with the run's camera as the intrinsics prior and its masks), matching, mapper, and
-// the text export of the largest model, in OUT/colmap with each step's log in OUT/logs.
-ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log);
+// the text export of the largest model, in OUT/colmap with each step's log in OUT/logs. Photos
+// bring their own masks, cameras and capture order (`photos`).
+ColmapRun run_colmap(const EvalOptions& options, const EvalInputs& inputs, std::ostream& log,
+                     const PhotoSetup* photos = nullptr);
 
 }  // namespace rigc::eval

@@ -2,15 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ostream>
+#include <set>
 
 #include "eval/align.h"
 #include "eval/colmap.h"
 #include "eval/geometry.h"
 #include "eval/inputs.h"
 #include "eval/measure.h"
+#include "eval/photos.h"
 #include "eval/reconstruction.h"
 #include "eval/report.h"
 
@@ -44,6 +47,13 @@ bool EvalOptions::check(std::string* error) const {
     return refuse(
         fmt::format("{} ground-truth samples; at least 1 is needed", ground_truth_samples));
   }
+  if (!(std::isfinite(key_tolerance) && key_tolerance > 0 && key_tolerance <= 1)) {
+    return refuse(fmt::format(
+        "the key tolerance is {}; it must be in (0, 1] (a chromaticity distance)", key_tolerance));
+  }
+  if (photos_dir.empty() && (!masks_dir.empty() || !camera.empty())) {
+    return refuse("--masks and --camera are for photos (--photos DIR)");
+  }
   if (!(std::isfinite(color_range_mm) && color_range_mm >= 0)) {
     return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
                               color_range_mm));
@@ -68,6 +78,18 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// Photos of which fewer than half registered: the numbers describe a part of the object. An
+// error unless --allow-partial.
+bool too_few_registered(const EvalOptions& o, const EvalInputs& in, std::size_t registered,
+                        std::ostream& log) {
+  if (!in.photos || o.allow_partial || 2 * registered >= in.images.names.size()) return false;
+  log << fmt::format(
+      "rigc eval: error: only {} of the {} photos registered (fewer than half): the numbers "
+      "above describe part of the object (see the causes above; --allow-partial accepts it)\n",
+      registered, in.images.names.size());
+  return true;
+}
+
 }  // namespace
 
 int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
@@ -81,13 +103,29 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   }
   const auto in = gather_inputs(o, log, sum);
   if (!in) return 1;
+  std::optional<PhotoSetup> photos;
+  if (in->photos) {
+    photos = prepare_photos(o, *in, log, &error);
+    if (!photos) {
+      log << "rigc eval: error: " << error << "\n";
+      return 1;
+    }
+  }
   EvalReport report(*in, log, sum);
+  if (photos) report.add_photos(*photos);
   if (!o.reconstruction.empty()) return evaluate_reconstruction(o, *in, report, log, sum, t_start);
 
   EvalTimes times;
   times.setup = seconds_since(t_start);
-  const ColmapRun colmap = run_colmap(o, *in, log);
+  const ColmapRun colmap = run_colmap(o, *in, log, photos ? &*photos : nullptr);
   report.add_colmap(colmap);
+  const bool masked = colmap.prior.is_object() && colmap.prior.contains("masks");
+  const bool mapped = std::any_of(colmap.steps.begin(), colmap.steps.end(), [](const auto& step) {
+    return step.is_object() && step.value("name", "") == "mapper";
+  });
+  if (!colmap.ok && photos && mapped) {
+    report.sections()["unregistered"] = report_unregistered(*in, &*photos, {}, masked, log);
+  }
   if (!colmap.ok) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);
   }
@@ -95,6 +133,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   const auto model = read_sparse_model(colmap.model_txt, &error);
   if (!model) return report.fail("reconstruction", error, 2);
   report.add_reconstruction(*model, colmap, o.quiet);
+  std::set<std::string> registered;
+  for (const auto& image : model->images) registered.insert(image.name);
+  report.sections()["unregistered"] =
+      report_unregistered(*in, photos ? &*photos : nullptr, registered, masked, log);
   if (model->points.size() < 3) {
     return report.fail("reconstruction", "the reconstruction has fewer than 3 points", 2);
   }
@@ -116,7 +158,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   report.add_timing(colmap, times);
   if (!report.write()) return 2;
   if (!o.quiet) report.print_summary(o, colmap, m, times);
-  return 0;
+  return too_few_registered(o, *in, registered.size(), log) ? 2 : 0;
 }
 
 }  // namespace rigc::eval

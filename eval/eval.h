@@ -45,6 +45,13 @@ struct EvalOptions {
   bool align = true;           // false: the reconstruction is in the scene's frame (--no-align)
   int mesh_samples = 1000000;  // dense samples of a reconstructed mesh
   double min_fitness = 0.5;    // a registration that fits worse is refused
+  // Photos (eval/photos.h): masks made elsewhere (same stems, any common format) instead of the
+  // chroma key; the key's tolerance (chromaticity distance); the camera when EXIF has none
+  // ("canon-6d,50mm"); accept a reconstruction of fewer than half of the photos.
+  std::string masks_dir;
+  double key_tolerance = 0.12;
+  std::string camera;
+  bool allow_partial = false;
 
   // False with a one-line `error` when a field is out of its range or the folders are not one
   // run folder or one photos folder. evaluate() checks it first.

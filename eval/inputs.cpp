@@ -9,6 +9,7 @@
 
 #include "assets/mesh_io.h"
 #include "compiler/frontend.h"
+#include "eval/raw_photos.h"
 #include "run/manifest.h"
 
 namespace rigc::eval {
@@ -32,7 +33,8 @@ namespace {
 bool is_image_file(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" || ext == ".tiff" ||
+         is_raw_photo(p);
 }
 
 std::vector<std::string> list_images(const fs::path& dir) {
@@ -153,6 +155,7 @@ bool load_scene_object(const std::string& scene_path, const fs::path& run_dir, c
   gt.positions = ir::object_frame_positions(scene->object);
   gt.triangles = scene->object.mesh.triangles;
   gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
+  if (scene->studio.backdrop.green_screen) gt.backdrop_color = scene->studio.backdrop.color;
   const json& m = manifest;
   if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
       m["inputs"].contains("object_sha256") && m["inputs"]["object_sha256"].is_string() &&
@@ -290,6 +293,7 @@ std::optional<EvalInputs> gather_inputs(const EvalOptions& o, std::ostream& log,
     return refuse();
   }
   summary.output_dir = in.out.string();
+  if (in.photos && !develop_raw_photos(in.images, in.out, log, o.quiet, &error)) return refuse();
   return in;
 }
 

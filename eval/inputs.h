@@ -38,6 +38,7 @@ struct GroundTruth {
   std::string description;
   std::map<std::string, ir::Mat4> poses;    // camera_from_world by image name (sparse/images.txt)
   std::optional<run::ColmapCamera> camera;  // sparse/cameras.txt's first camera
+  std::optional<ir::Vec3> backdrop_color;   // the scene's green screen (linear RGB), for keying
 };
 
 // Everything evaluate() reads, checked.

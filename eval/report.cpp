@@ -80,6 +80,13 @@ void EvalReport::add_colmap(const ColmapRun& colmap) {
   summary_.colmap_s = colmap.seconds;
 }
 
+void EvalReport::add_photos(const PhotoSetup& photos) {
+  json cameras = json::array();
+  for (const auto& c : photos.cameras) cameras.push_back(c.to_json());
+  report_["photos"] = {
+      {"masks", photos.masks.report}, {"cameras", cameras}, {"capture_order", photos.order_basis}};
+}
+
 void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& colmap, bool quiet) {
   summary_.reconstructed = true;
   summary_.registered = static_cast<int>(model.images.size());

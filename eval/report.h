@@ -13,6 +13,7 @@
 #include "eval/eval.h"
 #include "eval/inputs.h"
 #include "eval/measure.h"
+#include "eval/photos.h"
 
 namespace rigc::eval {
 
@@ -39,6 +40,8 @@ class EvalReport {
   int fail(const std::string& section, const std::string& reason, int exit_code);
 
   void add_colmap(const ColmapRun& colmap);
+  // The "photos" section: masks, cameras, capture order.
+  void add_photos(const PhotoSetup& photos);
   // The "reconstruction" section, and its line on the log.
   void add_reconstruction(const SparseModel& model, const ColmapRun& colmap, bool quiet);
   // cloud_signed_distance.ply, histogram.png and heatmap.png (seen by the first camera): the

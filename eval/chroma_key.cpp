@@ -1,0 +1,328 @@
+#include "eval/chroma_key.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace rigc::eval {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// sRGB code -> linear value.
+const std::array<float, 256>& linear_of_code() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double c = i / 255.0;
+      t[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return t;
+  }();
+  return table;
+}
+
+ir::Vec3 linear_pixel(const std::vector<std::uint8_t>& srgb, std::size_t i) {
+  const auto& lin = linear_of_code();
+  return {lin[srgb[3 * i]], lin[srgb[3 * i + 1]], lin[srgb[3 * i + 2]]};
+}
+
+// Below this sum of linear R, G and B the chromaticity is mostly JPEG noise.
+constexpr double kDarkestKeyed = 0.01;
+
+}  // namespace
+
+bool read_uint8_image(const fs::path& path, OIIO::ImageBuf& image, std::string* error) {
+  // Through ImageInput, not ImageBuf's shared cache: a file rewritten under the same name
+  // (a mask redone, a photo replaced) is read again.
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) {
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), OIIO::geterror());
+    return false;
+  }
+  OIIO::ImageSpec spec = input->spec();
+  spec.set_format(OIIO::TypeDesc::UINT8);
+  image.reset(spec);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, image.localpixels())) {
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), input->geterror());
+    return false;
+  }
+  return true;
+}
+
+std::optional<KeyImage> read_key_image(const fs::path& path, int max_side, std::string* error) {
+  OIIO::ImageBuf in;
+  if (!read_uint8_image(path, in, error)) return std::nullopt;
+  const OIIO::ImageSpec& spec = in.spec();
+  const int long_side = std::max(spec.width, spec.height);
+  OIIO::ImageBuf work = in;
+  if (long_side > max_side) {
+    const double s = static_cast<double>(max_side) / long_side;
+    const int w = std::max(1, static_cast<int>(std::lround(spec.width * s)));
+    const int h = std::max(1, static_cast<int>(std::lround(spec.height * s)));
+    work = OIIO::ImageBufAlgo::resize(in, "", 0, OIIO::ROI(0, w, 0, h, 0, 1, 0, spec.nchannels));
+  }
+  KeyImage image;
+  image.width = work.spec().width;
+  image.height = work.spec().height;
+  image.srgb.resize(image.pixels() * 3);
+  const int channels = work.spec().nchannels;
+  std::vector<std::uint8_t> all(image.pixels() * channels);
+  if (!work.get_pixels(work.roi(), OIIO::TypeDesc::UINT8, all.data())) {
+    *error = fmt::format("cannot read the pixels of {}: {}", path.string(), work.geterror());
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    for (int c = 0; c < 3; ++c)
+      image.srgb[3 * i + c] = all[i * channels + std::min(c, channels - 1)];
+  }
+  return image;
+}
+
+Chroma chroma_of_linear(const ir::Vec3& rgb) {
+  const double sum = rgb.sum();
+  if (sum <= 0) return {1.0 / 3, 1.0 / 3};
+  return {rgb.x() / sum, rgb.y() / sum};
+}
+
+double chroma_distance(const Chroma& a, const Chroma& b) {
+  return std::hypot(a.r - b.r, a.g - b.g);
+}
+
+std::optional<Chroma> backdrop_at_borders(const KeyImage& image, const std::optional<Chroma>& hint,
+                                          double tolerance) {
+  const int band = std::max(1, std::min(image.width, image.height) / 50);
+  std::vector<Chroma> border;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const bool edge = x < band || y < band || x >= image.width - band || y >= image.height - band;
+      if (!edge) continue;
+      const ir::Vec3 rgb = linear_pixel(image.srgb, static_cast<std::size_t>(y) * image.width + x);
+      if (rgb.sum() < kDarkestKeyed) continue;
+      const Chroma c = chroma_of_linear(rgb);
+      // Near the scene's colour: a wide margin, since white balance moves it.
+      if (hint && chroma_distance(c, *hint) > 3 * tolerance) continue;
+      border.push_back(c);
+    }
+  }
+  if (border.empty()) return std::nullopt;
+  auto median_of = [&](auto value) {
+    std::vector<double> v;
+    v.reserve(border.size());
+    for (const auto& c : border) v.push_back(value(c));
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  const Chroma key{median_of([](const Chroma& c) { return c.r; }),
+                   median_of([](const Chroma& c) { return c.g; })};
+  const std::size_t all_border =
+      2 * static_cast<std::size_t>(band) * (image.width + image.height - 2 * band);
+  const auto near = std::count_if(border.begin(), border.end(), [&](const Chroma& c) {
+    return chroma_distance(c, key) <= tolerance;
+  });
+  if (2 * static_cast<std::size_t>(near) < all_border) return std::nullopt;
+  return key;
+}
+
+std::vector<std::uint8_t> key_backdrop(const KeyImage& image, const Chroma& key, double tolerance) {
+  std::vector<std::uint8_t> mask(image.pixels(), 255);
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    const ir::Vec3 rgb = linear_pixel(image.srgb, i);
+    if (rgb.sum() < kDarkestKeyed) continue;
+    if (chroma_distance(chroma_of_linear(rgb), key) <= tolerance) mask[i] = 0;
+  }
+  return mask;
+}
+
+namespace {
+
+// Whether two linear colours are one surface under the same light: within JPEG's noise and a
+// tenth of their brightness, channel by channel.
+bool same_colour(const ir::Vec3& a, const ir::Vec3& b) {
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(a[c] - b[c]) > 0.01 + 0.1 * std::max(a[c], b[c])) return false;
+  }
+  return true;
+}
+
+// Whether `pixel` is `background` in a shadow: darker, the same chromaticity.
+bool shadow_of(const ir::Vec3& pixel, const ir::Vec3& background) {
+  const double ratio = pixel.sum() / std::max(1e-6, background.sum());
+  if (ratio < 0.15 || ratio > 1.0) return false;
+  return chroma_distance(chroma_of_linear(pixel), chroma_of_linear(background)) < 0.04;
+}
+
+}  // namespace
+
+std::optional<StillBackground> still_background(const std::vector<const KeyImage*>& images) {
+  constexpr std::size_t kFewest = 5;
+  if (images.size() < kFewest) return std::nullopt;
+  const KeyImage& first = *images.front();
+  for (const KeyImage* im : images) {
+    if (im->width != first.width || im->height != first.height) return std::nullopt;
+  }
+  StillBackground still;
+  still.width = first.width;
+  still.height = first.height;
+  const std::size_t n = first.pixels();
+  still.median_srgb.resize(3 * n);
+  still.still_share.resize(n);
+  std::vector<std::uint8_t> values(images.size());
+  for (std::size_t v = 0; v < 3 * n; ++v) {
+    for (std::size_t k = 0; k < images.size(); ++k) values[k] = images[k]->srgb[v];
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    still.median_srgb[v] = values[values.size() / 2];
+  }
+  std::size_t still_pixels = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const ir::Vec3 median = linear_pixel(still.median_srgb, i);
+    int agree = 0;
+    for (const KeyImage* im : images) agree += same_colour(linear_pixel(im->srgb, i), median);
+    still.still_share[i] = static_cast<float>(agree) / static_cast<float>(images.size());
+    still_pixels += still.still_share[i] >= 0.5f;
+  }
+  still.still_fraction = static_cast<double>(still_pixels) / static_cast<double>(n);
+  return still;
+}
+
+std::vector<std::uint8_t> key_still(const KeyImage& image, const StillBackground& still) {
+  std::vector<std::uint8_t> mask(image.pixels(), 255);
+  if (image.width != still.width || image.height != still.height) return mask;
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    if (still.still_share[i] < 0.5f) continue;
+    const ir::Vec3 pixel = linear_pixel(image.srgb, i);
+    const ir::Vec3 background = linear_pixel(still.median_srgb, i);
+    if (same_colour(pixel, background) || shadow_of(pixel, background)) mask[i] = 0;
+  }
+  return mask;
+}
+
+namespace {
+
+// Square max filter of radius r (a dilation of the 255 pixels), separable.
+std::vector<std::uint8_t> dilate(const std::vector<std::uint8_t>& in, int w, int h, int r) {
+  if (r <= 0) return in;
+  std::vector<std::uint8_t> rows(in.size()), out(in.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t m = 0;
+      for (int dx = std::max(0, x - r); dx <= std::min(w - 1, x + r); ++dx) {
+        m = std::max(m, in[static_cast<std::size_t>(y) * w + dx]);
+      }
+      rows[static_cast<std::size_t>(y) * w + x] = m;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t m = 0;
+      for (int dy = std::max(0, y - r); dy <= std::min(h - 1, y + r); ++dy) {
+        m = std::max(m, rows[static_cast<std::size_t>(dy) * w + x]);
+      }
+      out[static_cast<std::size_t>(y) * w + x] = m;
+    }
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> inverted(std::vector<std::uint8_t> mask) {
+  for (auto& v : mask) v = 255 - v;
+  return mask;
+}
+
+std::vector<std::uint8_t> erode(const std::vector<std::uint8_t>& in, int w, int h, int r) {
+  return inverted(dilate(inverted(in), w, h, r));
+}
+
+// Labels the 4-connected regions of pixels equal to `value`; returns each region's size, label
+// k in labels (k + 1; 0 for the other pixels).
+std::vector<std::size_t> label_regions(const std::vector<std::uint8_t>& mask, int w, int h,
+                                       std::uint8_t value, std::vector<int>& labels) {
+  labels.assign(mask.size(), 0);
+  std::vector<std::size_t> sizes, stack;
+  for (std::size_t start = 0; start < mask.size(); ++start) {
+    if (mask[start] != value || labels[start]) continue;
+    sizes.push_back(0);
+    const int label = static_cast<int>(sizes.size());
+    stack.push_back(start);
+    labels[start] = label;
+    while (!stack.empty()) {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      ++sizes.back();
+      const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+      const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+      for (int k = 0; k < 4; ++k) {
+        if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
+        const std::size_t j = static_cast<std::size_t>(ny[k]) * w + nx[k];
+        if (mask[j] == value && !labels[j]) {
+          labels[j] = label;
+          stack.push_back(j);
+        }
+      }
+    }
+  }
+  return sizes;
+}
+
+// Keeps the components of at least a tenth of the largest one's size.
+void keep_large_components(std::vector<std::uint8_t>& mask, int w, int h) {
+  std::vector<int> labels;
+  const auto sizes = label_regions(mask, w, h, 255, labels);
+  if (sizes.empty()) return;
+  const std::size_t largest = *std::max_element(sizes.begin(), sizes.end());
+  for (std::size_t i = 0; i < mask.size(); ++i) {
+    if (labels[i] && 10 * sizes[labels[i] - 1] < largest) mask[i] = 0;
+  }
+}
+
+// Fills the background regions that do not reach the image's border.
+void fill_holes(std::vector<std::uint8_t>& mask, int w, int h) {
+  std::vector<int> labels;
+  const auto sizes = label_regions(mask, w, h, 0, labels);
+  std::vector<bool> reaches_border(sizes.size(), false);
+  for (int x = 0; x < w; ++x) {
+    for (int y : {0, h - 1}) {
+      if (const int l = labels[static_cast<std::size_t>(y) * w + x]) reaches_border[l - 1] = true;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x : {0, w - 1}) {
+      if (const int l = labels[static_cast<std::size_t>(y) * w + x]) reaches_border[l - 1] = true;
+    }
+  }
+  for (std::size_t i = 0; i < mask.size(); ++i) {
+    if (labels[i] && !reaches_border[labels[i] - 1]) mask[i] = 255;
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> clean_object_mask(std::vector<std::uint8_t> mask, int w, int h,
+                                            int grow_px) {
+  constexpr int kSpeck = 1;  // an opening of this radius removes noise and thin spill fringes
+  mask = dilate(erode(mask, w, h, kSpeck), w, h, kSpeck);
+  keep_large_components(mask, w, h);
+  fill_holes(mask, w, h);
+  return dilate(mask, w, h, grow_px);
+}
+
+std::vector<std::uint8_t> scale_mask(const std::vector<std::uint8_t>& mask, int w, int h, int to_w,
+                                     int to_h) {
+  if (w == to_w && h == to_h) return mask;
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(to_w) * to_h);
+  for (int y = 0; y < to_h; ++y) {
+    const int sy = std::min(h - 1, static_cast<int>((y + 0.5) * h / to_h));
+    for (int x = 0; x < to_w; ++x) {
+      const int sx = std::min(w - 1, static_cast<int>((x + 0.5) * w / to_w));
+      out[static_cast<std::size_t>(y) * to_w + x] = mask[static_cast<std::size_t>(sy) * w + sx];
+    }
+  }
+  return out;
+}
+
+}  // namespace rigc::eval

@@ -1,0 +1,78 @@
+// Object masks for photos, made from the pictures alone: a chroma key on the backdrop (a green
+// screen: its shadows key like the lit screen, since only the chromaticity counts) and, for a
+// turntable capture (a camera that stays put while the object turns), a key on what stays still
+// from photo to photo: the turntable, its stand and the floor, with the shadows and the green
+// spill on them. What is left is the object, cleaned of specks and holes.
+#pragma once
+
+#include <OpenImageIO/imagebuf.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+
+namespace rigc::eval {
+
+// A photo at working resolution: 8-bit sRGB, row-major, 3 bytes a pixel.
+struct KeyImage {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> srgb;
+  std::size_t pixels() const { return static_cast<std::size_t>(width) * height; }
+};
+
+// Reads an image's first subimage as 8 bits a channel into `image`; false with `error`.
+bool read_uint8_image(const std::filesystem::path& path, OIIO::ImageBuf& image, std::string* error);
+
+// Reads any image OpenImageIO reads (its first three channels, grey repeated) scaled so that
+// its long side is at most max_side. nullopt with `error` when it cannot.
+std::optional<KeyImage> read_key_image(const std::filesystem::path& path, int max_side,
+                                       std::string* error);
+
+// Chromaticity (R, G) / (R + G + B) of linear RGB: the brightness drops out.
+struct Chroma {
+  double r = 0, g = 0;
+};
+Chroma chroma_of_linear(const ir::Vec3& linear_rgb);
+double chroma_distance(const Chroma& a, const Chroma& b);
+
+// The backdrop's chromaticity at the image's borders: the median over the border pixels (those
+// near `hint`, the scene's green screen, when it is given). nullopt when fewer than half of the
+// border pixels are within `tolerance` of it: the borders are no one backdrop.
+std::optional<Chroma> backdrop_at_borders(const KeyImage& image, const std::optional<Chroma>& hint,
+                                          double tolerance);
+
+// 255 where a pixel is not the backdrop (chromaticity farther than `tolerance` from `key`, or
+// too dark to tell), 0 where it is.
+std::vector<std::uint8_t> key_backdrop(const KeyImage& image, const Chroma& key, double tolerance);
+
+// What stays still across photos of one size taken from one place: per pixel, the median colour
+// and the share of the photos that show it there.
+struct StillBackground {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> median_srgb;
+  std::vector<float> still_share;
+  double still_fraction = 0;  // the share of pixels still in most photos
+};
+// nullopt for fewer than 5 photos (no median to trust) or photos of different sizes.
+std::optional<StillBackground> still_background(const std::vector<const KeyImage*>& images);
+
+// 255 where a pixel is not the still background: where most photos agree on the background (a
+// share of at least one half), a pixel that matches it or is a shadow of it (darker, same
+// chromaticity) is background; elsewhere every pixel is kept.
+std::vector<std::uint8_t> key_still(const KeyImage& image, const StillBackground& still);
+
+// The object from a raw key: specks opened away, the components much smaller than the largest
+// dropped, holes filled, and the outline grown by `grow_px` so features on the silhouette keep
+// their support.
+std::vector<std::uint8_t> clean_object_mask(std::vector<std::uint8_t> mask, int width, int height,
+                                            int grow_px);
+
+// `mask` (width x height) scaled to to_width x to_height, nearest neighbour.
+std::vector<std::uint8_t> scale_mask(const std::vector<std::uint8_t>& mask, int width, int height,
+                                     int to_width, int to_height);
+
+}  // namespace rigc::eval
