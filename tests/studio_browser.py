@@ -218,6 +218,18 @@ def check_save_and_broken_file(driver, checks, rigc, scene, original):
         f.write(text)
 
 
+def check_suggest_next_shot(driver, checks):
+    """The planner's next shot (rigc plan --next) becomes the view."""
+    before = driver.find_element(By.ID, 'pose-readout').text
+    driver.find_element(By.ID, 'suggest').click()
+    wait_for(driver, "return document.getElementById('status').textContent.startsWith('suggested')",
+             timeout=180, what='the suggestion')
+    status = driver.find_element(By.ID, 'status').text
+    after = driver.find_element(By.ID, 'pose-readout').text
+    checks.expect(after != before and 'adds' in status,
+                  f'"Suggest next shot" moves the view ({status}; {after})')
+
+
 def screenshots(rigc, scene, directory):
     for width, height in ((1280, 800), (1920, 1080)):
         proc, url = start_studio(rigc, scene)
@@ -256,6 +268,7 @@ def main():
         check_exposure_and_depth_of_field(driver, checks)
         check_capture_and_coverage(driver, checks, args.rigc, args.scene, os.path.dirname(args.scene))
         check_save_and_broken_file(driver, checks, args.rigc, args.scene, original)
+        check_suggest_next_shot(driver, checks)
     finally:
         driver.quit()
         proc.send_signal(2)  # Ctrl-C
