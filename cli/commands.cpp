@@ -266,6 +266,8 @@ const std::vector<Command>& commands() {
       {"compare", "render with several backends and compare reconstruction accuracy",
        run_compare_command},
       {"plan", "plan the fewest shots that reach a coverage target", run_plan_command},
+      {"sweep", "compare capture configurations: scene variants, locally or on Slurm",
+       run_sweep_command},
       {"version", "print the version", run_version},
   };
   return table;
