@@ -1,7 +1,11 @@
 // `rigc sweep` as a user runs it, with the local executor: variants, results, reruns, failures.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
+#include <sstream>
+#include <thread>
 
 #include "tests/test_support.h"
 
@@ -114,6 +118,101 @@ TEST(CliSweep, BadSweepsAreUserErrorsBeforeAnythingRuns) {
   auto no_scene = run_rigc({"sweep", dir.file("missing.yaml"), "--vary", "a=1"});
   EXPECT_EQ(no_scene.exit_code, 1);
   EXPECT_NE(no_scene.err.find("cannot read the scene file"), std::string::npos) << no_scene.err;
+}
+
+// True when a Slurm cluster answers (scripts/slurm_cluster.sh start; its slurm.conf is used when
+// SLURM_CONF is not set).
+bool slurm_cluster_up() {
+  const char* default_conf = "/tmp/rigc-slurm/slurm.conf";
+  if (!std::getenv("SLURM_CONF") && fs::exists(default_conf)) setenv("SLURM_CONF", default_conf, 1);
+  return testing::run_process({"sinfo", "-h"}).exit_code == 0;
+}
+
+// The first Slurm task of the sweep in `out` seen running ("123_4"), polled for up to a minute.
+std::string first_running_task(const std::string& out) {
+  for (int i = 0; i < 600; ++i) {
+    const auto queue = testing::run_process({"squeue", "-h", "-r", "-t", "RUNNING", "-o", "%i %o"});
+    std::istringstream lines(queue.out);
+    for (std::string id, command; lines >> id >> command;) {
+      if (command.starts_with(out + "/")) return id;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return "";
+}
+
+TEST(CliSweepSlurm, AJobArrayGivesTheSameResultsAsTheLocalExecutor) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  write_text(dir.file("s.yaml"), sweep_file("f/4, f/16"));
+  auto local = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("local")});
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  auto slurm = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--executor",
+                         "slurm", "--cpus-per-task", "1", "--time", "10:00"});
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
+  EXPECT_NE(slurm.err.find("4/4 tasks done"), std::string::npos) << slurm.err;
+  EXPECT_EQ(read_text(dir.file("slurm") + "/results.csv"),
+            read_text(dir.file("local") + "/results.csv"));
+  auto status = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--status"});
+  EXPECT_NE(status.out.find("4/4 variants done"), std::string::npos) << status.out;
+}
+
+TEST(CliSweepSlurm, AKilledTaskIsReportedAndRetryFailedCompletesIt) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::vector<std::string> sweep = {"sweep",      dir.file("scene.yaml"),
+                                          "--vary",     "shots[0].turntable.steps=3,4",
+                                          "--scale",    "0.05",
+                                          "-o",         dir.file("out"),
+                                          "--executor", "slurm"};
+  testing::ProcessResult waiting;
+  std::thread runner([&] { waiting = run_rigc(sweep); });
+  const std::string task = first_running_task(dir.file("out"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const int cancelled = testing::run_process({"scancel", task}).exit_code;
+  runner.join();
+  ASSERT_FALSE(task.empty()) << waiting.err;
+  ASSERT_EQ(cancelled, 0);
+  EXPECT_EQ(waiting.exit_code, 2) << waiting.err;
+  EXPECT_NE(waiting.err.find("failed (job " + task + "): Slurm: CANCELLED"), std::string::npos)
+      << waiting.err;
+  EXPECT_NE(waiting.err.find(dir.file("out") + "/slurm/" + task + ".log"), std::string::npos);
+
+  std::vector<std::string> retry = sweep;
+  retry.push_back("--retry-failed");
+  auto retried = run_rigc(retry);
+  ASSERT_EQ(retried.exit_code, 0) << retried.err;
+  EXPECT_NE(retried.err.find("1 to submit"), std::string::npos) << retried.err;
+  EXPECT_NE(retried.out.find("2/2 variants with results"), std::string::npos) << retried.out;
+}
+
+TEST(CliSweepSlurm, ABadSbatchOptionIsAClearError) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::vector<std::string> sweep = {
+      "sweep", dir.file("scene.yaml"), "--vary",     "shots[0].turntable.steps=3,4",
+      "-o",    dir.file("out"),        "--executor", "slurm"};
+  auto args = sweep;
+  args.push_back("--sbatch=--no-such-option");
+  auto bad = run_rigc(args);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("rigc: error: sbatch refused the job array"), std::string::npos)
+      << bad.err;
+  EXPECT_NE(bad.err.find("no-such-option"), std::string::npos) << bad.err;
+  args = sweep;
+  args.insert(args.end(), {"--partition", "nosuch"});
+  auto partition = run_rigc(args);
+  EXPECT_EQ(partition.exit_code, 1);
+  EXPECT_NE(partition.err.find("nvalid partition"), std::string::npos) << partition.err;
+  args = sweep;
+  args.push_back("--sbatch=--output=/tmp/x");
+  auto own = run_rigc(args);
+  EXPECT_EQ(own.exit_code, 1);
+  EXPECT_NE(own.err.find("is rigc's own"), std::string::npos) << own.err;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@ packages=(
   nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema python3-yaml
   povray blender colmap libopen3d-dev libembree-dev libnanoflann-dev fonts-dejavu-core
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
