@@ -1,6 +1,7 @@
 // `rigc sweep` as a user runs it, with the local executor: variants, results, reruns, failures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -213,6 +214,48 @@ TEST(CliSweepSlurm, ABadSbatchOptionIsAClearError) {
   auto own = run_rigc(args);
   EXPECT_EQ(own.exit_code, 1);
   EXPECT_NE(own.err.find("is rigc's own"), std::string::npos) << own.err;
+}
+
+// A run's outputs (images, masks, ground truth), relative to it; not the renderer's own scripts
+// and logs (render/), the manifest's timings or the Slurm parts.
+std::vector<std::string> run_files(const fs::path& run) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(run)) {
+    const std::string relative = fs::relative(e.path(), run).string();
+    if (e.is_regular_file() && !relative.starts_with(".") && !relative.starts_with("render/") &&
+        relative != "manifest.json") {
+      files.push_back(relative);
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(CliSweepSlurm, ACyclesRenderSplitOverSlurmIsByteIdenticalToALocalOne) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  RIGC_REQUIRE_TOOL(testing::run_process({"blender", "--version"}).exit_code == 0, "Blender");
+  TempDir dir;
+  std::string scene = small_scene();
+  scene.replace(scene.find("steps: 4, step: 90deg"), 21, "steps: 6, step: 60deg");
+  write_text(dir.file("scene.yaml"), scene);
+  const std::vector<std::string> render = {
+      "render", dir.file("scene.yaml"), "--backend", "cycles", "--scale", "0.05", "--samples", "4"};
+  auto args = render;
+  args.insert(args.end(), {"-o", dir.file("local")});
+  auto local = run_rigc(args);
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  args = render;
+  args.insert(args.end(), {"-o", dir.file("slurm"), "--executor", "slurm"});
+  auto slurm = run_rigc(args);
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
+  EXPECT_NE(slurm.err.find("6/6 shots done"), std::string::npos) << slurm.err;
+  const auto files = run_files(dir.file("local"));
+  ASSERT_EQ(files, run_files(dir.file("slurm")));
+  EXPECT_GE(files.size(), 15u);  // 6 images, 6 masks, sparse/, transforms.json
+  for (const std::string& f : files) {
+    EXPECT_EQ(read_text(dir.file("slurm") + "/" + f), read_text(dir.file("local") + "/" + f)) << f;
+  }
 }
 
 }  // namespace

@@ -18,26 +18,12 @@
 #include "sweep/task.h"
 
 namespace rigc::sweep {
-namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
-// Runs a Slurm client; its output (stdout and stderr) in `output`. -1 when it cannot start.
-int run_tool(const fs::path& sweep_dir, const std::vector<std::string>& argv, std::string* output) {
-  static std::atomic<int> counter{0};
-  const fs::path capture =
-      sweep_dir / "slurm" / fmt::format(".{}-{}-{}.out", argv[0], getpid(), counter++);
-  const ChildResult result = run_child({argv, capture, {}, {}});
-  std::ifstream in(capture);
-  std::ostringstream text;
-  text << in.rdbuf();
-  *output = text.str();
-  std::error_code ec;
-  fs::remove(capture, ec);
-  if (!result.started) *output = result.error;
-  return result.started ? result.exit_code : -1;
-}
+namespace {
+
+using Clock = std::chrono::steady_clock;
 
 nlohmann::json read_slurm_json(const fs::path& sweep_dir) {
   std::ifstream in(sweep_dir / "slurm.json");
@@ -46,26 +32,6 @@ nlohmann::json read_slurm_json(const fs::path& sweep_dir) {
   } catch (const nlohmann::json::exception&) {
   }
   return {{"tasks", nlohmann::json::object()}};
-}
-
-// The states of the tasks Slurm still holds ("123_4" -> "RUNNING"); every job of the queue.
-std::map<std::string, std::string> queued_tasks(const fs::path& sweep_dir) {
-  std::string output;
-  std::map<std::string, std::string> states;
-  if (run_tool(sweep_dir, {"squeue", "-h", "-r", "-o", "%i %T"}, &output) != 0) return states;
-  std::istringstream lines(output);
-  for (std::string id, state; lines >> id >> state;) states[id] = state;
-  return states;
-}
-
-// JobState (and Reason) of a finished task, while slurmctld still remembers it.
-std::string finished_state(const fs::path& sweep_dir, const std::string& job) {
-  std::string output;
-  if (run_tool(sweep_dir, {"scontrol", "-o", "show", "job", job}, &output) != 0) return "";
-  const std::size_t at = output.find("JobState=");
-  if (at == std::string::npos) return "";
-  const std::size_t end = output.find(' ', at);
-  return output.substr(at + 9, end == std::string::npos ? end : end - at - 9);
 }
 
 // The sbatch options RigC sets itself; a user's would break the array or its logs.
@@ -105,7 +71,7 @@ int submit(const fs::path& sweep_dir, const std::vector<Variant>& variants,
   argv.insert(argv.end(), {(slurm_dir / "task.sh").string(), fs::absolute(options.rigc).string(),
                            fs::absolute(sweep_dir).string()});
   std::string output;
-  const int status = run_tool(sweep_dir, argv, &output);
+  const int status = run_slurm_tool(sweep_dir, argv, &output);
   if (status == -1) {
     log << "rigc: error: cannot run sbatch (--executor slurm needs Slurm's client tools): "
         << output << '\n';
@@ -169,6 +135,43 @@ void wait_for(const fs::path& sweep_dir, const nlohmann::json& record,
 }
 
 }  // namespace
+
+// Runs a Slurm client; its output (stdout and stderr) in `output`. -1 when it cannot start.
+int run_slurm_tool(const fs::path& sweep_dir, const std::vector<std::string>& argv,
+                   std::string* output) {
+  static std::atomic<int> counter{0};
+  const fs::path capture =
+      sweep_dir / "slurm" / fmt::format(".{}-{}-{}.out", argv[0], getpid(), counter++);
+  const ChildResult result = run_child({argv, capture, {}, {}});
+  std::ifstream in(capture);
+  std::ostringstream text;
+  text << in.rdbuf();
+  *output = text.str();
+  std::error_code ec;
+  fs::remove(capture, ec);
+  if (!result.started) *output = result.error;
+  return result.started ? result.exit_code : -1;
+}
+
+// The states of the tasks Slurm still holds ("123_4" -> "RUNNING"); every job of the queue.
+std::map<std::string, std::string> queued_tasks(const fs::path& sweep_dir) {
+  std::string output;
+  std::map<std::string, std::string> states;
+  if (run_slurm_tool(sweep_dir, {"squeue", "-h", "-r", "-o", "%i %T"}, &output) != 0) return states;
+  std::istringstream lines(output);
+  for (std::string id, state; lines >> id >> state;) states[id] = state;
+  return states;
+}
+
+// JobState (and Reason) of a finished task, while slurmctld still remembers it.
+std::string finished_state(const fs::path& sweep_dir, const std::string& job) {
+  std::string output;
+  if (run_slurm_tool(sweep_dir, {"scontrol", "-o", "show", "job", job}, &output) != 0) return "";
+  const std::size_t at = output.find("JobState=");
+  if (at == std::string::npos) return "";
+  const std::size_t end = output.find(' ', at);
+  return output.substr(at + 9, end == std::string::npos ? end : end - at - 9);
+}
 
 std::string array_list(std::vector<int> indices) {
   std::sort(indices.begin(), indices.end());

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,17 @@ SlurmOutcome run_slurm(const std::filesystem::path& sweep_dir, const SweepSpec& 
 // One line per variant: done, failed (why, log), queued or running in Slurm, or not run.
 std::string status_text(const std::filesystem::path& sweep_dir, const SweepSpec& spec,
                         const std::vector<Variant>& variants);
+
+// Runs a Slurm client (argv[0]: sbatch, squeue, scontrol, ...) with its output captured through a
+// file in DIR/slurm/ into `output`. Its exit code, or -1 when it cannot start (`output` says why).
+int run_slurm_tool(const std::filesystem::path& dir, const std::vector<std::string>& argv,
+                   std::string* output);
+
+// The tasks Slurm holds, pending or running ("123_4" -> "RUNNING").
+std::map<std::string, std::string> queued_tasks(const std::filesystem::path& dir);
+
+// A finished task's JobState ("CANCELLED", "FAILED", ...) while slurmctld remembers it, or "".
+std::string finished_state(const std::filesystem::path& dir, const std::string& job);
 
 // "0-3,7,9-10": sorted indices as an sbatch --array list.
 std::string array_list(std::vector<int> indices);
