@@ -62,7 +62,7 @@ std::string csv_text(const SweepSpec& spec, const std::vector<ResultRow>& rows) 
   for (const ResultRow& r : rows) {
     csv += csv_field(r.variant->name);
     for (const std::string& v : r.variant->values) csv += "," + csv_field(v);
-    csv += r.ok ? ",ok" : ",failed";
+    csv += r.ok ? ",ok" : r.ran ? ",failed" : ",not run";
     for (std::size_t m = 0; m < measures().size(); ++m) {
       csv += "," + number_text(r.numbers[m], measures()[m].decimals);
     }
@@ -157,7 +157,8 @@ std::string markdown_text(const SweepSpec& spec, const std::vector<ResultRow>& r
   }
   std::string failures;
   for (const ResultRow& r : rows) {
-    if (!r.ok) failures += fmt::format("- {}: {} (log: {})\n", r.variant->name, r.reason, r.log);
+    if (r.ran && !r.ok)
+      failures += fmt::format("- {}: {} (log: {})\n", r.variant->name, r.reason, r.log);
   }
   if (!failures.empty()) md += "\n## Failed variants\n\n" + failures;
   md += rank_agreement(spec, rows);
@@ -194,6 +195,7 @@ std::vector<ResultRow> collect_results(const fs::path& sweep_dir,
     if (!result) {
       row.reason = "not run";
     } else {
+      row.ran = true;
       row.ok = result->value("status", "") == "ok";
       row.reason = row.ok ? "" : result->value("reason", std::string("failed"));
       for (std::size_t m = 0; m < measures().size(); ++m) {

@@ -24,6 +24,7 @@ const std::vector<Measure>& measures();
 
 struct ResultRow {
   const Variant* variant = nullptr;
+  bool ran = false;  // it has a result.json for its inputs
   bool ok = false;
   std::string reason, log;
   std::vector<std::optional<double>> numbers;  // per measures()
