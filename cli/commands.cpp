@@ -22,6 +22,7 @@
 #include "run/run_loop.h"
 #include "run/shots.h"
 #include "scene/studio_scene.h"
+#include "sweep/split_render.h"
 
 namespace rigc::cli {
 namespace {
@@ -184,6 +185,12 @@ int run_render(std::vector<std::string> args) {
   app.add_option("--seed", seed, "sensor noise seed")
       ->check(non_negative_number())
       ->capture_default_str();
+  std::string executor = "local";
+  std::vector<std::string> sbatch;
+  app.add_option("--executor", executor, "local, or slurm: a Slurm array task per shot")
+      ->check(CLI::IsMember({"local", "slurm"}))
+      ->capture_default_str();
+  app.add_option("--sbatch", sbatch, "slurm: an sbatch option, e.g. --sbatch=--time=1:00:00");
   if (auto code = parse_options(app, args)) return *code;
 
   DiagnosticEngine diag;
@@ -203,6 +210,10 @@ int run_render(std::vector<std::string> args) {
   options.settings.samples = samples;
   options.progress_bar = isatty(STDERR_FILENO);
   const std::unique_ptr<run::Backend> renderer = backends::find_backend(backend)->make();
+  if (executor == "slurm") {
+    const sweep::SplitRender split{fs::read_symlink("/proc/self/exe"), scene_path, backend, sbatch};
+    return sweep::render_on_slurm(*scene, *renderer, options, split, std::cerr);
+  }
   return run::run_backend(*scene, *renderer, options, std::cerr);
 }
 
@@ -267,6 +278,8 @@ const std::vector<Command>& commands() {
        run_compare_command},
       {"plan", "plan the fewest shots that reach a coverage target", run_plan_command},
       {"studio", "the interactive capture studio in a browser", run_studio_command},
+      {"sweep", "compare capture configurations: scene variants, locally or on Slurm",
+       run_sweep_command},
       {"version", "print the version", run_version},
   };
   return table;

@@ -11,6 +11,7 @@ packages=(
   python3 python3-jsonschema python3-yaml
   povray blender colmap libopen3d-dev libembree-dev libnanoflann-dev fonts-dejavu-core
   libcpp-httplib-dev libjs-three chromium chromium-driver python3-selenium
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()

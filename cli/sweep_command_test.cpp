@@ -1,0 +1,262 @@
+// `rigc sweep` as a user runs it, with the local executor: variants, results, reruns, failures.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+
+#include "tests/test_support.h"
+
+namespace rigc::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::read_text;
+using testing::run_rigc;
+using testing::source_path;
+using testing::TempDir;
+using testing::write_text;
+
+// The paper scene made small: a coarse statue, four shots.
+std::string small_scene() {
+  std::string text = read_text(source_path("scenes/paper-turntable.yaml"));
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+  };
+  replace("detail: 6", "detail: 3");
+  replace("steps: 18, step: 20deg", "steps: 4, step: 90deg");
+  return text;
+}
+
+std::string sweep_file(const std::string& apertures) {
+  return "rigc-sweep: 1\nscene: scene.yaml\nvary:\n  camera.exposure.aperture: [" + apertures +
+         "]\n  shots[0].turntable.steps: [3, 4]\nscale: 0.05\nmeasure: [coverage]\n";
+}
+
+int count_lines(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
+TEST(CliSweep, RunsEveryVariantAndRerunsOnlyWhatChanged) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  write_text(dir.file("s.yaml"), sweep_file("f/4, f/16"));
+  const std::string out = dir.file("out");
+  auto first = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_NE(first.err.find("4 to run"), std::string::npos) << first.err;
+  EXPECT_NE(first.err.find("4/4 done"), std::string::npos) << first.err;
+  const std::string csv = read_text(out + "/results.csv");
+  EXPECT_EQ(count_lines(csv), 5) << csv;
+  EXPECT_NE(csv.find("aperture-f-16_steps-4,f/16,4,ok,"), std::string::npos) << csv;
+  const std::string md = read_text(out + "/results.md");
+  EXPECT_NE(md.find("Best variant: **"), std::string::npos) << md;
+  EXPECT_TRUE(fs::exists(out + "/plots/reconstructable_pct_vs_camera.exposure.aperture.png"));
+  // Each variant is an ordinary scene file with its run outputs beside it.
+  const std::string variant = out + "/aperture-f-16_steps-3";
+  EXPECT_NE(read_text(variant + "/scene.yaml").find("{aperture: f/16, shutter"), std::string::npos);
+  EXPECT_TRUE(fs::exists(variant + "/images/shot_002.jpg"));
+  EXPECT_FALSE(fs::exists(variant + "/images/shot_003.jpg"));
+  EXPECT_TRUE(fs::exists(variant + "/coverage/coverage.json"));
+  EXPECT_EQ(run_rigc({"check", variant + "/scene.yaml", "--no-advice"}).exit_code, 0);
+
+  auto again = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_NE(again.err.find("0 to run (4 done already)"), std::string::npos) << again.err;
+  EXPECT_EQ(read_text(out + "/results.csv"), csv);
+
+  write_text(dir.file("s.yaml"), sweep_file("f/4, f/11"));
+  auto changed = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
+  ASSERT_EQ(changed.exit_code, 0) << changed.err;
+  EXPECT_NE(changed.err.find("2 to run (2 done already)"), std::string::npos) << changed.err;
+  EXPECT_NE(read_text(out + "/results.csv").find("f/11"), std::string::npos);
+}
+
+TEST(CliSweep, AFailingVariantIsReportedAndTheOthersComplete) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::string out = dir.file("out");
+  // A file where the variant's coverage folder goes: its coverage cannot be written.
+  fs::create_directories(out + "/steps-3");
+  write_text(out + "/steps-3/coverage", "in the way");
+  auto result = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "shots[0].turntable.steps=3,4",
+                          "--scale", "0.05", "-o", out});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_NE(result.err.find("variant steps-3 failed: "), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("(log: " + out + "/steps-3/log.txt)"), std::string::npos) << result.err;
+  const std::string csv = read_text(out + "/results.csv");
+  EXPECT_NE(csv.find("steps-4,4,ok,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("steps-3,3,failed,"), std::string::npos) << csv;
+  EXPECT_NE(read_text(out + "/results.md").find("## Failed variants"), std::string::npos);
+  auto status = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "shots[0].turntable.steps=3,4",
+                          "--scale", "0.05", "-o", out, "--status"});
+  EXPECT_NE(status.out.find("steps-4"), std::string::npos);
+  EXPECT_NE(status.out.find("1/2 variants done"), std::string::npos) << status.out;
+}
+
+TEST(CliSweep, BadSweepsAreUserErrorsBeforeAnythingRuns) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  write_text(dir.file("s.yaml"), sweep_file("f/4, f/99"));
+  auto bad_value = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("out")});
+  EXPECT_EQ(bad_value.exit_code, 1);
+  EXPECT_NE(bad_value.err.find(dir.file("s.yaml") + ":4:35: error: variant 'aperture-f-99_steps-3'"
+                                                    " does not compile"),
+            std::string::npos)
+      << bad_value.err;
+  EXPECT_NE(bad_value.err.find(dir.file("scene.yaml") + ":23:"), std::string::npos)
+      << bad_value.err;
+  EXPECT_FALSE(fs::exists(dir.file("out")));
+  auto bad_vary = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "camera.nope=1,2"});
+  EXPECT_EQ(bad_vary.exit_code, 1);
+  EXPECT_NE(bad_vary.err.find("'camera' has no key 'nope'"), std::string::npos) << bad_vary.err;
+  auto no_eq = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "camera.nope"});
+  EXPECT_EQ(no_eq.exit_code, 1);
+  EXPECT_NE(no_eq.err.find("is not PATH=V1,V2"), std::string::npos) << no_eq.err;
+  auto no_scene = run_rigc({"sweep", dir.file("missing.yaml"), "--vary", "a=1"});
+  EXPECT_EQ(no_scene.exit_code, 1);
+  EXPECT_NE(no_scene.err.find("cannot read the scene file"), std::string::npos) << no_scene.err;
+}
+
+// True when a Slurm cluster answers (scripts/slurm_cluster.sh start; its slurm.conf is used when
+// SLURM_CONF is not set).
+bool slurm_cluster_up() {
+  const char* default_conf = "/tmp/rigc-slurm/slurm.conf";
+  if (!std::getenv("SLURM_CONF") && fs::exists(default_conf)) setenv("SLURM_CONF", default_conf, 1);
+  return testing::run_process({"sinfo", "-h"}).exit_code == 0;
+}
+
+// The first Slurm task of the sweep in `out` seen running ("123_4"), polled for up to a minute.
+std::string first_running_task(const std::string& out) {
+  for (int i = 0; i < 600; ++i) {
+    const auto queue = testing::run_process({"squeue", "-h", "-r", "-t", "RUNNING", "-o", "%i %o"});
+    std::istringstream lines(queue.out);
+    for (std::string id, command; lines >> id >> command;) {
+      if (command.starts_with(out + "/")) return id;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return "";
+}
+
+TEST(CliSweepSlurm, AJobArrayGivesTheSameResultsAsTheLocalExecutor) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  write_text(dir.file("s.yaml"), sweep_file("f/4, f/16"));
+  auto local = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("local")});
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  auto slurm = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--executor",
+                         "slurm", "--cpus-per-task", "1", "--time", "10:00"});
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
+  EXPECT_NE(slurm.err.find("4/4 tasks done"), std::string::npos) << slurm.err;
+  EXPECT_EQ(read_text(dir.file("slurm") + "/results.csv"),
+            read_text(dir.file("local") + "/results.csv"));
+  auto status = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--status"});
+  EXPECT_NE(status.out.find("4/4 variants done"), std::string::npos) << status.out;
+}
+
+TEST(CliSweepSlurm, AKilledTaskIsReportedAndRetryFailedCompletesIt) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::vector<std::string> sweep = {"sweep",      dir.file("scene.yaml"),
+                                          "--vary",     "shots[0].turntable.steps=3,4",
+                                          "--scale",    "0.05",
+                                          "-o",         dir.file("out"),
+                                          "--executor", "slurm"};
+  testing::ProcessResult waiting;
+  std::thread runner([&] { waiting = run_rigc(sweep); });
+  const std::string task = first_running_task(dir.file("out"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const int cancelled = testing::run_process({"scancel", task}).exit_code;
+  runner.join();
+  ASSERT_FALSE(task.empty()) << waiting.err;
+  ASSERT_EQ(cancelled, 0);
+  EXPECT_EQ(waiting.exit_code, 2) << waiting.err;
+  EXPECT_NE(waiting.err.find("failed (job " + task + "): Slurm: CANCELLED"), std::string::npos)
+      << waiting.err;
+  EXPECT_NE(waiting.err.find(dir.file("out") + "/slurm/" + task + ".log"), std::string::npos);
+
+  std::vector<std::string> retry = sweep;
+  retry.push_back("--retry-failed");
+  auto retried = run_rigc(retry);
+  ASSERT_EQ(retried.exit_code, 0) << retried.err;
+  EXPECT_NE(retried.err.find("1 to submit"), std::string::npos) << retried.err;
+  EXPECT_NE(retried.out.find("2/2 variants with results"), std::string::npos) << retried.out;
+}
+
+TEST(CliSweepSlurm, ABadSbatchOptionIsAClearError) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::vector<std::string> sweep = {
+      "sweep", dir.file("scene.yaml"), "--vary",     "shots[0].turntable.steps=3,4",
+      "-o",    dir.file("out"),        "--executor", "slurm"};
+  auto args = sweep;
+  args.push_back("--sbatch=--no-such-option");
+  auto bad = run_rigc(args);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("rigc: error: sbatch refused the job array"), std::string::npos)
+      << bad.err;
+  EXPECT_NE(bad.err.find("no-such-option"), std::string::npos) << bad.err;
+  args = sweep;
+  args.insert(args.end(), {"--partition", "nosuch"});
+  auto partition = run_rigc(args);
+  EXPECT_EQ(partition.exit_code, 1);
+  EXPECT_NE(partition.err.find("nvalid partition"), std::string::npos) << partition.err;
+  args = sweep;
+  args.push_back("--sbatch=--output=/tmp/x");
+  auto own = run_rigc(args);
+  EXPECT_EQ(own.exit_code, 1);
+  EXPECT_NE(own.err.find("is rigc's own"), std::string::npos) << own.err;
+}
+
+// A run's outputs (images, masks, ground truth), relative to it; not the renderer's own scripts
+// and logs (render/), the manifest's timings or the Slurm parts.
+std::vector<std::string> run_files(const fs::path& run) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(run)) {
+    const std::string relative = fs::relative(e.path(), run).string();
+    if (e.is_regular_file() && !relative.starts_with(".") && !relative.starts_with("render/") &&
+        relative != "manifest.json") {
+      files.push_back(relative);
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(CliSweepSlurm, ACyclesRenderSplitOverSlurmIsByteIdenticalToALocalOne) {
+  RIGC_REQUIRE_TOOL(slurm_cluster_up(), "a Slurm cluster (bash scripts/slurm_cluster.sh start)");
+  RIGC_REQUIRE_TOOL(testing::run_process({"blender", "--version"}).exit_code == 0, "Blender");
+  TempDir dir;
+  std::string scene = small_scene();
+  scene.replace(scene.find("steps: 4, step: 90deg"), 21, "steps: 6, step: 60deg");
+  write_text(dir.file("scene.yaml"), scene);
+  const std::vector<std::string> render = {
+      "render", dir.file("scene.yaml"), "--backend", "cycles", "--scale", "0.05", "--samples", "4"};
+  auto args = render;
+  args.insert(args.end(), {"-o", dir.file("local")});
+  auto local = run_rigc(args);
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  args = render;
+  args.insert(args.end(), {"-o", dir.file("slurm"), "--executor", "slurm"});
+  auto slurm = run_rigc(args);
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
+  EXPECT_NE(slurm.err.find("6/6 shots done"), std::string::npos) << slurm.err;
+  const auto files = run_files(dir.file("local"));
+  ASSERT_EQ(files, run_files(dir.file("slurm")));
+  EXPECT_GE(files.size(), 15u);  // 6 images, 6 masks, sparse/, transforms.json
+  for (const std::string& f : files) {
+    EXPECT_EQ(read_text(dir.file("slurm") + "/" + f), read_text(dir.file("local") + "/" + f)) << f;
+  }
+}
+
+}  // namespace
+}  // namespace rigc::cli

@@ -1,0 +1,184 @@
+// The sweep's parts: value paths and spans in scene text, the sweep file and its errors, the
+// variants (grid, zip, names), compile errors at their lines, rank correlation, array lists.
+#include <gtest/gtest.h>
+
+#include "sweep/results.h"
+#include "sweep/scene_edit.h"
+#include "sweep/slurm_executor.h"
+#include "sweep/sweep_spec.h"
+#include "sweep/variants.h"
+#include "tests/test_support.h"
+
+namespace rigc::sweep {
+namespace {
+
+using testing::read_text;
+using testing::source_path;
+using testing::TempDir;
+
+// Keeps the diagnostics in the engine instead of printing them.
+void capture(DiagnosticEngine& diag) {
+  diag.set_handler([](const Diagnostic&, const std::string&) {});
+}
+
+std::string all_diagnostics(DiagnosticEngine& diag) {
+  std::string text;
+  for (const auto& d : diag.diagnostics()) {
+    text += d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " +
+            d.message + "\n";
+  }
+  return text;
+}
+
+TEST(SweepEdit, PathsFollowTheSchemasNames) {
+  std::string error;
+  const auto steps = parse_value_path("shots[0].turntable.steps", &error);
+  ASSERT_TRUE(steps) << error;
+  ASSERT_EQ(steps->size(), 4u);
+  EXPECT_EQ((*steps)[0].key, "shots");
+  EXPECT_EQ((*steps)[1].index, 0);
+  EXPECT_EQ((*steps)[3].key, "steps");
+  EXPECT_FALSE(parse_value_path("shots[x].a", &error));
+  EXPECT_FALSE(parse_value_path("[0].a", &error));
+  EXPECT_FALSE(parse_value_path("a..b", &error));
+  EXPECT_FALSE(parse_value_path("a;rm -rf", &error));
+}
+
+TEST(SweepEdit, ReplacesOnlyTheValuesSpanInFlowAndBlockStyle) {
+  const std::string text =
+      "camera:\n  exposure: {aperture: f/13, shutter: 1/125}  # keep\n  focus: auto # note\n"
+      "shots:\n  - turntable: {steps: 18, step: 20deg}\n";
+  std::string error;
+  const auto span = find_value_span(text, "camera.exposure.aperture", &error);
+  ASSERT_TRUE(span) << error;
+  EXPECT_EQ(span->line, 2);
+  EXPECT_EQ(text.substr(span->begin, span->end - span->begin), "f/13");
+  const auto edited = edit_scene_text(text,
+                                      {{"camera.exposure.aperture", "f/4"},
+                                       {"shots[0].turntable.steps", "36"},
+                                       {"camera.focus", "1.2m"}},
+                                      &error);
+  ASSERT_TRUE(edited) << error;
+  EXPECT_EQ(*edited,
+            "camera:\n  exposure: {aperture: f/4, shutter: 1/125}  # keep\n  focus: 1.2m # note\n"
+            "shots:\n  - turntable: {steps: 36, step: 20deg}\n");
+  EXPECT_FALSE(find_value_span(text, "camera.exposure.iso", &error));
+  EXPECT_NE(error.find("no key 'iso'"), std::string::npos) << error;
+  EXPECT_FALSE(find_value_span(text, "shots[3].turntable", &error));
+  EXPECT_FALSE(find_value_span(text, "camera.exposure", &error));  // not a scalar
+}
+
+TEST(SweepEdit, ValuesThatAreNotPlainAreQuoted) {
+  EXPECT_EQ(yaml_scalar_text("f/8"), "f/8");
+  EXPECT_EQ(yaml_scalar_text("-0.5"), "-0.5");
+  EXPECT_EQ(yaml_scalar_text("a: b"), "\"a: b\"");
+  EXPECT_EQ(yaml_scalar_text("x\"\n"), "\"x\\\"\\x0a\"");
+  EXPECT_EQ(yaml_scalar_text("[1, 2]"), "\"[1, 2]\"");
+}
+
+TEST(SweepFile, ReadsAxesZipBackendScaleAndMeasures) {
+  DiagnosticEngine diag;
+  const auto spec = parse_sweep_text(
+      "rigc-sweep: 1\nscene: scenes/paper.yaml\nvary:\n  camera.exposure.aperture: [f/4, f/8]\n"
+      "  shots[0].turntable.steps: [12, 36]\n  shots[0].turntable.step: [30deg, 10deg]\n"
+      "zip: [\"shots[0].turntable.steps\", \"shots[0].turntable.step\"]\nbackend: [preview, "
+      "povray]\n"
+      "scale: 0.1\nmeasure: [coverage, eval]\n",
+      "/tmp/s/sweep.yaml", diag);
+  ASSERT_TRUE(spec) << all_diagnostics(diag);
+  EXPECT_EQ(spec->scene_path, "/tmp/s/scenes/paper.yaml");
+  EXPECT_EQ(spec->name, "sweep");
+  ASSERT_EQ(spec->axes.size(), 4u);
+  EXPECT_TRUE(spec->axes[3].is_backend());
+  EXPECT_DOUBLE_EQ(spec->scale, 0.1);
+  EXPECT_TRUE(spec->coverage && spec->eval);
+  const auto variants = expand_variants(*spec);
+  ASSERT_EQ(variants.size(), 8u);  // 2 apertures x 2 zipped pairs x 2 backends
+  EXPECT_EQ(variants[0].name, "aperture-f-4_steps-12_step-30deg_backend-preview");
+  EXPECT_EQ(variants[1].backend, "povray");
+  EXPECT_EQ(variants[2].values[1], "36");
+  EXPECT_EQ(variants[2].values[2], "10deg");  // zipped with 36
+}
+
+TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
+  DiagnosticEngine diag;
+  capture(diag);
+  EXPECT_FALSE(parse_sweep_text(
+      "rigc-sweep: 1\nscene: a.yaml\nvary:\n  camera.exposure.aperture: [f/4, f/4]\n"
+      "  shots[0].turntable.steps: [12]\nzip: [camera.exposure.aperture, "
+      "\"shots[0].turntable.steps\"]"
+      "\nbackend: [preview, dali]\nmesure: [eval]\n",
+      "s.yaml", diag));
+  const std::string text = all_diagnostics(diag);
+  EXPECT_NE(text.find("s.yaml:8:1: unknown key 'mesure' in the sweep file; did you mean "
+                      "'measure'?"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("s.yaml:7:20: unknown backend 'dali'"), std::string::npos) << text;
+  EXPECT_NE(text.find("s.yaml:4:35: 'f/4' is given twice"), std::string::npos) << text;
+  EXPECT_NE(text.find("zipped axes need as many values"), std::string::npos) << text;
+  DiagnosticEngine other;
+  capture(other);
+  EXPECT_FALSE(parse_sweep_text("rigc: 1\n", "s.yaml", other));
+  EXPECT_NE(all_diagnostics(other).find("starts with `rigc-sweep: 1`"), std::string::npos);
+}
+
+TEST(SweepFile, FolderNamesAreSanitised) {
+  EXPECT_EQ(folder_name("../../etc/passwd"), "..-..-etc-passwd");
+  EXPECT_EQ(folder_name(".."), "_..");
+  EXPECT_EQ(folder_name(""), "_");
+  EXPECT_EQ(folder_name("a b$(x)`y`"), "a-b--x--y-");
+  EXPECT_EQ(folder_name(std::string(100, 'x')).size(), 40u);
+}
+
+TEST(SweepVariants, AVariantThatDoesNotCompileIsAnErrorAtItsValueAndTheScenesLine) {
+  TempDir dir;
+  const std::string scene = source_path("scenes/paper-turntable.yaml");
+  DiagnosticEngine diag;
+  capture(diag);
+  const std::string sweep_text =
+      "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.aperture: [f/8, f/0.5]\n";
+  const auto spec = parse_sweep_text(sweep_text, dir.file("s.yaml"), diag);
+  ASSERT_TRUE(spec) << all_diagnostics(diag);
+  std::vector<Variant> variants;
+  EXPECT_FALSE(build_variants(*spec, read_text(scene), dir.path() / "out", variants, diag));
+  const std::string text = all_diagnostics(diag);
+  EXPECT_NE(text.find(dir.file("s.yaml") + ":4:35: variant 'aperture-f-0.5' does not compile "
+                                           "(camera.exposure.aperture = f/0.5): aperture f/0.5"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find(scene + ":23:"), std::string::npos) << text;  // the scene's line
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));        // nothing ran
+}
+
+TEST(SweepVariants, AMissingPathIsAnErrorAtTheAxis) {
+  const std::string scene = source_path("scenes/paper-turntable.yaml");
+  DiagnosticEngine diag;
+  capture(diag);
+  const auto spec = parse_sweep_text(
+      "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.isoo: [100]\n", "s.yaml",
+      diag);
+  ASSERT_TRUE(spec);
+  std::vector<Variant> variants;
+  EXPECT_FALSE(build_variants(*spec, read_text(scene), "/nonexistent", variants, diag));
+  EXPECT_NE(all_diagnostics(diag).find("s.yaml:4:3: 'camera.exposure' has no key 'isoo'"),
+            std::string::npos)
+      << all_diagnostics(diag);
+}
+
+TEST(SweepResults, SpearmanRanksWithTies) {
+  EXPECT_NEAR(*spearman({1, 2, 3, 4}, {10, 20, 30, 40}), 1.0, 1e-12);
+  EXPECT_NEAR(*spearman({1, 2, 3, 4}, {4, 3, 2, 1}), -1.0, 1e-12);
+  // Ranks (1, 2.5, 2.5, 4) against (1, 2, 3, 4): rho = 4.5 / sqrt(4.5 * 5).
+  EXPECT_NEAR(*spearman({1, 2, 2, 3}, {1, 2, 3, 4}), 4.5 / std::sqrt(4.5 * 5), 1e-12);
+  EXPECT_FALSE(spearman({1, 1, 1}, {1, 2, 3}));
+  EXPECT_FALSE(spearman({1}, {1}));
+}
+
+TEST(SweepSlurm, ArrayListsAreRanges) {
+  EXPECT_EQ(array_list({3, 0, 1, 2, 7, 9, 10}), "0-3,7,9-10");
+  EXPECT_EQ(array_list({5}), "5");
+}
+
+}  // namespace
+}  // namespace rigc::sweep
