@@ -15,6 +15,7 @@ namespace {
 using testing::read_text;
 using testing::source_path;
 using testing::TempDir;
+using testing::write_text;
 
 // Keeps the diagnostics in the engine instead of printing them.
 void capture(DiagnosticEngine& diag) {
@@ -164,6 +165,37 @@ TEST(SweepVariants, AMissingPathIsAnErrorAtTheAxis) {
   EXPECT_NE(all_diagnostics(diag).find("s.yaml:4:3: 'camera.exposure' has no key 'isoo'"),
             std::string::npos)
       << all_diagnostics(diag);
+}
+
+TEST(SweepVariants, AModelFileEditedInPlaceChangesTheVariantsKey) {
+  TempDir dir;
+  write_text(dir.file("box.obj"),
+             "v 0 0 0\nv 0.2 0 0\nv 0 0.2 0\nv 0 0 0.2\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  std::string scene_text = read_text(source_path("scenes/paper-turntable.yaml"));
+  const std::string primitive = "primitive: {shape: statue, detail: 6, seed: 7}";
+  scene_text.replace(scene_text.find(primitive), primitive.size(), "mesh: box.obj");
+  write_text(dir.file("scene.yaml"), scene_text);
+  DiagnosticEngine diag;
+  capture(diag);
+  const auto spec = parse_sweep_text(
+      "rigc-sweep: 1\nscene: scene.yaml\nvary:\n  "
+      "camera.exposure.aperture: [f/8, f/11]\n",
+      dir.file("s.yaml"), diag);
+  ASSERT_TRUE(spec) << all_diagnostics(diag);
+  auto keys = [&] {
+    std::vector<Variant> variants = expand_variants(*spec);
+    EXPECT_TRUE(build_variants(*spec, scene_text, dir.path() / "out", variants, diag))
+        << all_diagnostics(diag);
+    return std::vector<std::string>{variants.at(0).key, variants.at(1).key};
+  };
+  const auto before = keys();
+  EXPECT_NE(before[0], before[1]);
+  EXPECT_EQ(keys(), before);  // the same inputs, the same keys
+  write_text(dir.file("box.obj"),
+             "v 0 0 0\nv 0.3 0 0\nv 0 0.2 0\nv 0 0 0.2\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  const auto after = keys();
+  EXPECT_NE(after[0], before[0]);
+  EXPECT_NE(after[1], before[1]);
 }
 
 TEST(SweepResults, SpearmanRanksWithTies) {

@@ -10,6 +10,7 @@
 #include "compiler/frontend.h"
 #include "io/atomic_file.h"
 #include "io/files.h"
+#include "run/manifest.h"
 #include "sweep/scene_edit.h"
 
 namespace rigc::sweep {
@@ -86,10 +87,13 @@ std::vector<std::pair<std::string, std::string>> variant_edits(const SweepSpec& 
   return edits;
 }
 
-std::string variant_key(const SweepSpec& spec, const Variant& v) {
-  const nlohmann::json inputs = {{"scene", v.scene_text}, {"backend", v.backend},
-                                 {"scale", spec.scale},   {"coverage", spec.coverage},
-                                 {"eval", spec.eval},     {"rigc", RIGC_VERSION}};
+// The scene's text does not hold its mesh and textures: `content_hash` (run::scene_content_hash)
+// stands for them, so editing a model file in place reruns the variants that use it.
+std::string variant_key(const SweepSpec& spec, const Variant& v, const std::string& content_hash) {
+  const nlohmann::json inputs = {{"scene", v.scene_text},     {"content", content_hash},
+                                 {"backend", v.backend},      {"scale", spec.scale},
+                                 {"coverage", spec.coverage}, {"eval", spec.eval},
+                                 {"rigc", RIGC_VERSION}};
   return sha256_hex(inputs.dump());
 }
 
@@ -184,15 +188,18 @@ bool build_variants(const SweepSpec& spec, const std::string& scene_text, const 
       return false;
     }
     v.scene_text = *text;
-    v.key = variant_key(spec, v);
     DiagnosticEngine local;
     std::vector<Diagnostic> errors;
     local.set_handler([&](const Diagnostic& d, const std::string&) { errors.push_back(d); });
     const fs::path variant_scene = out_dir / v.name / "scene.yaml";
-    if (!compile_scene_text(v.scene_text, variant_scene.string(), base_dir.string(), local)) {
+    const auto scene =
+        compile_scene_text(v.scene_text, variant_scene.string(), base_dir.string(), local);
+    if (!scene) {
       ok = false;
       report_compile_errors(spec, v, errors, axis_lines, reported, diag);
+      continue;
     }
+    v.key = variant_key(spec, v, run::scene_content_hash(*scene));
   }
   return ok;
 }
