@@ -43,16 +43,17 @@ bool draw_plot(const fs::path& path, const std::string& title, const Axis& axis,
   double lo = points[0].y, hi = points[0].y;
   for (const Point& p : points) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
   const double pad = hi > lo ? 0.08 * (hi - lo) : std::max(1e-3, std::abs(hi) * 0.05);
-  lo -= pad;
-  hi += pad;
+  const AxisTicks ticks = nice_ticks(lo - pad, hi + pad);
+  lo = ticks.values.front();
+  hi = ticks.values.back();
   const int plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
   const int n = static_cast<int>(axis.values.size());
   auto px = [&](int i) { return kLeft + static_cast<int>((i + 0.5) * plot_w / n); };
   auto py = [&](double y) { return kTop + static_cast<int>((hi - y) / (hi - lo) * plot_h); };
-  for (int t = 0; t <= 4; ++t) {
-    const double y = lo + (hi - lo) * t / 4;
+  for (const double y : ticks.values) {
     IBA::render_line(image, kLeft, py(y), kWidth - kRight, py(y), grey);
-    text(image, kLeft - 8, py(y) + 5, fmt::format("{:.4g}", y), 14, IBA::TextAlignX::Right);
+    text(image, kLeft - 8, py(y) + 5, fmt::format("{:.{}f}", y, ticks.decimals), 14,
+         IBA::TextAlignX::Right);
   }
   IBA::render_box(image, kLeft, kTop, kWidth - kRight, kTop + plot_h, ink, false);
   std::vector<double> sum(n, 0);
@@ -86,6 +87,28 @@ bool draw_plot(const fs::path& path, const std::string& title, const Axis& axis,
 }
 
 }  // namespace
+
+AxisTicks nice_ticks(double lo, double hi, int count) {
+  const double raw = std::max(hi - lo, 1e-12) / std::max(count, 1);
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10 * magnitude;
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * magnitude >= raw) {
+      step = m * magnitude;
+      break;
+    }
+  }
+  AxisTicks ticks;
+  ticks.decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
+  const long first = static_cast<long>(std::floor(lo / step + 1e-9));
+  const long last = static_cast<long>(std::ceil(hi / step - 1e-9));
+  for (long k = first; k <= std::max(last, first + 1); ++k) {
+    // Rounded to the printed decimals: 3 x 0.2 is 0.6, not 0.6000000000000001.
+    const double scale = std::pow(10.0, ticks.decimals);
+    ticks.values.push_back(std::round(k * step * scale) / scale);
+  }
+  return ticks;
+}
 
 std::vector<std::string> write_plots(const fs::path& sweep_dir, const SweepSpec& spec,
                                      const std::vector<ResultRow>& rows, std::string* error) {

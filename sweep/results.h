@@ -41,6 +41,15 @@ std::optional<double> spearman(const std::vector<double>& a, const std::vector<d
 // The variant with the best F-score (with eval) or reconstructable share; -1 if none has one.
 int best_variant(const std::vector<ResultRow>& rows);
 
+// Grid lines for a value axis over [lo, hi]: steps of 1, 2 or 5 x 10^k, about `count` of them,
+// from a multiple of the step at or below `lo` to one at or above `hi`, and the decimals that
+// print them exactly.
+struct AxisTicks {
+  std::vector<double> values;
+  int decimals = 0;
+};
+AxisTicks nice_ticks(double lo, double hi, int count = 4);
+
 // Writes results.csv, timings.csv, results.md and plots/*.png into `sweep_dir`.
 bool write_results(const std::filesystem::path& sweep_dir, const SweepSpec& spec,
                    const std::vector<ResultRow>& rows, std::string* error);

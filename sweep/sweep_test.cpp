@@ -198,6 +198,18 @@ TEST(SweepVariants, AModelFileEditedInPlaceChangesTheVariantsKey) {
   EXPECT_NE(after[1], before[1]);
 }
 
+TEST(SweepResults, PlotAxesTickAtRoundNumbers) {
+  const AxisTicks f = nice_ticks(-0.0066, 0.5329);
+  EXPECT_EQ(f.values, (std::vector<double>{-0.2, 0.0, 0.2, 0.4, 0.6}));
+  EXPECT_EQ(f.decimals, 1);
+  const AxisTicks points = nice_ticks(640, 26000);
+  EXPECT_EQ(points.values.front(), 0);
+  EXPECT_EQ(points.values.back(), 30000);
+  EXPECT_EQ(points.decimals, 0);
+  const AxisTicks flat = nice_ticks(0.95, 0.95);
+  EXPECT_GE(flat.values.size(), 2u);
+}
+
 TEST(SweepResults, SpearmanRanksWithTies) {
   EXPECT_NEAR(*spearman({1, 2, 3, 4}, {10, 20, 30, 40}), 1.0, 1e-12);
   EXPECT_NEAR(*spearman({1, 2, 3, 4}, {4, 3, 2, 1}), -1.0, 1e-12);
