@@ -4,25 +4,10 @@
 
 #include <charconv>
 
+#include "compiler/yaml_text.h"
+
 namespace rigc::studio {
 namespace {
-
-// One past the closing quote of the quoted scalar that starts at `pos` (npos if unclosed).
-size_t quoted_end(const std::string& text, size_t pos) {
-  const char quote = text[pos];
-  for (size_t i = pos + 1; i < text.size(); ++i) {
-    if (quote == '"' && text[i] == '\\') {
-      ++i;
-    } else if (text[i] == quote) {
-      if (quote == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
-        ++i;
-        continue;
-      }
-      return i + 1;
-    }
-  }
-  return std::string::npos;
-}
 
 // One past the bracket that closes the flow collection opening at `pos` (npos if unclosed).
 size_t flow_end(const std::string& text, size_t pos) {
@@ -30,7 +15,7 @@ size_t flow_end(const std::string& text, size_t pos) {
   for (size_t i = pos; i < text.size(); ++i) {
     const char c = text[i];
     if (c == '"' || c == '\'') {
-      i = quoted_end(text, i);
+      i = quoted_scalar_end(text, i);
       if (i == std::string::npos) return i;
       --i;
     } else if (c == '#' && i > 0 && (text[i - 1] == ' ' || text[i - 1] == '\t')) {
@@ -56,7 +41,7 @@ size_t node_end(const std::string& text, const YAML::Node& node) {
   const size_t pos = node.Mark().pos;
   if (pos >= text.size()) return std::string::npos;
   if (node.IsScalar()) {
-    if (text[pos] == '"' || text[pos] == '\'') return quoted_end(text, pos);
+    if (text[pos] == '"' || text[pos] == '\'') return quoted_scalar_end(text, pos);
     const std::string& value = node.Scalar();
     return text.compare(pos, value.size(), value) == 0 ? pos + value.size() : std::string::npos;
   }

@@ -6,29 +6,14 @@
 #include <algorithm>
 #include <charconv>
 
+#include "compiler/yaml_text.h"
+
 namespace rigc::sweep {
 namespace {
 
 bool is_key_char(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
          c == '-';
-}
-
-// The end of a quoted scalar starting at `begin` (one past its closing quote), or npos.
-std::size_t quoted_end(const std::string& text, std::size_t begin) {
-  const char quote = text[begin];
-  for (std::size_t i = begin + 1; i < text.size(); ++i) {
-    if (quote == '"' && text[i] == '\\') {
-      ++i;
-    } else if (text[i] == quote) {
-      if (quote == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
-        ++i;
-        continue;
-      }
-      return i + 1;
-    }
-  }
-  return std::string::npos;
 }
 
 // The end of a plain scalar starting at `begin`: the line's end, a comment, or in a flow
@@ -145,7 +130,7 @@ std::optional<ValueSpan> find_value_span(const std::string& text, const std::str
   const char first = text[begin];
   std::size_t end = std::string::npos;
   if (first == '"' || first == '\'') {
-    end = quoted_end(text, begin);
+    end = quoted_scalar_end(text, begin);
   } else if (first != '|' && first != '>' && first != '&' && first != '!' && first != '*') {
     end = plain_end(text, begin, in_flow);
     // A plain scalar folded over several lines would not end at the line's end.
