@@ -35,7 +35,7 @@ std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::
   return lower_scene(*checked, diag);
 }
 
-std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
+std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
   if (!in || fs::is_directory(path, ec)) {
@@ -54,9 +54,15 @@ std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticE
       return std::nullopt;
     }
   }
+  return text;
+}
+
+std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
+  const auto text = read_scene_file(path, diag);
+  if (!text) return std::nullopt;
   std::string base_dir = fs::path(path).parent_path().string();
   if (base_dir.empty()) base_dir.push_back('.');  // (GCC 12 warns, falsely, on = ".")
-  return compile_scene_text(text, path, base_dir, diag);
+  return compile_scene_text(*text, path, base_dir, diag);
 }
 
 }  // namespace rigc

@@ -19,6 +19,10 @@ std::optional<ir::Scene> lower_scene(const spec::SceneSpec& scene, DiagnosticEng
 std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::string& file,
                                             const std::string& base_dir, DiagnosticEngine& diag);
 
+// A scene file's text, read up to the scene size limit; nullopt after a diagnostic when it is
+// unreadable or larger.
+std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag);
+
 // Reads and compiles a scene file; an unreadable file is a diagnostic too.
 std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag);
 

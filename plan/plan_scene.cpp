@@ -4,8 +4,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "compiler/check.h"
 #include "compiler/frontend.h"
@@ -104,27 +102,20 @@ bool analyse_candidates(const std::string& text, const PlanRequest& request, Pla
   return true;
 }
 
-std::optional<std::string> read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 }  // namespace
 
 std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEngine& diag,
                                         std::string* error) {
-  auto scene = request.scene_text.empty()
-                   ? compile_scene_file(request.scene_path, diag)
-                   : compile_scene_text(request.scene_text, request.scene_path,
-                                        folder_of(request.scene_path), diag);
+  // The file is read once: this text is compiled, and edited into the candidates and the plan.
+  const auto text = request.scene_text.empty() ? read_scene_file(request.scene_path, diag)
+                                               : std::optional<std::string>(request.scene_text);
+  if (!text) return nullptr;
+  auto scene = compile_scene_text(*text, request.scene_path, folder_of(request.scene_path), diag);
   if (!scene) return nullptr;
-  const auto text = request.scene_text.empty() ? read_text(request.scene_path) : request.scene_text;
-  const auto spec = text ? scene_spec(*text, request.scene_path) : std::nullopt;
+  // The scene compiled, so its checked description exists.
+  const auto spec = scene_spec(*text, request.scene_path);
   if (!spec) {
-    *error = fmt::format("cannot read {} again", request.scene_path);
+    *error = fmt::format("{} compiled but does not check", request.scene_path);
     return nullptr;
   }
   auto outcome = std::make_unique<PlanOutcome>();
