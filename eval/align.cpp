@@ -1,6 +1,8 @@
 #include "eval/align.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -105,8 +107,13 @@ class Aligner {
                         : method_ == AlignMethod::kRegistration ? register_clouds()
                                                                 : keep_frame();
     if (!coarse) return std::move(a_);
-    a_.points.reserve(rec_points_.size());
-    for (const auto& p : rec_points_) a_.points.push_back(a_.transform.apply(p));
+    a_.points.resize(rec_points_.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rec_points_.size(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                          a_.points[i] = a_.transform.apply(rec_points_[i]);
+                        }
+                      });
     sample_visible_surface();
     if (o_.icp && method_ != AlignMethod::kNone) refine_with_icp();
     measure_fitness();

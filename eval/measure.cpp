@@ -20,14 +20,14 @@ json stats_json(const DistanceStats& s) {
 }
 
 std::vector<double> signed_distance_mm(const Surface& surface, const std::vector<Vec3>& points) {
-  std::vector<double> d_mm;
-  for (double d : surface.signed_distance(points)) d_mm.push_back(1000 * d);
+  std::vector<double> d_mm = surface.signed_distance(points);
+  for (double& d : d_mm) d *= 1000;
   return d_mm;
 }
 
-// The geometry whose distances give the precision and the recall: the points, or the Poisson
-// mesh's samples.
-struct Compared {
+// The Poisson mesh's samples and their distances, which replace the points' in the precision and
+// the recall when --poisson meshed them.
+struct PoissonSamples {
   std::vector<double> distance_mm;
   std::vector<Vec3> cloud;
 };
@@ -58,12 +58,17 @@ class Measurer {
     report_["signed_distance_mm"] = distances;
     report_["signed_distance_mm"]["convention"] =
         "nearest ground-truth triangle, positive on its normal's side (outside)";
-    Compared compared{m_.distance_mm, m_.points};
+    m_.point_stats = m_.stats;
     // Poisson needs the points' observers: COLMAP's points have them, a file's have not.
+    PoissonSamples poisson;
     if (o_.poisson && view_points_.size() == m_.points.size() && !m_.points.empty()) {
-      compare_poisson_mesh(compared);
+      compare_poisson_mesh(poisson);
     }
-    score(compared);
+    if (poisson.cloud.empty()) {
+      score(m_.distance_mm, m_.points);
+    } else {
+      score(poisson.distance_mm, poisson.cloud);
+    }
     if (!truth_.poses.empty() && !model_.images.empty()) camera_errors();
     return std::move(m_);
   }
@@ -104,7 +109,7 @@ class Measurer {
   }
 
   // --poisson: a screened Poisson mesh of the points, measured by its surface samples.
-  void compare_poisson_mesh(Compared& compared) {
+  void compare_poisson_mesh(PoissonSamples& samples) {
     std::string why;
     auto mesh = poisson_mesh(m_.points, view_points_, o_.poisson_depth, &why);
     if (!mesh) {
@@ -128,7 +133,7 @@ class Measurer {
     if (write_ply((out_ / "poisson_mesh.ply").string(), m, &why)) {
       report_["poisson_mesh"]["file"] = (out_ / "poisson_mesh.ply").string();
     }
-    compared = {std::move(dm), std::move(mesh_samples)};
+    samples = {std::move(dm), std::move(mesh_samples)};
     m_.stats = ms;
   }
 
@@ -144,7 +149,9 @@ class Measurer {
     return d;
   }
 
-  void score(const Compared& compared) {
+  // Precision from `distance_mm` (of `cloud` to the ground truth), recall from the ground-truth
+  // samples' distances to `cloud`.
+  void score(const std::vector<double>& distance_mm, const std::vector<Vec3>& cloud) {
     const SurfaceSamples& s = a_.samples;
     const bool all = s.visible.empty();
     const std::vector<Vec3>& reference = all ? s.all : s.visible;
@@ -152,10 +159,10 @@ class Measurer {
     if (reconstructed_mesh_ && report_["compared"] == "mesh_samples") {
       truth_to_rec = distances_to_reconstructed_mesh(reference);
     } else {
-      truth_to_rec = nearest_distances(reference, compared.cloud);
+      truth_to_rec = nearest_distances(reference, cloud);
       for (auto& d : truth_to_rec) d *= 1000;
     }
-    m_.f = f_score(compared.distance_mm, truth_to_rec, o_.tau_mm);
+    m_.f = f_score(distance_mm, truth_to_rec, o_.tau_mm);
     report_["fscore"] = {
         {"tau_mm", m_.f.tau},
         {"precision", m_.f.precision},

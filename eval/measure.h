@@ -20,6 +20,7 @@ struct Measurements {
   std::vector<Vec3> points;         // the aligned points near the object (object_crop)
   std::vector<double> distance_mm;  // their signed distances
   DistanceStats stats;              // of the compared geometry: the points or the Poisson mesh
+  DistanceStats point_stats;        // of the points
   FScore f;
 };
 

@@ -272,22 +272,32 @@ bool write_heatmap_png(const fs::path& path, const Surface& surface, const ViewC
     const auto g = static_cast<std::uint8_t>(std::lround(255 * shade));
     canvas.set(static_cast<int>(i % w), static_cast<int>(i / w), {g, g, g});
   }
-  // Splats, far to near, hidden when well behind the surface.
-  std::vector<std::pair<double, std::size_t>> order;
+  // Splats, far to near, hidden when well behind the surface. Points on one pixel have the same
+  // disk, so only the nearest of them shows: one per pixel is sorted, not every point.
+  const double tolerance = 0.01 * (surface.bounds().diagonal().norm());
+  constexpr std::size_t kNoPoint = ~std::size_t{0};
+  std::vector<std::size_t> nearest(origins.size(), kNoPoint);
+  std::vector<double> nearest_z(origins.size(), std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Vec3 pc = r * points[i] + t;
-    if (pc.z() > 0) order.emplace_back(pc.z(), i);
-  }
-  std::sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first > b.first; });
-  const int radius = std::max(1, static_cast<int>(std::lround(w / 400.0)));
-  const double tolerance = 0.01 * (surface.bounds().diagonal().norm());
-  for (const auto& [z, i] : order) {
-    const Vec3 pc = r * points[i] + t;
+    if (!(pc.z() > 0)) continue;
     const int u = static_cast<int>(std::floor(fx * pc.x() / pc.z() + cx));
     const int v = static_cast<int>(std::floor(fy * pc.y() / pc.z() + cy));
     if (u < 0 || v < 0 || u >= w || v >= h) continue;
-    if (z > depth[static_cast<std::size_t>(v) * w + u] + tolerance) continue;
-    const auto c = signed_distance_color(d_mm[i], range_mm);
+    const std::size_t pixel = static_cast<std::size_t>(v) * w + u;
+    if (pc.z() > depth[pixel] + tolerance || pc.z() >= nearest_z[pixel]) continue;
+    nearest[pixel] = i;
+    nearest_z[pixel] = pc.z();
+  }
+  std::vector<std::pair<double, std::size_t>> order;  // (depth, pixel)
+  for (std::size_t pixel = 0; pixel < nearest.size(); ++pixel) {
+    if (nearest[pixel] != kNoPoint) order.emplace_back(nearest_z[pixel], pixel);
+  }
+  std::sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first > b.first; });
+  const int radius = std::max(1, static_cast<int>(std::lround(w / 400.0)));
+  for (const auto& [z, pixel] : order) {
+    const int u = static_cast<int>(pixel % w), v = static_cast<int>(pixel / w);
+    const auto c = signed_distance_color(d_mm[nearest[pixel]], range_mm);
     for (int dy = -radius; dy <= radius; ++dy)
       for (int dx = -radius; dx <= radius; ++dx)
         if (dx * dx + dy * dy <= radius * radius) canvas.set(u + dx, v + dy, c);

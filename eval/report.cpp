@@ -1,6 +1,7 @@
 #include "eval/report.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
@@ -109,28 +110,33 @@ void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& c
 void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
                                 const Alignment& alignment, const Measurements& m) {
   const std::vector<double>& d_mm = m.distance_mm;
-  const DistanceStats stats = distance_stats(d_mm);
+  const DistanceStats& stats = m.point_stats;
   const double range = o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * stats.rms);
-  json files;
-  std::string why;
-  if (write_colored_ply(out_ / "cloud_signed_distance.ply", m.points, d_mm, range, &why)) {
-    files["cloud_ply"] = (out_ / "cloud_signed_distance.ply").string();
-  } else {
-    log_ << "rigc eval: warning: " << why << "\n";
-  }
-  if (write_histogram_png(out_ / "histogram.png", d_mm, range, stats, &why)) {
-    files["histogram_png"] = (out_ / "histogram.png").string();
-    summary_.histogram_png = files["histogram_png"];
-  } else {
-    log_ << "rigc eval: warning: " << why << "\n";
-  }
   const ViewCamera view =
       alignment.views.empty() ? overview_camera(surface) : alignment.views.front();
-  if (write_heatmap_png(out_ / "heatmap.png", surface, view, m.points, d_mm, range, 1280, &why)) {
-    files["heatmap_png"] = (out_ / "heatmap.png").string();
-    summary_.heatmap_png = files["heatmap_png"];
-  } else {
-    log_ << "rigc eval: warning: " << why << "\n";
+  // Three independent files: the cloud's write overlaps the pictures' drawing.
+  const fs::path cloud_ply = out_ / "cloud_signed_distance.ply";
+  const fs::path histogram_png = out_ / "histogram.png";
+  const fs::path heatmap_png = out_ / "heatmap.png";
+  std::string cloud_why, histogram_why, heatmap_why;
+  bool cloud_ok = false, histogram_ok = false, heatmap_ok = false;
+  tbb::parallel_invoke(
+      [&] { cloud_ok = write_colored_ply(cloud_ply, m.points, d_mm, range, &cloud_why); },
+      [&] {
+        histogram_ok = write_histogram_png(histogram_png, d_mm, range, stats, &histogram_why);
+      },
+      [&] {
+        heatmap_ok = write_heatmap_png(heatmap_png, surface, view, m.points, d_mm, range, 1280,
+                                       &heatmap_why);
+      });
+  json files;
+  if (cloud_ok) files["cloud_ply"] = cloud_ply.string();
+  if (histogram_ok) files["histogram_png"] = summary_.histogram_png = histogram_png.string();
+  if (heatmap_ok) files["heatmap_png"] = summary_.heatmap_png = heatmap_png.string();
+  for (const auto& [ok, why] :
+       {std::pair{cloud_ok, &cloud_why}, std::pair{histogram_ok, &histogram_why},
+        std::pair{heatmap_ok, &heatmap_why}}) {
+    if (!ok) log_ << "rigc eval: warning: " << *why << "\n";
   }
   files["color_range_mm"] = range;
   report_["files"] = files;
