@@ -145,10 +145,14 @@ int remove_stale_temporaries(const fs::path& run_dir) {
       }
     }
   };
-  sweep(run_dir);
-  for (fs::directory_iterator it(run_dir, ec), end; !ec && it != end; it.increment(ec)) {
+  // Only the folders a run writes: `rigc eval` writes into run_dir/eval without the lock.
+  for (const fs::path& dir :
+       {run_dir, run_dir / "images", run_dir / "masks", run_dir / "sparse", run_dir / "render"}) {
     std::error_code dir_ec;
-    if (!it->is_symlink(dir_ec) && it->is_directory(dir_ec)) sweep(it->path());
+    if (!fs::is_symlink(fs::symlink_status(dir, dir_ec)) && fs::is_directory(dir, dir_ec)) {
+      sweep(dir);
+    }
+    ec.clear();
   }
   return removed;
 }

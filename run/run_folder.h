@@ -44,7 +44,8 @@ bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene,
                          const std::filesystem::path& manifest_path, std::ostream& log);
 
 // Removes the temporary files (io/atomic_file.h) that a killed or crashed writer left in run_dir
-// and its folders one level down; call it holding the RunFolderLock. Returns how many.
+// and the folders a run writes (images, masks, sparse, render); call it holding the
+// RunFolderLock. Returns how many.
 int remove_stale_temporaries(const std::filesystem::path& run_dir);
 
 // A run folder holds one scene: refuses (false after a `rigc: error:` line) when the manifest
