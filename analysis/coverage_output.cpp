@@ -8,7 +8,9 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <sstream>
 
+#include "dslr/image_io.h"
 #include "dslr/lens.h"
 #include "io/atomic_file.h"
 #include "io/files.h"
@@ -153,43 +155,22 @@ tinygltf::Model face_color_model(const UnweldedFaces& faces) {
 bool write_face_color_glb(const fs::path& path, const scene::Geometry& mesh,
                           const std::vector<Vector3f>& colors, std::string* error) {
   tinygltf::Model model = face_color_model(unweld_faces(mesh, colors));
-  const fs::path temporary = temporary_path_beside(path);
+  // Encoded in memory, then written atomically: a write error is reported, never a short file.
+  std::ostringstream bytes;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&model, temporary.string(), true, true, false, true)) {
+  if (!writer.WriteGltfSceneToStream(&model, bytes, false, true)) {
     *error = fmt::format("{}: cannot write the GLB", path.string());
-    std::error_code ec;
-    fs::remove(temporary, ec);
     return false;
   }
-  std::error_code ec;
-  fs::rename(temporary, path, ec);
-  if (ec) {
-    *error = fmt::format("{}: {}", path.string(), ec.message());
-    fs::remove(temporary, ec);
-    return false;
-  }
-  return true;
+  return rigc::write_file_atomically(path, bytes.str(), error);
 }
 
 bool write_png(const fs::path& path, const std::vector<float>& rgb, int width, int height,
                std::string* error) {
   std::vector<std::uint8_t> pixels(rgb.size());
   for (size_t i = 0; i < rgb.size(); ++i) pixels[i] = to_srgb8(rgb[i]);
-  // The writer for the final name's format, opened on a temporary name beside it.
-  const fs::path temporary = temporary_path_beside(path);
-  auto out = OIIO::ImageOutput::create(path.string());
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  if (!out || !out->open(temporary.string(), spec) ||
-      !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close()) {
-    *error = fmt::format("{}: cannot write the picture", path.string());
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    return false;
-  }
-  std::error_code ec;
-  fs::rename(temporary, path, ec);
-  if (ec) *error = fmt::format("{}: {}", path.string(), ec.message());
-  return !ec;
+  return dslr::write_pixels(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8),
+                            pixels.data(), error);
 }
 
 // A camera orbiting the object at `azimuth`/`elevation` (radians), framing it whole.

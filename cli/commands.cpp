@@ -20,6 +20,7 @@
 #include "io/atomic_file.h"
 #include "ir/ir_json.h"
 #include "run/run_loop.h"
+#include "run/scene_inputs.h"
 #include "run/shots.h"
 #include "scene/studio_scene.h"
 #include "sweep/split_render.h"
@@ -139,6 +140,7 @@ int run_compile(std::vector<std::string> args) {
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
+  run::protect_scene_inputs(scene_path, *scene);
   if (target != "ir") {
     if (output.empty()) output = (fs::path("out") / scene->name / target / "render").string();
     return emit_scripts(*scene, target, output, scale, samples);
@@ -185,6 +187,10 @@ int run_render(std::vector<std::string> args) {
   app.add_option("--seed", seed, "sensor noise seed")
       ->check(non_negative_number())
       ->capture_default_str();
+  bool force = false;
+  app.add_flag("--force", force,
+               "render into a run folder that holds another scene's shots or files no manifest "
+               "lists, deleting them");
   std::string executor = "local";
   std::vector<std::string> sbatch;
   app.add_option("--executor", executor, "local, or slurm: a Slurm array task per shot")
@@ -196,6 +202,7 @@ int run_render(std::vector<std::string> args) {
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
+  run::protect_scene_inputs(scene_path, *scene);
   std::string error;
   auto shots = run::parse_shot_selection(shot_text, static_cast<int>(scene->shots.size()), &error);
   if (!shots) {
@@ -209,6 +216,7 @@ int run_render(std::vector<std::string> args) {
   options.settings.seed = seed;
   options.settings.samples = samples;
   options.progress_bar = isatty(STDERR_FILENO);
+  options.force = force;
   const std::unique_ptr<run::Backend> renderer = backends::find_backend(backend)->make();
   if (executor == "slurm") {
     const sweep::SplitRender split{fs::read_symlink("/proc/self/exe"), scene_path, backend, sbatch};
@@ -241,6 +249,7 @@ int run_coverage(std::vector<std::string> args) {
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return kExitUserError;
+  run::protect_scene_inputs(scene_path, *scene);
   if (output.empty()) output = (fs::path("out") / scene->name / "coverage").string();
   const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
   analysis::CoverageOptions options;
@@ -308,6 +317,12 @@ int run_main(std::vector<std::string> args) {
     verb_args.insert(verb_args.end(), args.begin() + 2, args.end());
     try {
       return command.run(verb_args);
+    } catch (const fs::filesystem_error& e) {
+      // A path the user gave that cannot be followed (a symbolic link loop, no permission):
+      // their files, not a bug.
+      std::cerr << fmt::format("rigc: error: cannot use '{}': {}\n", e.path1().string(),
+                               e.code().message());
+      return kExitUserError;
     } catch (const std::exception& e) {
       // Libraries colour their messages (Open3D's errors come as "\e[1;31m[Open3D Error] ...");
       // the terminal codes are dropped.

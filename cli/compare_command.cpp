@@ -18,6 +18,7 @@
 #include "io/atomic_file.h"
 #include "run/manifest.h"
 #include "run/run_loop.h"
+#include "run/scene_inputs.h"
 
 namespace rigc::cli {
 
@@ -302,6 +303,7 @@ int run_compare_command(std::vector<std::string> args) {
   DiagnosticEngine diag;
   auto scene = compile_scene_file(scene_path, diag);
   if (!scene) return 1;
+  run::protect_scene_inputs(scene_path, *scene);
   const auto chosen = chosen_backends(backends_text);
   if (!chosen) return 1;
   if (chosen->empty() && photos.empty()) {

@@ -9,6 +9,7 @@
 #include "cli/verbs.h"
 #include "compiler/units.h"
 #include "io/atomic_file.h"
+#include "io/input_files.h"
 #include "plan/plan_scene.h"
 #include "plan/report.h"
 
@@ -166,6 +167,7 @@ int run_plan_command(std::vector<std::string> args) {
 
   DiagnosticEngine diag;
   std::string error;
+  protect_input_file(request.scene_path, "the scene file");
   const auto outcome = plan::plan_scene(request, diag, &error);
   if (!outcome) {
     if (!error.empty()) std::cerr << "rigc: error: " << error << '\n';

@@ -1,5 +1,6 @@
 #include "dslr/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -21,32 +22,35 @@ void set_error(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
 }
 
-// Writes pixels to a temporary file with the final name's format, then renames it into place.
-bool write_atomically(const fs::path& requested, OIIO::ImageSpec spec, const void* pixels,
-                      std::string* error) {
-  const fs::path path = file_to_replace(requested, error);
-  if (path.empty()) return false;
-  auto out = OIIO::ImageOutput::create(path.string());
+}  // namespace
+
+bool write_pixels(const fs::path& path, const OIIO::ImageSpec& spec, const void* pixels,
+                  std::string* error) {
+  OIIO::Filesystem::IOVecOutput memory;
+  auto out = OIIO::ImageOutput::create(path.string(), &memory);
   if (!out) {
     set_error(error, "cannot write " + path.string() + ": " + OIIO::geterror());
     return false;
   }
-  const fs::path temporary = temporary_path_beside(path);
-  std::error_code ec;
+  if (!out->supports("ioproxy")) {
+    set_error(error, "cannot write " + path.string() + ": the " + out->format_name() +
+                         " writer cannot encode to memory; name a .jpg, .png or .tif file");
+    return false;
+  }
   auto fail = [&](const std::string& why) {
-    out.reset();  // closes the file before it is removed
-    fs::remove(temporary, ec);
     set_error(error, "cannot write " + path.string() + ": " + why);
     return false;
   };
-  if (!out->open(temporary.string(), spec)) return fail(out->geterror());
+  if (!out->open(path.string(), spec)) return fail(out->geterror());
   if (!out->write_image(spec.format, pixels)) return fail(out->geterror());
   if (!out->close()) return fail(out->geterror());
   out.reset();
-  fs::rename(temporary, path, ec);
-  if (ec) return fail(ec.message());
-  return true;
+  const std::vector<unsigned char>& bytes = memory.buffer();
+  return write_file_atomically(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), error);
 }
+
+namespace {
 
 // ".jpg" for "shot.JPG": the file type the name asks for.
 std::string lowercase_extension(const fs::path& path) {
@@ -99,7 +103,7 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
     spec.attribute("Exif:FocalPlaneResolutionUnit", 3);  // centimetres
   }
 
-  if (bytes_only) return write_atomically(path, spec, result.encoded_bytes.data(), error);
+  if (bytes_only) return write_pixels(path, spec, result.encoded_bytes.data(), error);
   if (eight_bits) {
     std::vector<std::uint8_t> pixels = take_bytes(values);  // every value is written
     // Plain pointers and one loop per case: stores through a byte pointer may alias anything,
@@ -113,11 +117,11 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
         bytes[i] = static_cast<std::uint8_t>((codes[i] * 255u + 32767u) / 65535u);
       }
     }
-    const bool written = write_atomically(path, spec, pixels.data(), error);
+    const bool written = write_pixels(path, spec, pixels.data(), error);
     recycle(std::move(pixels));
     return written;
   }
-  return write_atomically(path, spec, result.encoded.data(), error);
+  return write_pixels(path, spec, result.encoded.data(), error);
 }
 
 bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int width, int height,
@@ -131,8 +135,8 @@ bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int
     return write_file_atomically(path, encode_mask_png(mask.data(), width, height), error);
   }
   // Any other format OpenImageIO writes (the backends name masks .png).
-  return write_atomically(path, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8),
-                          mask.data(), error);
+  return write_pixels(path, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8), mask.data(),
+                      error);
 }
 
 }  // namespace rigc::dslr

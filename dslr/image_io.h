@@ -2,6 +2,8 @@
 // rename), with the EXIF a photogrammetry tool reads. Errors are returned, never thrown.
 #pragma once
 
+#include <OpenImageIO/imageio.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -11,6 +13,14 @@
 #include "ir/ir.h"
 
 namespace rigc::dslr {
+
+// Encodes `pixels` (laid out as `spec` says) in memory in the format the path's extension asks for,
+// then writes the bytes with write_file_atomically (io/atomic_file.h). The codecs never touch the
+// disk: on a full disk libjpeg's writer called exit() from a worker thread (a crash), and libpng's
+// left a truncated PNG that was renamed to its final name. A failed write leaves no file at the
+// final name and no temporary; false with *error set ("cannot write PATH: WHY").
+bool write_pixels(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
+                  const void* pixels, std::string* error);
 
 // Writes result.encoded (or result.encoded_bytes when that holds the codes); the file type follows
 // the path's extension (.jpg, .png, .tif). JPEG uses camera.jpeg_quality and is always 8-bit.

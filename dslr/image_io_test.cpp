@@ -2,6 +2,9 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <csignal>
 
 #include "dslr/pipeline.h"
 #include "dslr/test_helpers.h"
@@ -160,6 +163,58 @@ TEST(DslrWrite, ReplacesAnExistingFile) {
   std::string error;
   ASSERT_TRUE(write_image(path, small_image(camera), camera, &error)) << error;
   EXPECT_GT(fs::file_size(path), 100u);
+}
+
+// A file-size limit (RLIMIT_FSIZE) for the life of the object, with SIGXFSZ ignored: a write past
+// it fails with EFBIG, as one on a full disk fails with ENOSPC.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    old_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, old_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*old_handler_)(int) = nullptr;
+};
+
+// libjpeg called exit() when its file could not be written (a crash when the caller was a worker
+// thread), and a truncated PNG was renamed to its final name: a failed write leaves nothing.
+TEST(DslrWrite, AWriteThatRunsOutOfSpaceFailsAndLeavesNothing) {
+  rigc::testing::TempDir dir;
+  const ir::Camera camera = canon_6d();
+  const DevelopResult image = small_image(camera);
+  ir::Camera camera16 = camera;
+  camera16.format = ir::ImageFormat::kPng16;
+  const DevelopResult image16 = small_image(camera16);
+  for (const std::string name : {"shot_000.jpg", "shot_000.png", "shot_000.tif"}) {
+    std::string error;
+    {
+      const FileSizeLimit limit(100);  // the flat test image packs small
+      const bool jpeg = name.ends_with(".jpg");
+      EXPECT_FALSE(
+          write_image(dir.file(name), jpeg ? image : image16, jpeg ? camera : camera16, &error))
+          << name;
+    }
+    EXPECT_NE(error.find("cannot write " + dir.file(name) + ": File too large"), std::string::npos)
+        << error;
+    EXPECT_TRUE(folder_entries(dir.path()).empty()) << name;
+  }
+  std::string error;
+  {
+    const FileSizeLimit limit(20);
+    EXPECT_FALSE(write_mask(dir.file("mask.png"), image.mask, image.width, image.height, &error));
+  }
+  EXPECT_NE(error.find("File too large"), std::string::npos) << error;
+  EXPECT_TRUE(folder_entries(dir.path()).empty());
 }
 
 }  // namespace

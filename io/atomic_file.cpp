@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <system_error>
 
+#include "io/input_files.h"
+
 namespace rigc {
 namespace {
 
@@ -54,13 +56,33 @@ std::filesystem::path file_to_replace(const std::filesystem::path& path, std::st
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::path target = path;
-  if (fs::is_symlink(fs::symlink_status(path, ec))) {
-    target = fs::weakly_canonical(path, ec);
-    if (ec) {
-      set_error(error, fmt::format("cannot write {}: the symbolic link leads nowhere: {}",
-                                   path.string(), ec.message()));
+  // Follows a chain of links by hand: weakly_canonical takes a link to a missing file for a
+  // missing file of its own name, and the write replaced the link.
+  for (int links = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++links) {
+    const fs::path to = fs::read_symlink(target, ec);
+    if (ec || links == 40) {
+      set_error(error,
+                fmt::format("cannot write {}: the symbolic link leads nowhere: {}", path.string(),
+                            ec ? ec.message() : "Too many levels of symbolic links"));
       return {};
     }
+    target = to.is_absolute() ? to : target.parent_path() / to;
+  }
+  if (target != path) {
+    std::error_code folder_ec;
+    const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    if (!fs::is_directory(folder, folder_ec)) {
+      set_error(error, fmt::format("cannot write {}: it is a symbolic link to '{}', whose folder "
+                                   "does not exist",
+                                   path.string(), target.string()));
+      return {};
+    }
+  }
+  if (const auto input = protected_input_at(target)) {
+    set_error(error, fmt::format("cannot write {}: it is {}, an input of this command; choose "
+                                 "another name or folder",
+                                 path.string(), *input));
+    return {};
   }
   const fs::file_status status = fs::status(target, ec);
   if (fs::exists(status) && !fs::is_regular_file(status)) {

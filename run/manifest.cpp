@@ -30,6 +30,10 @@ std::optional<ShotRecord> record_from_json(const std::string& name, const json& 
       if (ms.is_number()) record.stage_ms[stage] = ms.get<double>();
     }
   }
+  if (auto it = j.find("scale"); it != j.end() && it->is_number()) record.scale = it->get<double>();
+  if (auto it = j.find("seed"); it != j.end() && it->is_number_unsigned()) {
+    record.seed = it->get<std::uint64_t>();
+  }
   const auto files = j.find("files");
   if (files == j.end() || !files->is_array()) return std::nullopt;
   for (const auto& file : *files) {
@@ -57,7 +61,17 @@ Manifest Manifest::load(const fs::path& path) {
     if (auto it = j.find("inputs"); it != j.end() && it->is_object()) manifest.inputs_ = *it;
     if (auto it = j.find("shots"); it != j.end() && it->is_object()) {
       for (const auto& [name, entry] : it->items()) {
-        if (auto record = record_from_json(name, entry)) manifest.shots_[name] = std::move(*record);
+        auto record = record_from_json(name, entry);
+        if (!record) continue;
+        // Written before shots had their own: the run's values were every shot's.
+        const json& inputs = manifest.inputs_;
+        if (!record->scale && inputs.contains("scale") && inputs["scale"].is_number()) {
+          record->scale = inputs["scale"].get<double>();
+        }
+        if (!record->seed && inputs.contains("seed") && inputs["seed"].is_number_unsigned()) {
+          record->seed = inputs["seed"].get<std::uint64_t>();
+        }
+        manifest.shots_[name] = std::move(*record);
       }
     }
   } catch (...) {
@@ -97,6 +111,8 @@ json Manifest::to_json() const {
                    {"render_ms", record.render_ms},
                    {"stage_ms", record.stage_ms},
                    {"files", record.files}};
+    if (record.scale) shots[name]["scale"] = *record.scale;
+    if (record.seed) shots[name]["seed"] = *record.seed;
   }
   return {
       {"rigc_version", RIGC_VERSION}, {"backend", backend_}, {"inputs", inputs_}, {"shots", shots}};

@@ -3,13 +3,16 @@
 //
 //   {"rigc_version": "0.1.0", "backend": "preview", "inputs": {...},
 //    "shots": {"shot_000": {"key": "...", "render_ms": 812.5, "stage_ms": {...},
-//                           "files": ["images/shot_000.jpg", "masks/shot_000.png"]}}}
+//                           "files": ["images/shot_000.jpg", "masks/shot_000.png"],
+//                           "scale": 0.25, "seed": 1}}}
+// inputs.scale and inputs.seed are the last run's; a shot's own entry says what its files have.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,9 @@ struct ShotRecord {
   double render_ms = 0;
   std::map<std::string, double> stage_ms;
   std::vector<std::string> files;  // written files, relative to the run folder
+  // The render scale and noise seed of this shot's files (a rerun of some shots may use others).
+  std::optional<double> scale;
+  std::optional<std::uint64_t> seed;
 };
 
 class Manifest {

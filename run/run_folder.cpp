@@ -12,6 +12,8 @@
 #include <system_error>
 
 #include "io/atomic_file.h"
+#include "io/input_files.h"
+#include "io/output_paths.h"
 #include "run/bundler.h"
 #include "run/camera_csv.h"
 #include "run/colmap_text.h"
@@ -36,10 +38,15 @@ bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& ex
                         std::ostream& log) {
   std::vector<fs::path> folders = {run_dir / "images", run_dir / "masks", run_dir / "sparse"};
   folders.insert(folders.end(), extra.begin(), extra.end());
+  std::string error;
+  if (!make_output_folder(run_dir, &error)) {
+    log << fmt::format("rigc: error: {}\n", error);
+    return false;
+  }
   for (const fs::path& dir : folders) {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir)) {
+    if (ec || !fs::is_directory(dir, ec)) {
       log << fmt::format("rigc: error: cannot create the output folder '{}': {}\n", dir.string(),
                          ec ? ec.message() : "not a folder");
       return false;
@@ -50,7 +57,6 @@ bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& ex
     return false;
   }
   // Before any shot renders: a folder named manifest.json let the whole run render, then fail.
-  std::string error;
   if (file_to_replace(run_dir / "manifest.json", &error).empty()) {
     log << fmt::format("rigc: error: {}\n", error);
     return false;
@@ -125,6 +131,146 @@ bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene, const fs::p
     return false;
   }
   return true;
+}
+
+int remove_stale_temporaries(const fs::path& run_dir) {
+  int removed = 0;
+  std::error_code ec;
+  auto sweep = [&](const fs::path& dir) {
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+      std::error_code file_ec;
+      if (it->is_regular_file(file_ec) && is_temporary_name(it->path().filename().string()) &&
+          fs::remove(it->path(), file_ec)) {
+        ++removed;
+      }
+    }
+  };
+  // Only the folders a run writes: `rigc eval` writes into run_dir/eval without the lock.
+  for (const fs::path& dir :
+       {run_dir, run_dir / "images", run_dir / "masks", run_dir / "sparse", run_dir / "render"}) {
+    std::error_code dir_ec;
+    if (!fs::is_symlink(fs::symlink_status(dir, dir_ec)) && fs::is_directory(dir, dir_ec)) {
+      sweep(dir);
+    }
+    ec.clear();
+  }
+  return removed;
+}
+
+namespace {
+
+// "shot_000" or "shot_000 and 17 more".
+std::string some_names(const std::vector<std::string>& names) {
+  if (names.size() == 1) return names.front();
+  return fmt::format("{} and {} more", names.front(), names.size() - 1);
+}
+
+// Deletes run_dir/relative when it is a regular file in images/ or masks/ (a manifest is only
+// data: nothing outside those folders is touched). True when it is gone.
+bool remove_output_file(const fs::path& run_dir, const std::string& relative) {
+  const fs::path file(relative);
+  const auto first = file.begin();
+  if (file.is_absolute() || first == file.end() || (*first != "images" && *first != "masks")) {
+    return false;
+  }
+  if (std::any_of(file.begin(), file.end(),
+                  [](const fs::path& part) { return part == ".." || part == "."; })) {
+    return false;
+  }
+  std::error_code ec;
+  if (protected_input_at(run_dir / file)) return false;
+  const fs::file_status status = fs::symlink_status(run_dir / file, ec);
+  return (fs::is_regular_file(status) || fs::is_symlink(status)) && fs::remove(run_dir / file, ec);
+}
+
+}  // namespace
+
+bool claim_run_folder(Manifest& manifest, const ir::Scene& scene, const fs::path& run_dir,
+                      bool force, std::ostream& log) {
+  const auto recorded = manifest.inputs().find("scene");
+  if (manifest.shots().empty() || recorded == manifest.inputs().end() || !recorded->is_string() ||
+      recorded->get<std::string>() == scene.name) {
+    return true;
+  }
+  const std::string other = recorded->get<std::string>();
+  if (!force) {
+    log << fmt::format(
+        "rigc: error: the run folder '{}' holds {} shot{} of the scene '{}', not '{}'; choose "
+        "another folder with -o, or pass --force to delete them\n",
+        run_dir.string(), manifest.shots().size(), manifest.shots().size() == 1 ? "" : "s", other,
+        scene.name);
+    return false;
+  }
+  int removed = 0;
+  for (const auto& [name, record] : manifest.shots()) {
+    for (const auto& file : record.files) removed += remove_output_file(run_dir, file);
+  }
+  log << fmt::format("rigc: --force: deleted {} file{} of the scene '{}' from '{}'\n", removed,
+                     removed == 1 ? "" : "s", other, run_dir.string());
+  manifest = Manifest();
+  return true;
+}
+
+bool remove_unrecorded_outputs(const Manifest& manifest, const ir::Scene& scene,
+                               const fs::path& run_dir, bool force, std::ostream& log) {
+  std::set<std::string> listed, ours;
+  for (const auto& [name, record] : manifest.shots())
+    listed.insert(record.files.begin(), record.files.end());
+  for (const auto& shot : scene.shots) {
+    ours.insert(image_relative_path(scene.camera, shot));
+    ours.insert(mask_relative_path(shot));
+  }
+  std::vector<std::string> unrecorded, foreign;
+  for (const char* folder : {"images", "masks"}) {
+    std::error_code ec;
+    for (fs::directory_iterator it(run_dir / folder, ec), end; !ec && it != end; it.increment(ec)) {
+      std::error_code entry_ec;
+      if (it->is_directory(entry_ec) && !it->is_symlink(entry_ec)) continue;
+      const std::string name = it->path().filename().string();
+      const std::string relative = std::string(folder) + "/" + name;
+      if (name.starts_with(".") || listed.count(relative)) continue;
+      (ours.count(relative) ? unrecorded : foreign).push_back(relative);
+    }
+  }
+  if (!foreign.empty() && !force) {
+    log << fmt::format(
+        "rigc: warning: the run folder '{}' holds {} file{} that no shot of '{}' writes and its "
+        "manifest does not list ({}); `rigc eval` would use them: move them, or pass --force to "
+        "delete them\n",
+        run_dir.string(), foreign.size(), foreign.size() == 1 ? "" : "s", scene.name,
+        some_names(foreign));
+    foreign.clear();
+  }
+  unrecorded.insert(unrecorded.end(), foreign.begin(), foreign.end());
+  int removed = 0;
+  for (const auto& file : unrecorded) removed += remove_output_file(run_dir, file);
+  if (removed > 0) {
+    log << fmt::format(
+        "rigc: deleted {} file{} in '{}' that the manifest does not list ({}), left by an "
+        "interrupted run or another scene\n",
+        removed, removed == 1 ? "" : "s", run_dir.string(), some_names(unrecorded));
+  }
+  return true;
+}
+
+bool check_one_scale(const Manifest& manifest, const ir::Scene& scene,
+                     const std::vector<int>& selected, double scale, std::ostream& log) {
+  std::set<std::string> rendering;
+  for (const int index : selected) rendering.insert(scene.shots[index].name);
+  std::vector<std::string> others;
+  double other_scale = 0;
+  for (const auto& [name, record] : manifest.shots()) {
+    if (rendering.count(name) || !record.scale || *record.scale == scale) continue;
+    others.push_back(name);
+    other_scale = *record.scale;
+  }
+  if (others.empty()) return true;
+  log << fmt::format(
+      "rigc: error: this run folder holds {} rendered at --scale {:g}, and a run folder holds "
+      "one image size: render every shot at --scale {:g} (leave out --shots), or choose another "
+      "folder with -o\n",
+      some_names(others), other_scale, scale);
+  return false;
 }
 
 int finish_run(const ir::Scene& scene, const Manifest& manifest, const fs::path& run_dir,

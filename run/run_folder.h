@@ -43,6 +43,29 @@ bool prune_stale_outputs(Manifest& manifest, const ir::Scene& scene,
                          const std::filesystem::path& run_dir,
                          const std::filesystem::path& manifest_path, std::ostream& log);
 
+// Removes the temporary files (io/atomic_file.h) that a killed or crashed writer left in run_dir
+// and the folders a run writes (images, masks, sparse, render); call it holding the
+// RunFolderLock. Returns how many.
+int remove_stale_temporaries(const std::filesystem::path& run_dir);
+
+// A run folder holds one scene: refuses (false after a `rigc: error:` line) when the manifest
+// records shots of a scene with another name, unless `force`; then deletes those shots' files,
+// says so in `log` and empties the manifest.
+bool claim_run_folder(Manifest& manifest, const ir::Scene& scene,
+                      const std::filesystem::path& run_dir, bool force, std::ostream& log);
+
+// Files in images/ and masks/ that the manifest does not list, which `rigc eval` would hand to
+// COLMAP: an interrupted run's last shots, another scene's shots. Those named like this scene's
+// shots are deleted (said in `log`); any other only with `force`, else a warning names them.
+// False after a `rigc: error:` line.
+bool remove_unrecorded_outputs(const Manifest& manifest, const ir::Scene& scene,
+                               const std::filesystem::path& run_dir, bool force, std::ostream& log);
+
+// A run folder holds one image size (cameras.txt states one): false after a `rigc: error:` line
+// when a shot the manifest keeps but this run does not render was rendered at another scale.
+bool check_one_scale(const Manifest& manifest, const ir::Scene& scene,
+                     const std::vector<int>& selected, double scale, std::ostream& log);
+
 // "\r[#####     ] 5/18 shot_004 0.42 s": the progress bar a run redraws on a terminal.
 std::string progress_line(int done, int total, const std::string& name, double seconds);
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/task_group.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <future>
@@ -53,8 +54,11 @@ WriteOutcome write_shot_files(const ir::Scene& scene, const fs::path& run_dir,
                               dslr::DevelopResult& result) {
   const auto start = Clock::now();
   WriteOutcome outcome;
-  if (dslr::write_image(run_dir / image, result, scene.camera, &outcome.error)) {
-    dslr::write_mask(run_dir / mask, result.mask, result.width, result.height, &outcome.error);
+  if (dslr::write_image(run_dir / image, result, scene.camera, &outcome.error) &&
+      !dslr::write_mask(run_dir / mask, result.mask, result.width, result.height, &outcome.error)) {
+    // A shot has both files or neither: an image without its mask is in no manifest.
+    std::error_code ec;
+    fs::remove(run_dir / image, ec);
   }
   dslr::recycle(std::move(result.encoded));
   dslr::recycle(std::move(result.encoded_bytes));
@@ -120,7 +124,7 @@ class RunLoop {
   std::optional<PendingWrite> pending_;
   tbb::task_group writers_;  // the writes run as tasks of the renderer's own threads
   int failures_ = 0, done_ = 0;
-  bool manifest_failed_ = false, unsaved_ = false;
+  bool manifest_failed_ = false, write_failed_ = false, unsaved_ = false;
   Clock::time_point last_save_ = Clock::now() - std::chrono::hours(1);
 };
 
@@ -153,8 +157,11 @@ bool RunLoop::open_run_folder() {
   std::vector<fs::path> extra;
   if (!work_dir_.empty()) extra.push_back(work_dir_);
   if (!prepare_run_folder(run_dir_, extra, log_) || !lock_.acquire(run_dir_, log_)) return false;
+  remove_stale_temporaries(run_dir_);
   manifest_ = Manifest::load(manifest_path_);
-  return true;
+  return claim_run_folder(manifest_, scene_, run_dir_, options_.force, log_) &&
+         remove_unrecorded_outputs(manifest_, scene_, run_dir_, options_.force, log_) &&
+         check_one_scale(manifest_, scene_, shots_, settings_.scale, log_);
 }
 
 std::string RunLoop::key_of(const ir::Shot& shot) const {
@@ -203,8 +210,13 @@ int RunLoop::run() {
       finish_pending_write();
       return 2;
     }
+    if (write_failed_) break;
   }
   finish_pending_write();
+  if (write_failed_) {
+    log_ << fmt::format("{}rigc: stopped after a shot's files could not be written\n",
+                        options_.progress_bar ? "\n" : "");
+  }
   if (manifest_failed_ || !save_manifest(true)) return 2;
   if (options_.progress_bar) log_ << '\n';
   return finish_run(scene_, manifest_, run_dir_, settings_.scale, failures_, shots_.size(), log_);
@@ -271,6 +283,7 @@ void RunLoop::finish_pending_write() {
     write.timing.failed = true;
     if (timings_) timings_->push_back(write.timing);
     report_failure(*write.shot, outcome.error, write.renderer_log);
+    write_failed_ = true;  // a full disk or a lost folder: every later shot would fail the same way
     return;
   }
   record_shot(write);
@@ -283,6 +296,8 @@ void RunLoop::record_shot(const PendingWrite& write) {
   record.render_ms = write.timing.total_ms;
   record.stage_ms = write.timing.stage_ms;
   record.files = {write.image, write.mask};
+  record.scale = settings_.scale;
+  record.seed = settings_.seed;
   manifest_.record(record);
   unsaved_ = true;
   if (!save_manifest(false)) return;
@@ -293,6 +308,14 @@ void RunLoop::record_shot(const PendingWrite& write) {
 
 bool RunLoop::save_manifest(bool now) {
   if (!unsaved_ || (!now && ms_since(last_save_) < kManifestSaveIntervalMs)) return true;
+  // inputs.seed is every shot's seed, or null when `--shots` reran some with another.
+  nlohmann::json inputs = manifest_.inputs();
+  const bool one_seed =
+      std::all_of(manifest_.shots().begin(), manifest_.shots().end(), [&](const auto& entry) {
+        return !entry.second.seed || *entry.second.seed == settings_.seed;
+      });
+  inputs["seed"] = one_seed ? nlohmann::json(settings_.seed) : nlohmann::json(nullptr);
+  manifest_.set_inputs(std::move(inputs));
   std::string error;
   if (!manifest_.save(manifest_path_, &error)) {
     log_ << fmt::format("rigc: error: {}\n", error);

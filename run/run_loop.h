@@ -21,6 +21,9 @@ struct RunOptions {
   std::vector<int> shots;            // indices to render (all when empty)
   RenderSettings settings;
   bool progress_bar = false;  // redraw one line on a terminal instead of a line per shot
+  // Delete another scene's shots and files no manifest lists from the run folder instead of
+  // refusing to render into it.
+  bool force = false;
 };
 
 struct ShotTiming {

@@ -7,6 +7,8 @@
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
+#include "dslr/image_io.h"
+#include "io/output_paths.h"
 
 namespace rigc::external {
 
@@ -45,26 +47,15 @@ bool read_linear_image(const fs::path& path, LinearImage* image, std::string* er
 }
 
 bool write_texture_png(const fs::path& path, const ir::Texture& texture, std::string* error) {
-  auto output = OIIO::ImageOutput::create(path.string());
-  OIIO::ImageSpec spec(texture.width, texture.height, texture.channels, OIIO::TypeDesc::UINT8);
-  if (!output || !output->open(path.string(), spec) ||
-      !output->write_image(OIIO::TypeDesc::UINT8, texture.pixels.data()) || !output->close()) {
-    *error = fmt::format("cannot write the texture '{}': {}", path.string(),
-                         output ? output->geterror() : OIIO::geterror());
-    return false;
-  }
-  return true;
+  const OIIO::ImageSpec spec(texture.width, texture.height, texture.channels,
+                             OIIO::TypeDesc::UINT8);
+  return dslr::write_pixels(path, spec, texture.pixels.data(), error);
 }
 
 bool prepare_emit_folder(const ir::Scene& scene, const fs::path& dir,
                          const run::RenderSettings& settings, std::string* error) {
   if (!settings.check(error)) return false;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir)) {
-    *error = fmt::format("cannot create the folder '{}'", dir.string());
-    return false;
-  }
+  if (!make_output_folder(dir, error)) return false;
   for (const auto& shot : scene.shots) {
     if (!is_plain_file_stem(shot.name)) {
       *error = fmt::format("shot name '{}' cannot be a file name", comment_text(shot.name));

@@ -13,6 +13,7 @@
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
+#include "dslr/image_io.h"
 #include "dslr/lens.h"
 #include "io/files.h"
 #include "scene/motion_blur.h"
@@ -77,15 +78,9 @@ bool write_baked_texture(const fs::path& path, const ir::Texture& texture,
           static_cast<std::uint16_t>(std::lround(std::clamp(value, 0.0f, 1.0f) * 65535));
     }
   }
-  auto output = OIIO::ImageOutput::create(path.string());
   OIIO::ImageSpec spec(texture.width, texture.height, channels, OIIO::TypeDesc::UINT16);
   spec.attribute("oiio:ColorSpace", "Linear");
-  if (!output || !output->open(path.string(), spec) ||
-      !output->write_image(OIIO::TypeDesc::UINT16, pixels.data()) || !output->close()) {
-    *error = fmt::format("cannot write the texture '{}'", path.string());
-    return false;
-  }
-  return true;
+  return dslr::write_pixels(path, spec, pixels.data(), error);
 }
 
 std::string pigment_text(const scene::ShadedMaterial& material, int index, bool is_object) {

@@ -1,0 +1,25 @@
+// The files a command reads (the scene, its mesh, MTL libraries, textures): no writer of rigc
+// replaces or deletes one, however its path is spelled (relative, through a symbolic link, or a
+// hard link: files are compared by device and inode).
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rigc {
+
+// Records the file at `path` (following symbolic links), if there is one, as an input;
+// `what` names it in messages ("the scene's mesh"). Thread-safe.
+void protect_input_file(const std::filesystem::path& path, const std::string& what);
+
+// What the file at `path` (following symbolic links) is when it is a recorded input, for
+// "cannot write PATH: it is WHAT, an input of this command".
+std::optional<std::string> protected_input_at(const std::filesystem::path& path);
+
+// The material libraries an OBJ file names on its `mtllib` lines, resolved against its folder.
+// Empty for another format or an unreadable file.
+std::vector<std::filesystem::path> obj_material_libraries(const std::filesystem::path& obj);
+
+}  // namespace rigc

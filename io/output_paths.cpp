@@ -1,0 +1,58 @@
+#include "io/output_paths.h"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <regex>
+#include <system_error>
+
+namespace rigc {
+namespace {
+
+void set_error(std::string* error, std::string text) {
+  if (error != nullptr) *error = std::move(text);
+}
+
+}  // namespace
+
+// The suffix is atomic_file.cpp's unique_suffix: ".tmp.PID.COUNTER.HEX".
+bool is_temporary_name(const std::string& filename) {
+  static const std::regex pattern(R"(\..+\.tmp\.[0-9]+\.[0-9]+\.[0-9a-f]+)");
+  return std::regex_match(filename, pattern);
+}
+
+bool make_output_folder(const std::filesystem::path& dir, std::string* error) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(dir, ec);
+  if (fs::is_symlink(link)) {
+    const fs::file_status target = fs::status(dir, ec);
+    if (ec.value() == ELOOP) {
+      set_error(error,
+                fmt::format("the output folder '{}' is a symbolic link that loops", dir.string()));
+      return false;
+    }
+    if (!fs::exists(target)) {
+      const fs::path to = fs::read_symlink(dir, ec);
+      set_error(error,
+                fmt::format("the output folder '{}' is a symbolic link to '{}', which does not "
+                            "exist; create it or name another folder",
+                            dir.string(), to.string()));
+      return false;
+    }
+  }
+  fs::create_directories(dir, ec);
+  std::error_code is_dir_ec;
+  if (!ec && fs::is_directory(dir, is_dir_ec)) return true;
+  if (!ec && !is_dir_ec) {
+    set_error(error,
+              fmt::format("cannot create the output folder '{}': a file of that name is in the way",
+                          dir.string()));
+    return false;
+  }
+  set_error(error, fmt::format("cannot create the output folder '{}': {}", dir.string(),
+                               (ec ? ec : is_dir_ec).message()));
+  return false;
+}
+
+}  // namespace rigc
