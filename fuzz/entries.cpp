@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,17 +13,16 @@
 #include "assets/model_loading.h"
 #include "assets/textures.h"
 #include "compiler/frontend.h"
-#include "eval/colmap.h"
+#include "fuzz/input_file.h"
 #include "run/colmap_text.h"
 #include "run/manifest.h"
 
 namespace rigc::fuzz {
-namespace {
 
 namespace fs = std::filesystem;
 
 // A folder of this process's own for the inputs the readers want as files, removed at exit.
-const fs::path& input_dir() {
+const std::filesystem::path& input_dir() {
   static const fs::path dir = [] {
     fs::path d = fs::temp_directory_path() / ("rigc-fuzz-" + std::to_string(::getpid()));
     fs::create_directories(d);
@@ -38,13 +36,15 @@ const fs::path& input_dir() {
 }
 
 // Writes `input` to the file `name` in input_dir() and returns its path.
-fs::path write_input(std::string_view input, const std::string& name) {
+std::filesystem::path write_input(std::string_view input, const std::string& name) {
   const fs::path path = input_dir() / name;
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(input.data(), static_cast<std::streamsize>(input.size()));
   if (!out.flush()) throw std::runtime_error("fuzz: cannot write " + path.string());
   return path;
 }
+
+namespace {
 
 // A model loads or fails with a one-line error naming the file; it never comes back empty.
 void load_model_file(std::string_view input, const std::string& name) {
@@ -58,29 +58,7 @@ void load_model_file(std::string_view input, const std::string& name) {
   }
 }
 
-// A reader's failure must come with a message.
-template <typename Result>
-void require_error_if_failed(const std::optional<Result>& result, const std::string& error) {
-  if (!result && error.empty()) throw std::logic_error("a reader failed without an error");
-}
-
 }  // namespace
-
-std::span<const Harness> harnesses() {
-  static constexpr std::array<Harness, 10> kHarnesses{{
-      {"scene", scene},
-      {"ply", ply},
-      {"obj", obj},
-      {"stl", stl},
-      {"gltf", gltf},
-      {"texture", texture},
-      {"colmap_cameras", colmap_cameras},
-      {"colmap_images", colmap_images},
-      {"colmap_points", colmap_points},
-      {"manifest", manifest},
-  }};
-  return kHarnesses;
-}
 
 void scene(std::string_view input) {
   DiagnosticEngine diag;
@@ -131,17 +109,6 @@ void colmap_cameras(std::string_view input) {
 void colmap_images(std::string_view input) {
   std::string error;
   require_error_if_failed(run::read_colmap_images(write_input(input, "images.txt"), &error), error);
-}
-
-void colmap_points(std::string_view input) {
-  std::string error;
-  const auto points = eval::read_colmap_points(write_input(input, "points3D.txt"), &error);
-  require_error_if_failed(points, error);
-  if (!points) return;
-  eval::SparseModel model;
-  model.points = *points;
-  model.mean_track_length();
-  model.mean_reprojection_error();
 }
 
 void manifest(std::string_view input) {

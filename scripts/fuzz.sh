@@ -1,17 +1,16 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer harnesses (fuzz/, docs/fuzzing.md) into build-asan/ and runs each for
+# Builds the libFuzzer harnesses (fuzz/, docs/fuzzing.md) into build-fuzz/ and runs each for
 # SECONDS (default 60) under `nice`, starting from its corpus: the seeds (scenes/, tests/bad_scenes/,
-# Debian's assimp-testmodels, fuzz/seeds/), the inputs found so far (build-asan/fuzz-corpus/) and
+# Debian's assimp-testmodels, fuzz/seeds/), the inputs found so far (build-fuzz/fuzz-corpus/) and
 # the regression inputs (tests/fuzz_regressions/). Every crash, hang (> 10 s) or out-of-memory
 # (> 2 GB) becomes a regression input under tests/fuzz_regressions/<harness>/, which rigc_tests
 # replays; the script then exits 1.
 #   RIGC_FUZZ_ONLY="scene ply"  run only these harnesses
 #   RIGC_FUZZ_JOBS=2            run this many harnesses at once (default 1)
-# `scripts/fuzz.sh --configure` only configures build-asan/ (scripts/test.sh builds its tests).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-build=build-asan
+build=build-fuzz
 harnesses=(${RIGC_FUZZ_ONLY:-scene ply obj stl gltf texture colmap_cameras colmap_images colmap_points manifest})
 
 launcher=()
@@ -19,7 +18,6 @@ if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=cc
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only -DNDEBUG" -DRIGC_FUZZ=ON \
   "${launcher[@]}" >/dev/null
-if [[ $seconds == --configure ]]; then exit 0; fi
 nice -n 10 cmake --build "$build" -j "$(nproc)" --target "${harnesses[@]/#/fuzz_}"
 
 models=/usr/share/assimp/models
