@@ -63,7 +63,7 @@ run_harness() {
     -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$artifacts"
     -print_final_stats=1)
   if [[ -n $dict ]]; then args+=(-dict="$dict"); fi
-  TMPDIR=$(realpath "$tmp") nice -n 10 "$build/fuzz/fuzz_$h" "${args[@]}" "$corpus" \
+  TMPDIR=$(realpath "$tmp") LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp nice -n 10 "$build/fuzz/fuzz_$h" "${args[@]}" "$corpus" \
     "$build/fuzz-seeds/$h" "$regressions" >"$build/fuzz-logs/$h.log" 2>&1 || true
   rm -rf "$tmp"
 }
