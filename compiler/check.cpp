@@ -1,6 +1,7 @@
 #include "compiler/check.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/eventhandler.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include "assets/primitives.h"
@@ -1108,20 +1110,67 @@ std::optional<YAML::Mark> first_invalid_utf8_scalar(const YAML::Node& root) {
   return std::nullopt;
 }
 
+// Where each document of a YAML text starts and where its first node is, for at most two
+// documents: enough to refuse a second one. (yaml-cpp 0.7's LoadAll never ends on some malformed
+// texts, e.g. a lone ",": each "document" then starts where the last one did.)
+struct DocumentStart {
+  YAML::Mark start;
+  std::optional<YAML::Mark> first_node;
+};
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<DocumentStart> documents;
+  void OnDocumentStart(const YAML::Mark& mark) override { documents.push_back({mark, {}}); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    node(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    node(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    node(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void node(const YAML::Mark& mark) {
+    if (!documents.empty() && !documents.back().first_node) documents.back().first_node = mark;
+  }
+};
+
+std::vector<DocumentStart> first_two_documents(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentStarts starts;
+  while (starts.documents.size() < 2 && parser.HandleNextDocument(starts)) {
+  }
+  return starts.documents;
+}
+
 }  // namespace
 
 std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string& file,
                                      DiagnosticEngine& diag) {
   try {
-    // Every document, so that a second one is an error rather than silently left unread.
-    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    // Two documents at most, so that a second one is an error rather than silently left unread.
+    const std::vector<DocumentStart> documents = first_two_documents(text);
     if (documents.size() > 1) {
-      const YAML::Mark mark = documents[1].Mark();
+      const bool stuck = documents[1].start.pos == documents[0].start.pos;
+      const YAML::Mark mark =
+          stuck ? documents[0].start : documents[1].first_node.value_or(documents[1].start);
       diag.error({file, std::max(mark.line, 0) + 1, std::max(mark.column, 0) + 1},
-                 "a scene file holds one YAML document; a second one starts here");
+                 stuck ? "YAML syntax error: unexpected character"
+                       : "a scene file holds one YAML document; a second one starts here");
       return std::nullopt;
     }
-    const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+    const YAML::Node root = documents.empty() ? YAML::Node() : YAML::Load(text);
     if (const auto bad = first_invalid_utf8_scalar(root)) {
       diag.error({file, bad->line + 1, bad->column + 1},
                  "this text is not valid UTF-8 (save the scene file as UTF-8)");

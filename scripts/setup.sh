@@ -12,6 +12,7 @@ packages=(
   povray blender colmap libopen3d-dev libembree-dev libnanoflann-dev fonts-dejavu-core
   libcpp-httplib-dev libjs-three chromium chromium-driver python3-selenium
   slurmctld slurmd slurm-client munge
+  clang libfuzzer-14-dev ccache
 )
 
 missing=()
