@@ -437,8 +437,12 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   ++frames_rendering_;
   struct Done {
     std::atomic<int>& count;
-    ~Done() { --count; }
-  } done{frames_rendering_};
+    std::atomic<std::int64_t>& ended;
+    ~Done() {
+      ended = Clock::now().time_since_epoch().count();
+      --count;
+    }
+  } done{frames_rendering_, last_frame_end_};
   std::lock_guard render_lock(render_mutex_);
   const auto start = Clock::now();
   const ir::Shot& shot = view->shots.front();
@@ -507,9 +511,15 @@ std::optional<analysis::CoverageResult> Session::analyse(
   }
   for (size_t s = cache.run->shot_count(); s < scene->shots.size(); ++s) {
     if (analysis_generation_ != generation) return std::nullopt;
-    // The live view first: a frame being rendered gets the cores before the next shot.
-    while (frames_rendering_ > 0 && analysis_generation_ == generation) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    // The live view first: while frames come (a slider or the camera moving), the next shot
+    // waits until they pause.
+    const auto live_view_busy = [&] {
+      const Clock::duration since_frame =
+          Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
+      return frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200);
+    };
+    while (live_view_busy() && analysis_generation_ == generation) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     cache.run->add_shot(scene->shots[s]);
   }

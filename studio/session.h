@@ -159,6 +159,7 @@ class Session {
   // analysis of an older generation stops at its next shot.
   std::atomic<int> analysis_generation_{0};
   std::atomic<int> frames_rendering_{0};  // the analysis yields to the live view between shots
+  std::atomic<std::int64_t> last_frame_end_{0};  // steady clock ticks
   AnalysisCache coverage_cache_, advice_cache_;  // under analysis_mutex_
   std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
   std::unique_ptr<run::Backend> preview_;
