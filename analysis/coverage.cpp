@@ -151,17 +151,24 @@ struct ViewFaults {
   bool any() const { return out_of_focus || clipped || dark || oblique || coarse; }
 };
 
+}  // namespace
+
 // The whole analysis: per shot, per face visibility, usability and triangulation; the per-face
-// state persists across shots (view counts, usable views by shot).
+// state persists across shots (view counts, usable views by shot). Shots are added in order.
 class CoverageAnalysis {
  public:
   CoverageAnalysis(const ir::Scene& scene, const scene::StudioScene& studio,
                    const CoverageOptions& options);
-  CoverageResult run();  // once
+  CoverageAnalysis(const CoverageAnalysis&) = default;
+  // Analyses `shot` (of a scene that differs from the constructor's in its shots alone) as the
+  // next shot.
+  void add_shot(const ir::Shot& shot);
+  CoverageResult result() const;
+  int shot_count() const { return static_cast<int>(result_.shots.size()); }
 
  private:
   void measure_faces();
-  ShotView view_shot(int s) const;
+  ShotView view_shot(int s, const ir::Shot& shot) const;
   ShotAreas analyse_faces(const ShotView& view);
   void analyse_face(const ShotView& view, size_t f, ShotSums& sum);
   std::optional<double> visible_depth(const ShotView& view, size_t f, const Vector3d& to_eye) const;
@@ -182,7 +189,6 @@ class CoverageAnalysis {
   const ir::CoverageSettings& settings_;
   const scene::Geometry& mesh_;
   const size_t face_count_;
-  const int shot_count_;
   const dslr::Intrinsics canvas_;
   const double pixel_pitch_m_;
   const double exposure_;
@@ -200,10 +206,14 @@ class CoverageAnalysis {
   CumulativeTotals totals_;
 };
 
+namespace {
+
 double visibility_scale(const CoverageOptions& options, const ir::Camera& camera) {
   return options.visibility_scale > 0 ? options.visibility_scale
                                       : std::min(1.0, 1400.0 / camera.width_px);
 }
+
+}  // namespace
 
 CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioScene& studio,
                                    const CoverageOptions& options)
@@ -213,33 +223,38 @@ CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioSc
       settings_(scene.coverage),
       mesh_(studio.object),
       face_count_(mesh_.triangles.size()),
-      shot_count_(static_cast<int>(scene.shots.size())),
       canvas_(dslr::sensor_intrinsics(camera_, visibility_scale(options, camera_))),
       pixel_pitch_m_(camera_.sensor_width_m / camera_.width_px),
       exposure_(dslr::exposure_scale(camera_)),
       cos_max_angle_(std::cos(settings_.max_view_angle_rad)),
       cos_min_triangulation_(std::cos(settings_.min_triangulation_angle_rad)),
       keep_sights_(options.keep_sights),
-      usable_by_shot_(shot_count_),
       seen_previous_(face_count_, 0),
-      seen_now_(face_count_, 0),
-      eye_by_shot_(shot_count_) {}
-
-CoverageResult CoverageAnalysis::run() {
+      seen_now_(face_count_, 0) {
+  std::string error;
+  if (!options.check(&error)) throw std::invalid_argument(error);
   measure_faces();
   albedo_ = face_albedo(scene_, studio_);
-  for (int s = 0; s < shot_count_; ++s) {
-    const ShotView view = view_shot(s);
-    result_.shots.push_back(summarise_shot(view, analyse_faces(view)));
-    if (keep_sights_) keep_sight(view);
-    std::swap(seen_previous_, seen_now_);
-  }
-  result_.blur_ratio_95 = totals_.blur_ratio_95();
+}
+
+void CoverageAnalysis::add_shot(const ir::Shot& shot) {
+  const int s = shot_count();
+  usable_by_shot_.emplace_back();
+  eye_by_shot_.emplace_back();
+  const ShotView view = view_shot(s, shot);
+  result_.shots.push_back(summarise_shot(view, analyse_faces(view)));
+  if (keep_sights_) keep_sight(view);
+  std::swap(seen_previous_, seen_now_);
+}
+
+CoverageResult CoverageAnalysis::result() const {
+  CoverageResult result = result_;
+  result.blur_ratio_95 = totals_.blur_ratio_95();
   if (keep_sights_) {
-    result_.face_center = center_;
-    result_.face_normal = normal_;
+    result.face_center = center_;
+    result.face_normal = normal_;
   }
-  return std::move(result_);
+  return result;
 }
 
 // Every face in one shot, in parallel; returns the shot's areas and adds its gains to the
@@ -289,8 +304,7 @@ void CoverageAnalysis::measure_faces() {
   }
 }
 
-ShotView CoverageAnalysis::view_shot(int s) const {
-  const ir::Shot& shot = scene_.shots[s];
+ShotView CoverageAnalysis::view_shot(int s, const ir::Shot& shot) const {
   ShotView view;
   view.index = s;
   view.shot = &shot;
@@ -484,13 +498,43 @@ ShotCoverage CoverageAnalysis::summarise_shot(const ShotView& view, const ShotAr
   return coverage;
 }
 
-}  // namespace
-
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options) {
-  std::string error;
-  if (!options.check(&error)) throw std::invalid_argument(error);
-  return CoverageAnalysis(scene, studio, options).run();
+  CoverageAnalysis analysis(scene, studio, options);
+  for (const ir::Shot& shot : scene.shots) analysis.add_shot(shot);
+  return analysis.result();
+}
+
+IncrementalCoverage::IncrementalCoverage(std::shared_ptr<const ir::Scene> scene,
+                                         std::shared_ptr<const scene::StudioScene> studio,
+                                         const CoverageOptions& options)
+    : scene_(std::move(scene)),
+      studio_(std::move(studio)),
+      analysis_(std::make_unique<CoverageAnalysis>(*scene_, *studio_, options)) {}
+
+IncrementalCoverage::~IncrementalCoverage() = default;
+
+int IncrementalCoverage::shot_count() const {
+  return analysis_->shot_count();
+}
+
+void IncrementalCoverage::add_shot(const ir::Shot& shot) {
+  before_.push_back(std::make_unique<CoverageAnalysis>(*analysis_));
+  if (before_.size() > kUndoDepth) before_.pop_front();
+  shots_.push_back(shot);
+  analysis_->add_shot(shot);
+}
+
+bool IncrementalCoverage::remove_last_shot() {
+  if (before_.empty()) return false;
+  analysis_ = std::move(before_.back());
+  before_.pop_back();
+  shots_.pop_back();
+  return true;
+}
+
+CoverageResult IncrementalCoverage::result() const {
+  return analysis_->result();
 }
 
 }  // namespace rigc::analysis

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -72,5 +74,34 @@ struct CoverageOptions {
 
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options = {});
+
+class CoverageAnalysis;
+
+// The analysis kept open, so that shots can be added one at a time (the studio's captures): after
+// add_shot of shots s0..sn, result() is analyse_coverage's on a scene with those shots (and the
+// scene's object, studio and camera). The last shots added can be taken back.
+class IncrementalCoverage {
+ public:
+  IncrementalCoverage(std::shared_ptr<const ir::Scene> scene,
+                      std::shared_ptr<const scene::StudioScene> studio,
+                      const CoverageOptions& options = {});
+  ~IncrementalCoverage();
+
+  void add_shot(const ir::Shot& shot);
+  // Takes the last shot back; false when it is not kept (more than kUndoDepth shots back).
+  bool remove_last_shot();
+  int shot_count() const;
+  const std::vector<ir::Shot>& shots() const { return shots_; }
+  CoverageResult result() const;
+
+  static constexpr size_t kUndoDepth = 32;
+
+ private:
+  std::shared_ptr<const ir::Scene> scene_;
+  std::shared_ptr<const scene::StudioScene> studio_;
+  std::unique_ptr<CoverageAnalysis> analysis_;
+  std::deque<std::unique_ptr<CoverageAnalysis>> before_;  // before each of the last shots added
+  std::vector<ir::Shot> shots_;
+};
 
 }  // namespace rigc::analysis

@@ -97,7 +97,8 @@ def main():
     driver = browser(1600, 1000)
     try:
         driver.get(url)
-        wait_for(driver, 'return window.rigcFrame.count > 0 && window.rigcCoverage', what='the page')
+        wait_for(driver, 'return window.rigcFrame.count > 0 && window.rigcCoverage', timeout=300,
+                 what='the page')
         settle(driver)
         slider = bench_slider(driver, args.changes)
         print(f'slider change -> 1280 px frame drawn: p50 {percentile(slider, 50):.0f} ms, '

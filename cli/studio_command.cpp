@@ -37,12 +37,15 @@ int run_studio_command(std::vector<std::string> args) {
                  "address to listen on (default 127.0.0.1; another one lets others connect)");
   app.add_option("--port", options.port, "port (default: any free one)")
       ->check(CLI::Range(0, 65535));
+  std::string run_folder;
+  app.add_option("-o,--output", run_folder,
+                 "run folder of the reference checks (default: out/<scene>/studio)");
   if (auto code = parse_options(app, args)) return *code;
   // Before any thread starts (the compiler's and the renderer's workers inherit the mask).
   const sigset_t signals = block_stop_signals();
 
   std::string error;
-  const auto session = studio::Session::open(scene_path, &error);
+  const auto session = studio::Session::open(scene_path, &error, run_folder);
   if (!session) {
     std::cerr << error;
     return kExitUserError;

@@ -130,6 +130,10 @@ bool is_executable_file(const fs::path& path) {
 
 }  // namespace
 
+void stop_child_processes() {
+  stop_children();
+}
+
 void set_spawn_hook_for_tests(void (*hook)()) {
   g_spawn_hook = hook;
 }

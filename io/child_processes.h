@@ -35,6 +35,10 @@ struct ChildResult {
 // runs on.)
 ChildResult run_child(const ChildRun& run);
 
+// Sends a SIGTERM to every program rigc is running (the studio's Cancel of a reference render);
+// run_child then returns with 128 + SIGTERM.
+void stop_child_processes();
+
 // Tests only: `hook` runs in run_child between the child's spawn and its watch, where a stop
 // signal has to be deferred (nullptr: none).
 void set_spawn_hook_for_tests(void (*hook)());

@@ -28,6 +28,33 @@ std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int hei
   return std::string(bytes.begin(), bytes.end());
 }
 
+std::string jpeg_of_image_file(const std::string& path, int quality, int* width, int* height,
+                               std::string* error) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    *error = "cannot read " + path + ": " + OIIO::geterror();
+    return {};
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.nchannels < 1 || spec.width < 1 || spec.height < 1) {
+    *error = "the image " + path + " has no pixels";
+    return {};
+  }
+  *width = spec.width;
+  *height = spec.height;
+  const size_t pixels = static_cast<size_t>(spec.width) * spec.height;
+  std::vector<std::uint8_t> rgb(pixels * 3);
+  const int channels = std::min(spec.nchannels, 3);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, rgb.data(), 3)) {
+    *error = "cannot read " + path + ": " + in->geterror();
+    return {};
+  }
+  if (channels == 1) {
+    for (size_t i = 0; i < pixels; ++i) rgb[3 * i + 1] = rgb[3 * i + 2] = rgb[3 * i];
+  }
+  return encode_jpeg(rgb, spec.width, spec.height, quality, error);
+}
+
 Histogram histogram_of(const std::vector<std::uint8_t>& rgb) {
   Histogram h;
   h.bins.assign(4 * Histogram::kBins, 0);

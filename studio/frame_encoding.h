@@ -12,6 +12,11 @@ namespace rigc::studio {
 std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int height, int quality,
                         std::string* error);
 
+// An image file (any format OpenImageIO reads) as a JPEG of `quality`, with its size; empty on
+// failure with `error` set.
+std::string jpeg_of_image_file(const std::string& path, int quality, int* width, int* height,
+                               std::string* error);
+
 struct Histogram {
   static constexpr int kBins = 64;
   std::vector<int> bins;  // 4 x kBins: red, green, blue, then luma (Rec. 709 weights on codes)

@@ -1,7 +1,11 @@
 #include "studio/server.h"
 
+#include <arpa/inet.h>
 #include <fmt/format.h>
 #include <httplib.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -69,6 +73,34 @@ bool same_token(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
+// localhost, the host's name, and the addresses of its interfaces (IPv6 in brackets), as a Host
+// header names them.
+std::vector<std::string> machine_names() {
+  std::vector<std::string> names = {"127.0.0.1", "localhost", "[::1]"};
+  char hostname[256] = {};
+  if (gethostname(hostname, sizeof hostname - 1) == 0 && hostname[0] != 0) {
+    names.push_back(hostname);
+  }
+  ifaddrs* interfaces = nullptr;
+  if (getifaddrs(&interfaces) != 0) return names;
+  for (const ifaddrs* i = interfaces; i; i = i->ifa_next) {
+    if (!i->ifa_addr) continue;
+    char text[INET6_ADDRSTRLEN] = {};
+    const int family = i->ifa_addr->sa_family;
+    if (family == AF_INET) {
+      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(i->ifa_addr)->sin_addr, text,
+                sizeof text);
+      names.push_back(text);
+    } else if (family == AF_INET6) {
+      inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(i->ifa_addr)->sin6_addr, text,
+                sizeof text);
+      names.push_back("[" + std::string(text) + "]");
+    }
+  }
+  freeifaddrs(interfaces);
+  return names;
+}
+
 }  // namespace
 
 std::string random_token() {
@@ -106,17 +138,26 @@ bool StudioServer::is_running() const {
 }
 
 std::string StudioServer::url() const {
-  const bool v6 = options_.host.find(':') != std::string::npos;
-  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", options_.host, v6 ? "]" : "",
-                     port_, options_.token);
+  std::string host = options_.host;
+  if (host == "0.0.0.0" || host == "::") {
+    // Every interface: the machine's name, which the Host check accepts.
+    char hostname[256] = {};
+    host = gethostname(hostname, sizeof hostname - 1) == 0 && hostname[0] ? hostname : "localhost";
+  }
+  const bool v6 = host.find(':') != std::string::npos;
+  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", host, v6 ? "]" : "", port_,
+                     options_.token);
 }
 
-// The names this server answers to: its own address, and localhost's when it listens there.
+// The names this server answers to: its own address, and localhost's when it listens there; on
+// every interface (0.0.0.0, ::), the machine's name and each of its addresses too.
 bool StudioServer::allowed_host(const std::string& host) const {
   const std::string port = ":" + std::to_string(port_);
   std::vector<std::string> names = {options_.host};
   if (options_.host == "127.0.0.1" || options_.host == "localhost" || options_.host == "::1") {
     names = {"127.0.0.1", "localhost", "[::1]"};
+  } else if (options_.host == "0.0.0.0" || options_.host == "::") {
+    names = machine_names();
   } else if (options_.host.find(':') != std::string::npos) {
     names = {"[" + options_.host + "]"};
   }
@@ -221,15 +262,20 @@ void StudioServer::add_page_routes() {
     }
     res.set_header("X-Rigc-Stages", stages);
     res.set_header("X-Rigc-Encode-Ms", fmt::format("{:.1f}", frame->encode_ms));
+    res.set_header("X-Rigc-Reused-Render", frame->reused_render ? "1" : "0");
     res.set_header("Cache-Control", "no-store");
     res.set_content(frame->jpeg, "image/jpeg");
   });
-  server_->Get("/api/coverage", [this](const httplib::Request&, httplib::Response& res) {
-    send_json(res, session_.coverage());
-  });
-  server_->Get("/api/advice", [this](const httplib::Request&, httplib::Response& res) {
-    send_json(res, session_.advice());
-  });
+  // 409 when the scene changed during the analysis: the page asks again for the new one.
+  auto analysis = [this](const char* route, std::optional<nlohmann::json> (Session::*method)()) {
+    server_->Get(route, [this, method](const httplib::Request&, httplib::Response& res) {
+      const auto result = (session_.*method)();
+      if (!result) return send_error(res, 409, "the scene changed during the analysis");
+      send_json(res, *result);
+    });
+  };
+  analysis("/api/coverage", &Session::coverage);
+  analysis("/api/advice", &Session::advice);
   server_->Get("/api/mesh", [this](const httplib::Request&, httplib::Response& res) {
     send_json(res, session_.mesh());
   });
@@ -300,9 +346,48 @@ void StudioServer::add_edit_routes() {
                     {"reconstructable", suggestion.reconstructable},
                     {"entry", suggestion.entry}});
   });
+  add_reference_routes();
   action("/api/capture", &Session::capture);
   action("/api/undo", &Session::undo);
   action("/api/save", &Session::save);
+}
+
+// The reference check: start {backend, width, samples}, its status, cancel, and the two images.
+void StudioServer::add_reference_routes() {
+  server_->Post("/api/reference", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto body = json_body(req, res);
+    if (!body) return;
+    ReferenceRequest request;
+    const nlohmann::json backend = body->value("backend", nlohmann::json(request.backend));
+    const nlohmann::json width = body->value("width", nlohmann::json(request.width));
+    const nlohmann::json samples = body->value("samples", nlohmann::json(request.samples));
+    if (!backend.is_string() || !width.is_number_integer() || !samples.is_number_integer()) {
+      return send_error(res, 400,
+                        "reference takes {\"backend\": \"povray\", \"width\": 640, "
+                        "\"samples\": 0}");
+    }
+    request.backend = backend.get<std::string>();
+    request.width = width.get<int>();
+    request.samples = samples.get<int>();
+    send_outcome(res, session_.start_reference(request));
+  });
+  server_->Get("/api/reference", [this](const httplib::Request&, httplib::Response& res) {
+    send_json(res, session_.reference().status());
+  });
+  server_->Post("/api/reference/cancel", [this](const httplib::Request&, httplib::Response& res) {
+    session_.reference().cancel();
+    send_json(res, {{"ok", true}});
+  });
+  server_->Get("/api/reference/image", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string which = req.has_param("which") ? req.get_param_value("which") : "reference";
+    if (which != "reference" && which != "preview") {
+      return send_error(res, 400, "which is reference or preview");
+    }
+    const std::string jpeg = session_.reference().image(which);
+    if (jpeg.empty()) return send_error(res, 404, "no reference check has finished yet");
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(jpeg, "image/jpeg");
+  });
 }
 
 }  // namespace rigc::studio

@@ -44,6 +44,7 @@ class StudioServer {
   void add_routes();
   void add_page_routes();
   void add_edit_routes();
+  void add_reference_routes();
   bool allowed_host(const std::string& host_header) const;
 
   Session& session_;

@@ -3,12 +3,14 @@
 
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <numeric>
 #include <sstream>
 #include <thread>
 
+#include "analysis/coverage.h"
 #include "compiler/frontend.h"
 #include "studio/studio_test_scene.h"
 #include "tests/test_support.h"
@@ -29,7 +31,7 @@ class StudioApi : public ::testing::Test {
     scene_file_ = dir_.path() / "scene.yaml";
     std::ofstream(scene_file_) << kStudioTestScene;
     std::string error;
-    session_ = Session::open(scene_file_, &error);
+    session_ = Session::open(scene_file_, &error, dir_.path() / "run");
     ASSERT_TRUE(session_) << error;
     server_ = std::make_unique<StudioServer>(*session_, ServerOptions{});
     const int port = server_->bind(&error);
@@ -137,6 +139,65 @@ TEST_F(StudioApi, CaptureAddsAShotToTheCoverageAndUndoTakesItBack) {
   EXPECT_EQ(post("/api/undo", {})->status, 422);  // nothing left to undo
 }
 
+// Captures and their undo reuse the analysis of the shots before; a camera change starts it
+// again. Either way the page gets what `rigc coverage` computes for the scene as saved.
+TEST_F(StudioApi, CapturesUndoAndChangesGiveTheCoverageOfAFullAnalysis) {
+  const auto expect_full_coverage = [&](const char* after) {
+    const auto res = client_->Get("/api/coverage");
+    ASSERT_TRUE(res && res->status == 200) << after;
+    const auto coverage = nlohmann::json::parse(res->body);
+    ASSERT_EQ(post("/api/save", {})->status, 200) << after;
+    DiagnosticEngine diag;
+    diag.set_handler([](const Diagnostic&, const std::string&) {});
+    const auto scene = compile_scene_file(scene_file_.string(), diag);
+    ASSERT_TRUE(scene) << after;
+    const auto full = analysis::analyse_coverage(*scene, scene::prepare_studio_scene(*scene));
+    EXPECT_EQ(coverage["views"].get<std::vector<int>>(),
+              std::vector<int>(full.views.begin(), full.views.end()))
+        << after;
+    EXPECT_NEAR(coverage["reconstructable"].get<double>(), full.shots.back().reconstructable, 1e-9)
+        << after;
+    EXPECT_NEAR(coverage["seen_2"].get<double>(), full.shots.back().seen_2, 1e-9) << after;
+    EXPECT_EQ(coverage["shots"].get<size_t>(), full.shots.size()) << after;
+  };
+  const auto capture_from = [&](double x, double y) {
+    ASSERT_EQ(post("/api/view", {{"position", {x, y, 1.0}}, {"look_at", {0, 0, 0.85}}})->status,
+              200);
+    ASSERT_EQ(post("/api/capture", {})->status, 200);
+  };
+  expect_full_coverage("at the start");
+  capture_from(0, -0.8);
+  capture_from(-0.6, -0.5);
+  expect_full_coverage("after two captures");
+  ASSERT_EQ(post("/api/undo", {})->status, 200);
+  capture_from(-0.7, 0.3);
+  expect_full_coverage("after an undo and a capture");
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.aperture"}, {"value", "f/4"}})->status,
+            200);
+  expect_full_coverage("after a change of the aperture");
+}
+
+// The renderer's frame is kept while only what the DSLR model applies changes.
+TEST_F(StudioApi, AnExposureChangeReusesTheRenderedFrame) {
+  const auto get = [&] {
+    const auto res = client_->Get("/api/frame?width=320");
+    EXPECT_TRUE(res && res->status == 200);
+    return std::make_pair(res->get_header_value("X-Rigc-Reused-Render") == "1",
+                          std::stod(res->get_header_value("X-Rigc-Mean")));
+  };
+  const auto first = get();
+  EXPECT_FALSE(first.first);
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.iso"}, {"value", "400"}})->status, 200);
+  const auto brighter = get();
+  EXPECT_TRUE(brighter.first);
+  EXPECT_GT(brighter.second, first.second * 1.2);
+  ASSERT_EQ(post("/api/view", {{"position", {0.7, -0.4, 1.0}}, {"look_at", {0, 0, 0.85}}})->status,
+            200);
+  EXPECT_FALSE(get().first);
+  ASSERT_EQ(post("/api/set", {{"path", "studio.ambient"}, {"value", "200lx"}})->status, 200);
+  EXPECT_FALSE(get().first);  // the studio changed: rendered again
+}
+
 TEST_F(StudioApi, SuggestMovesTheViewToThePlannersNextShot) {
   const auto view_before = state()["view"];
   const auto res = post("/api/suggest", {});
@@ -212,6 +273,35 @@ TEST_F(StudioApi, BadRequestsGetA4xxAndTheServerStaysUp) {
   EXPECT_EQ(client_->Get("/api/frame?width=5")->status, 400);
   EXPECT_EQ(client_->Get("/api/nothing")->status, 404);
   EXPECT_EQ(client_->Get("/api/state")->status, 200);
+}
+
+// Listening on every interface, the server answers to the machine's own names and addresses.
+TEST(StudioServerHosts, OnEveryInterfaceTheMachinesOwnNamesAreAccepted) {
+  testing::TempDir dir;
+  const auto scene_file = dir.path() / "scene.yaml";
+  std::ofstream(scene_file) << kStudioTestScene;
+  std::string error;
+  const auto session = Session::open(scene_file, &error, dir.path() / "run");
+  ASSERT_TRUE(session) << error;
+  ServerOptions options;
+  options.host = "0.0.0.0";
+  StudioServer server(*session, options);
+  const int port = server.bind(&error);
+  ASSERT_GT(port, 0) << error;
+  std::thread thread([&] { server.run(); });
+  while (!server.is_running()) std::this_thread::yield();
+  httplib::Client client("127.0.0.1", port);
+  client.set_default_headers({{"X-Rigc-Token", server.token()}});
+  char hostname[256] = {};
+  gethostname(hostname, sizeof hostname - 1);
+  const std::string suffix = ":" + std::to_string(port);
+  for (const std::string& name : std::vector<std::string>{"127.0.0.1", "localhost", hostname}) {
+    EXPECT_EQ(client.Get("/api/state", {{"Host", name + suffix}})->status, 200) << name;
+  }
+  EXPECT_EQ(client.Get("/api/state", {{"Host", "evil.example" + suffix}})->status, 403);
+  EXPECT_EQ(client.Get("/api/state", {{"Host", "0.0.0.0" + suffix}})->status, 403);
+  server.stop();
+  thread.join();
 }
 
 TEST_F(StudioApi, LightsAreAddedChangedAndRemoved) {

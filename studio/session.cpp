@@ -8,6 +8,7 @@
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <thread>
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
@@ -15,10 +16,12 @@
 #include "compiler/diagnostics.h"
 #include "compiler/frontend.h"
 #include "compiler/presets.h"
+#include "dslr/lens.h"
 #include "io/atomic_file.h"
 #include "plan/plan_scene.h"
 #include "plan/scene_text.h"
 #include "run/run_loop.h"
+#include "scene/motion_blur.h"
 #include "studio/frame_encoding.h"
 
 namespace rigc::studio {
@@ -68,12 +71,13 @@ double ms_since(Clock::time_point start) {
 
 }  // namespace
 
-std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* error) {
+std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* error,
+                                       fs::path run_folder) {
   std::unique_ptr<Session> session(new Session());
   session->file_ = scene_file;
   session->disk_text_ = session->read_disk(error);
   if (!error->empty()) return nullptr;
-  const Outcome outcome = session->apply_text(session->disk_text_);
+  const Outcome outcome = session->apply_text(session->disk_text_, Change::kAnything);
   if (!outcome.ok) {
     *error = outcome.message;
     return nullptr;
@@ -90,7 +94,30 @@ std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* 
     return nullptr;
   }
   session->preview_ = backends::find_backend("preview")->make();
+  if (run_folder.empty()) run_folder = fs::path("out") / session->scene_->name / "studio";
+  session->reference_ = std::make_unique<ReferenceCheck>(run_folder);
   return session;
+}
+
+Session::~Session() = default;
+
+Outcome Session::start_reference(const ReferenceRequest& request) {
+  if (!(request.width >= 64 && request.width <= 4096) || request.samples < 0) {
+    return Outcome::fail("a reference is 64..4096 pixels wide, with samples >= 0");
+  }
+  std::shared_ptr<const ir::Scene> view;
+  {
+    std::lock_guard lock(mutex_);
+    view = view_scene_;
+  }
+  const double scale = std::min(1.0, static_cast<double>(request.width) / view->camera.width_px);
+  std::string error;
+  std::optional<Frame> preview = frame(scale, &error);
+  if (!preview) return Outcome::fail(error);
+  if (!reference_->start(view, scale, std::move(preview->jpeg), request, &error)) {
+    return Outcome::fail(error);
+  }
+  return {};
 }
 
 std::string Session::read_disk(std::string* error) const {
@@ -106,19 +133,23 @@ std::string Session::read_disk(std::string* error) const {
 }
 
 // Compiles `text`; when it compiles it becomes the session's scene (the view is recompiled on
-// it), otherwise the last good scene stays and the diagnostics are the message.
-Outcome Session::apply_text(std::string text) {
+// it), otherwise the last good scene stays and the diagnostics are the message. What `change`
+// cannot have touched is kept.
+Outcome Session::apply_text(std::string text, Change change) {
   Compiled compiled = compile_text(text, file_);
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
   auto scene = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
-  auto studio = std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
+  auto studio =
+      change != Change::kAnything && studio_
+          ? studio_
+          : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
   const std::string previous = text_;
   auto previous_scene = scene_;
   auto previous_studio = studio_;
   text_ = std::move(text);
   scene_ = scene;
   studio_ = studio;
-  if (view_scene_) {
+  if (view_scene_ && change != Change::kShots) {
     const Outcome viewed = compile_view(view_);
     if (!viewed.ok) {
       text_ = previous;
@@ -127,7 +158,7 @@ Outcome Session::apply_text(std::string text) {
       return viewed;
     }
   }
-  coverage_.reset();
+  if (change != Change::kShots) ++analysis_generation_;
   ++revision_;
   return {};
 }
@@ -162,7 +193,7 @@ Outcome Session::set_value(const ScenePath& path, const std::string& value) {
   std::string error;
   const auto text = studio::set_value(text_, path, value, &error);
   if (!text) return Outcome::fail(error);
-  return push_text(*text);
+  return push_text(*text, path[0] == "camera" ? Change::kCamera : Change::kAnything);
 }
 
 Outcome Session::add_light(const std::string& entry) {
@@ -170,7 +201,7 @@ Outcome Session::add_light(const std::string& entry) {
   std::string error;
   const auto text = append_to_list(text_, {"studio", "lights"}, entry, &error);
   if (!text) return Outcome::fail(error);
-  return push_text(*text);
+  return push_text(*text, Change::kAnything);
 }
 
 Outcome Session::remove_light(size_t index) {
@@ -178,14 +209,14 @@ Outcome Session::remove_light(size_t index) {
   std::string error;
   const auto text = remove_from_list(text_, {"studio", "lights"}, index, &error);
   if (!text) return Outcome::fail(error);
-  return push_text(*text);
+  return push_text(*text, Change::kAnything);
 }
 
 // A change the user can undo.
-Outcome Session::push_text(const std::string& text) {
-  const std::string before = text_;
-  const Outcome outcome = apply_text(text);
-  if (outcome.ok) undo_texts_.push_back(before);
+Outcome Session::push_text(const std::string& text, Change change) {
+  std::string before = text_;
+  const Outcome outcome = apply_text(text, change);
+  if (outcome.ok) undo_.push_back({std::move(before), change});
   return outcome;
 }
 
@@ -205,7 +236,7 @@ Outcome Session::capture() {
   entry = entry.substr(1, entry.size() - 2);
   const auto text = append_to_list(text_, {"shots"}, entry, &error);
   if (!text) return Outcome::fail(error);
-  const Outcome outcome = push_text(*text);
+  const Outcome outcome = push_text(*text, Change::kShots);
   if (outcome.ok) ++captures_;
   return outcome;
 }
@@ -246,10 +277,10 @@ Outcome Session::suggest_next_shot(Suggestion* suggestion) {
 
 Outcome Session::undo() {
   std::lock_guard lock(mutex_);
-  if (undo_texts_.empty()) return Outcome::fail("nothing to undo");
-  const std::string text = undo_texts_.back();
-  const Outcome outcome = apply_text(text);
-  if (outcome.ok) undo_texts_.pop_back();
+  if (undo_.empty()) return Outcome::fail("nothing to undo");
+  const UndoEntry entry = undo_.back();
+  const Outcome outcome = apply_text(entry.text, entry.change);
+  if (outcome.ok) undo_.pop_back();
   return outcome;
 }
 
@@ -273,10 +304,10 @@ void Session::reload_if_changed() {
   if (!error.empty() || text == disk_text_) return;
   disk_text_ = text;
   const std::string before = text_;
-  const Outcome outcome = apply_text(text);
+  const Outcome outcome = apply_text(text, Change::kAnything);
   file_error_ = outcome.ok ? "" : outcome.message;
   ++revision_;
-  if (outcome.ok && before != text) undo_texts_.push_back(before);
+  if (outcome.ok && before != text) undo_.push_back({before, Change::kAnything});
 }
 
 namespace {
@@ -336,7 +367,7 @@ nlohmann::json Session::state() {
           {"file_error", file_error_},
           {"captures", captures_},
           {"revision", revision_},
-          {"can_undo", !undo_texts_.empty()},
+          {"can_undo", !undo_.empty()},
           {"shots", scene.shots.size()},
           {"camera", camera_json(scene.camera)},
           {"focus_auto", focus},
@@ -355,6 +386,45 @@ nlohmann::json Session::state() {
           {"bodies", bodies}};
 }
 
+// The preview's linear frame of `shot`, or the one kept from an earlier frame that differs only
+// in what the DSLR model applies (exposure, focus, white balance, noise). The studio stays the
+// same object as long as the object, the materials, the studio and its lights do.
+bool Session::render_linear(const ir::Scene& scene,
+                            const std::shared_ptr<const scene::StudioScene>& studio,
+                            const ir::Shot& shot, const run::RenderSettings& settings,
+                            run::RenderedShot* rendered, bool* reused, std::string* error) {
+  RenderCache key;
+  key.studio = studio;
+  key.world_from_camera = shot.world_from_camera;
+  key.turntable_angle_rad = shot.turntable_angle_rad;
+  key.turntable_velocity_rad_s = shot.turntable_velocity_rad_s;
+  key.canvas = dslr::render_geometry_for(scene.camera, settings.scale);
+  key.subframes = scene::motion_blur_subframes(scene, *studio, shot, settings.scale);
+  key.shutter_s = key.subframes > 1 ? scene.camera.shutter_s : 0;
+  const auto same = [&](const RenderCache& c) {
+    return c.studio == key.studio && c.world_from_camera == key.world_from_camera &&
+           c.turntable_angle_rad == key.turntable_angle_rad &&
+           c.turntable_velocity_rad_s == key.turntable_velocity_rad_s &&
+           c.shutter_s == key.shutter_s && c.subframes == key.subframes &&
+           c.canvas.width == key.canvas.width && c.canvas.height == key.canvas.height &&
+           c.canvas.fx == key.canvas.fx && c.canvas.fy == key.canvas.fy &&
+           c.canvas.cx == key.canvas.cx && c.canvas.cy == key.canvas.cy;
+  };
+  const auto hit = std::find_if(render_cache_.begin(), render_cache_.end(), same);
+  *reused = hit != render_cache_.end();
+  if (*reused) {
+    *rendered = hit->rendered;
+    rendered->stage_ms.clear();
+    return true;
+  }
+  if (!preview_->render(scene, *studio, shot, settings, {}, rendered, error)) return false;
+  key.rendered = *rendered;
+  render_cache_.push_front(std::move(key));
+  // The live view's two sizes (moving and at rest) of the current view.
+  if (render_cache_.size() > 2) render_cache_.pop_back();
+  return true;
+}
+
 std::optional<Frame> Session::frame(double scale, std::string* error) {
   std::shared_ptr<const ir::Scene> scene, view;
   std::shared_ptr<const scene::StudioScene> studio;
@@ -364,6 +434,15 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
     view = view_scene_;
     studio = studio_;
   }
+  ++frames_rendering_;
+  struct Done {
+    std::atomic<int>& count;
+    std::atomic<std::int64_t>& ended;
+    ~Done() {
+      ended = Clock::now().time_since_epoch().count();
+      --count;
+    }
+  } done{frames_rendering_, last_frame_end_};
   std::lock_guard render_lock(render_mutex_);
   const auto start = Clock::now();
   const ir::Shot& shot = view->shots.front();
@@ -371,7 +450,10 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   settings.scale = scale;
   if (!settings.check(error)) return std::nullopt;
   run::RenderedShot rendered;
-  if (!preview_->render(*scene, *studio, shot, settings, {}, &rendered, error)) return std::nullopt;
+  Frame frame;
+  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render, error)) {
+    return std::nullopt;
+  }
   error->clear();
   std::map<std::string, double> stages = rendered.stage_ms;
   dslr::DevelopResult developed =
@@ -383,7 +465,6 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
     if (error->empty()) *error = "the DSLR model produced no image";
     return std::nullopt;
   }
-  Frame frame;
   frame.width = developed.width;
   frame.height = developed.height;
   frame.render_ms = ms_since(start);
@@ -396,24 +477,73 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   return frame;
 }
 
-// The coverage `rigc coverage` computes (its default options), kept until the scene changes.
-nlohmann::json Session::coverage() {
+// The coverage of `scene`'s shots with `options`. The cached analysis serves when only shots
+// changed since it started (generation): the shots it has beyond those `scene` begins with are
+// taken back, and `scene`'s further shots added. Nullopt when a newer change started another
+// generation meanwhile (the analysis stops at its next shot).
+std::optional<analysis::CoverageResult> Session::analyse(
+    AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
+    const std::shared_ptr<const scene::StudioScene>& studio, int generation,
+    const analysis::CoverageOptions& options) {
+  const auto same_shot = [](const ir::Shot& a, const ir::Shot& b) {
+    return a.world_from_camera == b.world_from_camera &&
+           a.object_from_camera == b.object_from_camera &&
+           a.turntable_angle_rad == b.turntable_angle_rad &&
+           a.turntable_velocity_rad_s == b.turntable_velocity_rad_s &&
+           a.focus_distance_m == b.focus_distance_m;
+  };
+  if (cache.run && cache.generation == generation) {
+    const auto& kept = cache.run->shots();
+    size_t common = 0;
+    while (common < kept.size() && common < scene->shots.size() &&
+           same_shot(kept[common], scene->shots[common])) {
+      ++common;
+    }
+    while (cache.run && static_cast<size_t>(cache.run->shot_count()) > common) {
+      if (!cache.run->remove_last_shot()) cache.run.reset();
+    }
+  } else {
+    cache.run.reset();
+  }
+  if (!cache.run) {
+    cache.run = std::make_unique<analysis::IncrementalCoverage>(scene, studio, options);
+    cache.generation = generation;
+  }
+  for (size_t s = cache.run->shot_count(); s < scene->shots.size(); ++s) {
+    if (analysis_generation_ != generation) return std::nullopt;
+    // The live view first: while frames come (a slider or the camera moving), the next shot
+    // waits until they pause.
+    const auto live_view_busy = [&] {
+      const Clock::duration since_frame =
+          Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
+      return frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200);
+    };
+    while (live_view_busy() && analysis_generation_ == generation) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    cache.run->add_shot(scene->shots[s]);
+  }
+  return cache.run->result();
+}
+
+// The coverage `rigc coverage` computes (its default options).
+std::optional<nlohmann::json> Session::coverage() {
   std::shared_ptr<const ir::Scene> scene;
   std::shared_ptr<const scene::StudioScene> studio;
+  int generation = 0;
   {
     std::lock_guard lock(mutex_);
-    if (coverage_) return coverage_json(*scene_, *coverage_);
     scene = scene_;
     studio = studio_;
+    generation = analysis_generation_;
   }
   std::lock_guard analysis_lock(analysis_mutex_);
   const auto start = Clock::now();
-  analysis::CoverageResult result = analysis::analyse_coverage(*scene, *studio);
+  const auto result = analyse(coverage_cache_, scene, studio, generation, {});
+  if (!result) return std::nullopt;
   const double ms = ms_since(start);
-  std::lock_guard lock(mutex_);
-  nlohmann::json out = coverage_json(*scene, result);
+  nlohmann::json out = coverage_json(*scene, *result);
   out["analysis_ms"] = ms;
-  if (scene == scene_) coverage_ = std::move(result);
   return out;
 }
 
@@ -434,13 +564,15 @@ nlohmann::json Session::coverage_json(const ir::Scene& scene,
 }
 
 // The warnings `rigc check` prints, at the same reduced resolution.
-nlohmann::json Session::advice() {
+std::optional<nlohmann::json> Session::advice() {
   std::shared_ptr<const ir::Scene> scene;
   std::shared_ptr<const scene::StudioScene> studio;
+  int generation = 0;
   {
     std::lock_guard lock(mutex_);
     scene = scene_;
     studio = studio_;
+    generation = analysis_generation_;
   }
   std::lock_guard analysis_lock(analysis_mutex_);
   DiagnosticEngine diag;
@@ -455,8 +587,9 @@ nlohmann::json Session::advice() {
   });
   analysis::CoverageOptions options;
   options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-  const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, *studio, options);
-  analysis::report_capture_advice(*scene, *studio, coverage, diag);
+  const auto coverage = analyse(advice_cache_, scene, studio, generation, options);
+  if (!coverage) return std::nullopt;
+  analysis::report_capture_advice(*scene, *studio, *coverage, diag);
   return out;
 }
 

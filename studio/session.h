@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
+#include <deque>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -19,6 +21,7 @@
 #include "run/backend.h"
 #include "scene/studio_scene.h"
 #include "studio/frame_encoding.h"
+#include "studio/reference_check.h"
 #include "studio/scene_edit.h"
 
 namespace rigc::studio {
@@ -53,12 +56,21 @@ struct Frame {
   double render_ms = 0;                    // render and development
   std::map<std::string, double> stage_ms;  // the renderer's and the DSLR model's stages
   double encode_ms = 0;
+  bool reused_render = false;  // the renderer's linear frame was kept from an earlier frame
 };
+
+// What a change of the scene text touched, so that what it cannot have changed is kept: the
+// prepared studio (object, materials, studio) across camera and shot changes, the view across
+// shot changes, the coverage across shot changes (captures and their undo).
+enum class Change { kAnything, kCamera, kShots };
 
 class Session {
  public:
   // Compiles the scene file; nullopt with the diagnostics in `error` when it does not compile.
-  static std::unique_ptr<Session> open(const std::filesystem::path& scene_file, std::string* error);
+  // Reference renders go to `run_folder` (empty: out/<scene name>/studio).
+  static std::unique_ptr<Session> open(const std::filesystem::path& scene_file, std::string* error,
+                                       std::filesystem::path run_folder = {});
+  ~Session();
 
   nlohmann::json state();
   // Sets the value at `path` (camera.* or studio.* only) to scene-language text.
@@ -77,21 +89,52 @@ class Session {
 
   // The current view through the preview backend and the DSLR model; `scale` of the sensor.
   std::optional<Frame> frame(double scale, std::string* error);
-  nlohmann::json coverage();
-  nlohmann::json advice();
+  // The coverage of the scene's shots; nullopt when the scene changed (other than in its shots)
+  // while it was being analysed.
+  std::optional<nlohmann::json> coverage();
+  std::optional<nlohmann::json> advice();
   nlohmann::json mesh();
   int sensor_width_px();
 
+  // The reference check of the current view (see reference_check.h), beside the preview's frame
+  // of it at the same size.
+  Outcome start_reference(const ReferenceRequest& request);
+  ReferenceCheck& reference() { return *reference_; }
+
  private:
   Session() = default;
-  Outcome apply_text(std::string text);
-  Outcome push_text(const std::string& text);
+  // A coverage analysis kept between requests: shots added or taken back reuse it.
+  struct AnalysisCache {
+    std::unique_ptr<analysis::IncrementalCoverage> run;
+    int generation = -1;
+  };
+  // A linear frame the preview rendered, and what it depends on besides the exposure, focus and
+  // white balance (which the DSLR model applies after it).
+  struct RenderCache {
+    std::shared_ptr<const scene::StudioScene> studio;  // held, so that its address stays unique
+    ir::Mat4 world_from_camera;
+    double turntable_angle_rad = 0, turntable_velocity_rad_s = 0, shutter_s = 0;
+    dslr::RenderGeometry canvas;
+    int subframes = 1;
+    run::RenderedShot rendered;
+  };
+
+  Outcome apply_text(std::string text, Change change);
+  Outcome push_text(const std::string& text, Change change);
   Outcome compile_view(const View& view);
   std::string view_pose_text(const View& view) const;
   std::string read_disk(std::string* error) const;
   nlohmann::json coverage_json(const ir::Scene& scene,
                                const analysis::CoverageResult& coverage) const;
   std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
+  std::optional<analysis::CoverageResult> analyse(
+      AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
+      const std::shared_ptr<const scene::StudioScene>& studio, int generation,
+      const analysis::CoverageOptions& options);
+  bool render_linear(const ir::Scene& scene,
+                     const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
+                     const run::RenderSettings& settings, run::RenderedShot* rendered, bool* reused,
+                     std::string* error);
 
   std::mutex mutex_;
   // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
@@ -100,7 +143,11 @@ class Session {
   std::filesystem::path file_;
   std::string disk_text_;  // the file as last read or saved
   std::string text_;       // the scene as the user changed it
-  std::vector<std::string> undo_texts_;
+  struct UndoEntry {
+    std::string text;
+    Change change;
+  };
+  std::vector<UndoEntry> undo_;
   std::string file_error_;                  // the file on disk does not compile: its diagnostics
   std::shared_ptr<const ir::Scene> scene_;  // text_ compiled, with every shot
   std::shared_ptr<const scene::StudioScene> studio_;
@@ -108,8 +155,15 @@ class Session {
   View view_;
   int captures_ = 0;
   int revision_ = 0;  // counts the changes, so the page knows when to refresh
-  std::optional<analysis::CoverageResult> coverage_;
+  // Counts the changes that make the coverage analysis start again (all but shot changes); an
+  // analysis of an older generation stops at its next shot.
+  std::atomic<int> analysis_generation_{0};
+  std::atomic<int> frames_rendering_{0};  // the analysis yields to the live view between shots
+  std::atomic<std::int64_t> last_frame_end_{0};  // steady clock ticks
+  AnalysisCache coverage_cache_, advice_cache_;  // under analysis_mutex_
+  std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
   std::unique_ptr<run::Backend> preview_;
+  std::unique_ptr<ReferenceCheck> reference_;
 };
 
 }  // namespace rigc::studio

@@ -9,6 +9,7 @@ import argparse
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -18,6 +19,7 @@ from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.ui import Select
 
 # Mean linear luminance of a canvas (sRGB decoded), and a sharpness figure: the mean absolute
 # horizontal difference of luma in a box (fractions of the canvas).
@@ -63,7 +65,9 @@ class Checks:
 
 
 def start_studio(rigc, scene):
-    proc = subprocess.Popen([rigc, 'studio', scene], stdout=subprocess.PIPE,
+    # Reference checks go to a run folder beside the scene.
+    run_folder = os.path.join(os.path.dirname(os.path.abspath(scene)), 'studio-run')
+    proc = subprocess.Popen([rigc, 'studio', scene, '-o', run_folder], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     line = proc.stdout.readline()
     match = re.search(r'(http://\S+)', line)
@@ -230,6 +234,31 @@ def check_suggest_next_shot(driver, checks):
                   f'"Suggest next shot" moves the view ({status}; {after})')
 
 
+def check_reference(driver, checks):
+    """The reference check renders the view with POV-Ray beside the preview; flicker shows one."""
+    if not shutil.which('povray'):
+        print('skip: the reference check needs povray')
+        return
+    Select(driver.find_element(By.ID, 'reference-width')).select_by_visible_text('160')
+    driver.find_element(By.ID, 'reference-start').click()
+    checks.expect(bool(wait_for(driver, 'return !document.getElementById("reference-cancel").disabled',
+                                what='the render to start')), 'the reference check starts')
+    shown = wait_for(driver, "const p = document.getElementById('reference-panel');"
+                     "const r = document.getElementById('reference-image');"
+                     "const v = document.getElementById('reference-preview');"
+                     "return !p.hidden && r.complete && v.complete && r.naturalWidth > 0 && "
+                     "v.naturalWidth > 0 && [v.naturalWidth, r.naturalWidth, r.naturalHeight]",
+                     timeout=400, what='the reference')
+    status = driver.find_element(By.ID, 'reference-status').text
+    checks.expect(shown[0] == shown[1] == 160,
+                  f'the POV-Ray reference shows beside the preview ({shown[1]} x {shown[2]} px; {status})')
+    driver.find_element(By.ID, 'reference-flicker').click()
+    time.sleep(0.2)
+    visible = driver.execute_script(
+        "return ['reference-preview', 'reference-image'].filter((id) => !document.getElementById(id).hidden)")
+    checks.expect(len(visible) == 1, f'flicker shows one of the two at a time ({visible})')
+
+
 def screenshots(rigc, scene, directory):
     for width, height in ((1280, 800), (1920, 1080)):
         proc, url = start_studio(rigc, scene)
@@ -269,6 +298,7 @@ def main():
         check_capture_and_coverage(driver, checks, args.rigc, args.scene, os.path.dirname(args.scene))
         check_save_and_broken_file(driver, checks, args.rigc, args.scene, original)
         check_suggest_next_shot(driver, checks)
+        check_reference(driver, checks)
     finally:
         driver.quit()
         proc.send_signal(2)  # Ctrl-C

@@ -423,7 +423,9 @@ async function setUpCoverageView() {
 const PAPER = [[1, 1, 1], [0.85, 0.05, 0.05], [0.05, 0.7, 0.1]];
 
 async function refreshCoverage() {
-  const coverage = await (await api('api/coverage')).json();
+  const res = await api('api/coverage');
+  if (!res.ok) return;  // the scene changed meanwhile: the next change asks again
+  const coverage = await res.json();
   $('coverage-summary').textContent = `${coverage.shots} shots: ` +
     `${(100 * coverage.reconstructable).toFixed(1)} % reconstructable, ` +
     `${(100 * coverage.seen_2).toFixed(1)} % seen twice; last shot new ${(100 * coverage.new).toFixed(1)} %, ` +
@@ -447,7 +449,9 @@ let adviceTimer = null;
 function scheduleAnalysis() {
   clearTimeout(adviceTimer);
   adviceTimer = setTimeout(async () => {
-    const advice = await (await api('api/advice')).json();
+    const res = await api('api/advice');
+    if (!res.ok) return;
+    const advice = await res.json();
     const list = $('advice');
     list.innerHTML = '';
     if (advice.length === 0) list.innerHTML = '<li class="ok">no warnings</li>';
@@ -463,8 +467,89 @@ function scheduleAnalysis() {
   }, 400);
 }
 
+// ---- the reference check: the view by POV-Ray or Cycles beside the preview's frame ----
+const reference = { timer: null, flicker: null };
+
+async function startReference() {
+  const body = { backend: $('reference-backend').value, width: Number($('reference-width').value) };
+  showReferenceStatus(`starting ${body.backend} ...`);
+  const res = await api('api/reference', { method: 'POST', body: JSON.stringify(body),
+    headers: { 'Content-Type': 'application/json' } });
+  if (!res.ok) { showReferenceStatus((await res.json()).error, true); return; }
+  $('reference-cancel').disabled = false;
+  $('reference-start').disabled = true;
+  clearInterval(reference.timer);
+  reference.timer = setInterval(pollReference, 500);
+}
+
+function showReferenceStatus(text, isError) {
+  const status = $('reference-status');
+  status.textContent = text;
+  status.className = isError ? 'error' : '';
+}
+
+async function pollReference() {
+  const res = await api('api/reference');
+  if (!res.ok) return;
+  const s = await res.json();
+  window.rigcReference = s;
+  if (s.state === 'running') {
+    const share = s.progress === null ? '' : ` ${(100 * s.progress).toFixed(0)} %,`;
+    showReferenceStatus(`rendering with ${s.backend}:${share} ${s.elapsed_s.toFixed(0)} s`);
+    return;
+  }
+  clearInterval(reference.timer);
+  $('reference-cancel').disabled = true;
+  $('reference-start').disabled = false;
+  if (s.state === 'done') {
+    showReferenceStatus(`${s.backend}, ${s.width} x ${s.height}, ${s.elapsed_s.toFixed(1)} s`);
+    const stamp = Date.now();
+    $('reference-preview').src = `api/reference/image?which=preview&token=${token}&t=${stamp}`;
+    $('reference-image').src = `api/reference/image?which=reference&token=${token}&t=${stamp}`;
+    $('reference-panel').hidden = false;
+  } else if (s.state === 'failed') {
+    showReferenceStatus(`${s.backend} failed: ${s.message} (log: ${s.log})`, true);
+  } else if (s.state === 'cancelled') {
+    showReferenceStatus(`${s.backend}: cancelled`);
+  }
+}
+
+// Side by side, or one place showing the preview and the reference in turn.
+function setFlicker(on) {
+  clearInterval(reference.flicker);
+  $('reference-panel').classList.toggle('flicker', on);
+  const images = [$('reference-preview'), $('reference-image')];
+  images.forEach((img) => { img.hidden = false; });
+  $('reference-shown').textContent = '';
+  if (!on) return;
+  let k = 0;
+  const show = () => {
+    images.forEach((img, i) => { img.hidden = i !== k; });
+    $('reference-shown').textContent = k === 0 ? 'preview' : 'reference';
+    k = 1 - k;
+  };
+  show();
+  reference.flicker = setInterval(show, 600);
+}
+
+function bindReference() {
+  $('reference-start').addEventListener('click', startReference);
+  $('reference-cancel').addEventListener('click', async () => {
+    await api('api/reference/cancel', { method: 'POST', body: '{}',
+      headers: { 'Content-Type': 'application/json' } });
+    pollReference();
+  });
+  $('reference-flicker').addEventListener('change', () => setFlicker($('reference-flicker').checked));
+  $('reference-close').addEventListener('click', () => {
+    setFlicker(false);
+    $('reference-flicker').checked = false;
+    $('reference-panel').hidden = true;
+  });
+}
+
 async function start() {
   bindPanels();
+  bindReference();
   bindMovement();
   await refreshState();
   requestFrame(FULL_WIDTH);
