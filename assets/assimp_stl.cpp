@@ -150,18 +150,18 @@ void mend_binary_count(StlFile* stl, std::uint32_t claimed) {
   std::vector<unsigned char>& bytes = stl->bytes;
   const std::size_t body = bytes.size() - kBinaryHeaderBytes;
   const std::size_t expected = std::size_t{claimed} * kBinaryTriangleBytes;
-  if (body > expected) {
-    bytes.resize(kBinaryHeaderBytes + expected);
-    stl->warnings.push_back(
-        fmt::format("binary STL: ignored {} bytes after the {} triangles its header claims",
-                    body - expected, claimed));
-  } else if (body % kBinaryTriangleBytes == 0) {
+  if (body % kBinaryTriangleBytes == 0) {
     const auto held = static_cast<std::uint32_t>(body / kBinaryTriangleBytes);
     for (int k = 0; k < 4; ++k) bytes[80 + k] = static_cast<unsigned char>(held >> (8 * k));
     stl->warnings.push_back(fmt::format(
         "binary STL: the header claims {} triangles but the file holds {}; read {} (the file "
         "may be cut short)",
         claimed, held, held));
+  } else if (body > expected) {
+    bytes.resize(kBinaryHeaderBytes + expected);
+    stl->warnings.push_back(
+        fmt::format("binary STL: ignored {} bytes after the {} triangles its header claims",
+                    body - expected, claimed));
   } else {
     fail("is truncated: its header claims {} triangles ({} bytes) but the file has {} bytes",
          claimed, kBinaryHeaderBytes + expected, bytes.size());
