@@ -11,6 +11,7 @@
 #include "compiler/limits.h"
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
+#include "dslr/sensor.h"
 
 namespace rigc::analysis {
 namespace {
@@ -101,7 +102,7 @@ SeenSurface seen_surface(const CoverageResult& coverage) {
 
 // Depth of field, and diffraction where the depth of field does not need the aperture.
 void advise_aperture(const ir::Scene& scene, const CoverageResult& coverage,
-                     const SeenSurface& seen, DiagnosticEngine& diag) {
+                     const SeenSurface& seen, std::vector<Advice>& out) {
   const ir::Camera& camera = scene.camera;
   const double max_blur_px = scene.coverage.max_blur_px;
   const SourceLoc& aperture_loc = first_known(camera.aperture_loc, camera.loc);
@@ -110,75 +111,176 @@ void advise_aperture(const ir::Scene& scene, const CoverageResult& coverage,
   // The blur scales as 1/N, so the aperture that keeps 95 % sharp follows.
   const double needed_n = n * coverage.blur_ratio_95;
   if (seen.out_of_focus / seen.visible > kWarnShare) {
-    diag.warning(aperture_loc,
-                 fmt::format("depth of field at f/{:g} is shallower than the object: {:.0f}% of "
-                             "the seen surface is blurred beyond {:.1f} px; f/{:g} would keep 95% "
-                             "sharp (or focus nearer the object's front)",
-                             n, 100 * seen.out_of_focus / seen.visible, max_blur_px,
-                             next_standard_f_number(needed_n)));
+    out.push_back({aperture_loc,
+                   fmt::format("depth of field at f/{:g} is shallower than the object: {:.0f}% of "
+                               "the seen surface is blurred beyond {:.1f} px; f/{:g} would keep "
+                               "95% sharp (or focus nearer the object's front)",
+                               n, 100 * seen.out_of_focus / seen.visible, max_blur_px,
+                               next_standard_f_number(needed_n)),
+                   {{Setting::kFNumber, +1}}});
   }
   // An Airy disc wider than the blur budget.
   const double airy_px = 2.44 * kWavelengthM * n / pixel_pitch_m;
   if (airy_px > max_blur_px && n > next_standard_f_number(needed_n) * 1.01) {
     const double limit_n = max_blur_px * pixel_pitch_m / (2.44 * kWavelengthM);
-    diag.warning(
-        aperture_loc,
-        fmt::format("f/{:g} is diffraction-limited on this sensor ({:.1f} µm pixels): the "
-                    "Airy disc is {:.1f} px; the depth of field only needs f/{:g}, and "
-                    "f/{:.1f} or wider keeps diffraction under {:.1f} px",
-                    n, pixel_pitch_m * 1e6, airy_px,
-                    next_standard_f_number(std::max(needed_n, limits::camera::kAperture.min)),
-                    limit_n, max_blur_px));
+    out.push_back(
+        {aperture_loc,
+         fmt::format("f/{:g} is diffraction-limited on this sensor ({:.1f} µm pixels): the "
+                     "Airy disc is {:.1f} px; the depth of field only needs f/{:g}, and "
+                     "f/{:.1f} or wider keeps diffraction under {:.1f} px",
+                     n, pixel_pitch_m * 1e6, airy_px,
+                     next_standard_f_number(std::max(needed_n, limits::camera::kAperture.min)),
+                     limit_n, max_blur_px),
+         {{Setting::kFNumber, -1}}});
   }
 }
 
-// Clipped or too dark surface, with how many stops of light would fix it.
-void advise_exposure(const ir::Scene& scene, const SeenSurface& seen, DiagnosticEngine& diag) {
+// Whether an advice already given suggests `change`.
+bool suggested(const std::vector<Advice>& given, SettingChange change) {
+  return std::any_of(given.begin(), given.end(), [&](const Advice& a) {
+    return std::find(a.changes.begin(), a.changes.end(), change) != a.changes.end();
+  });
+}
+
+// The settings that would give `direction` (+1 more, -1 less) light, leaving out those another
+// advice in `given` moves the other way (a shorter shutter against motion blur, a larger
+// f-number for depth of field, a smaller one against diffraction). Aperture is left out of more
+// light: opening it shortens the depth of field the coverage was judged with.
+std::vector<SettingChange> light_changes(int direction, const std::vector<Advice>& given) {
+  std::vector<SettingChange> changes;
+  const SettingChange shutter{Setting::kShutter, direction};
+  if (!suggested(given, {Setting::kShutter, -direction})) changes.push_back(shutter);
+  if (direction < 0 && !suggested(given, {Setting::kFNumber, -1})) {
+    changes.push_back({Setting::kFNumber, +1});
+  }
+  changes.push_back({Setting::kIso, direction});
+  changes.push_back({Setting::kLight, direction});
+  return changes;
+}
+
+bool offers(const std::vector<SettingChange>& changes, Setting setting) {
+  return std::any_of(changes.begin(), changes.end(),
+                     [&](const SettingChange& c) { return c.setting == setting; });
+}
+
+// The share of the seen surface that clips is more than kWarnShare.
+void advise_over_exposure(const ir::Scene& scene, const SeenSurface& seen,
+                          const std::vector<Advice>& given, std::vector<Advice>& out) {
   const ir::Camera& camera = scene.camera;
-  const ir::CoverageSettings& settings = scene.coverage;
-  const SourceLoc& shutter_loc = first_known(camera.shutter_loc, camera.loc);
-  if (seen.clipped / seen.visible > kWarnShare) {
-    const double stops = std::max(1.0 / 3, stops_to_unclip(seen.signal_histogram, seen.visible));
-    const double shutter = camera.shutter_s * std::exp2(-stops);
-    diag.warning(shutter_loc,
+  const double stops = std::max(1.0 / 3, stops_to_unclip(seen.signal_histogram, seen.visible));
+  const double shutter = camera.shutter_s * std::exp2(-stops);
+  std::vector<SettingChange> changes = light_changes(-1, given);
+  const bool stop_down = offers(changes, Setting::kFNumber);
+  std::string remedy;
+  if (shutter >= limits::camera::kShutter.min) {
+    remedy = fmt::format("a shutter of {} ({}a lower ISO)", shutter_text(shutter),
+                         stop_down ? "or stop down, or " : "or ");
+  } else {
+    changes.erase(changes.begin());  // no shutter is short enough
+    remedy = stop_down ? "stop down, lower the ISO or dim the lights"
+                       : "lower the ISO or dim the lights";
+  }
+  out.push_back({first_known(camera.shutter_loc, camera.loc),
                  fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
                              "(EV100 {:.1f}); {} less light: {}",
                              100 * seen.clipped / seen.visible,
                              dslr::ev100(camera.aperture_f_number, camera.shutter_s, camera.iso),
-                             stops_text(stops),
-                             shutter >= limits::camera::kShutter.min
-                                 ? fmt::format("a shutter of {} (or stop down, or a lower ISO)",
-                                               shutter_text(shutter))
-                                 : "stop down, lower the ISO or dim the lights"));
+                             stops_text(stops), remedy),
+                 std::move(changes)});
+}
+
+// The share of the seen surface below min_signal is more than kWarnShare.
+void advise_under_exposure(const ir::Scene& scene, const SeenSurface& seen,
+                           const std::vector<Advice>& given, std::vector<Advice>& out) {
+  const ir::Camera& camera = scene.camera;
+  const ir::CoverageSettings& settings = scene.coverage;
+  const double dark_stops = std::log2(settings.min_signal / settings.max_signal);
+  const double stops =
+      std::max(1.0 / 3, stops_to_undarken(seen.signal_histogram, seen.visible, dark_stops));
+  std::vector<SettingChange> changes = light_changes(+1, given);
+  const std::string remedy = offers(changes, Setting::kShutter)
+                                 ? "lengthen the shutter, raise the ISO or add light"
+                                 : "raise the ISO or add light (a longer shutter would smear)";
+  out.push_back({first_known(camera.shutter_loc, camera.loc),
+                 fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
+                             "full scale, where sensor noise hides texture; {} more light: {}",
+                             100 * seen.dark / seen.visible, 100 * settings.min_signal,
+                             stops_text(stops), remedy),
+                 std::move(changes)});
+}
+
+// The signal, in stops from the clipping level, below which `share` of the seen area lies.
+double signal_percentile_stops(const std::vector<double>& histogram, double visible, double share) {
+  double below = 0;
+  for (int b = 0; b < ShotCoverage::kSignalBins; ++b) {
+    below += histogram[b];
+    if (below >= share * visible) {
+      return ShotCoverage::kSignalLowestStops + (b + 0.5) * ShotCoverage::kSignalBinStops;
+    }
   }
-  if (seen.dark / seen.visible > kWarnShare) {
-    const double dark_stops = std::log2(settings.min_signal / settings.max_signal);
-    const double stops =
-        std::max(1.0 / 3, stops_to_undarken(seen.signal_histogram, seen.visible, dark_stops));
-    diag.warning(
-        shutter_loc,
-        fmt::format("under-exposure: {:.0f}% of the seen surface is below {:.0f}% of "
-                    "full scale, where sensor noise hides texture; {} more light: "
-                    "lengthen the shutter, raise the ISO or add light",
-                    100 * seen.dark / seen.visible, 100 * settings.min_signal, stops_text(stops)));
+  return ShotCoverage::kSignalLowestStops +
+         ShotCoverage::kSignalBins * ShotCoverage::kSignalBinStops;
+}
+
+// Both clipped and dark surface: the scene's brightness range is wider than the window between
+// too dark and clipping, so less light for the one is more darkness for the other. Light
+// (fill or ambient) narrows the range; bracketing records it in two exposures.
+void advise_brightness_range(const ir::Scene& scene, const SeenSurface& seen,
+                             std::vector<Advice>& out) {
+  const ir::Camera& camera = scene.camera;
+  const ir::CoverageSettings& settings = scene.coverage;
+  const double dark = signal_percentile_stops(seen.signal_histogram, seen.visible, kWarnShare);
+  const double bright =
+      signal_percentile_stops(seen.signal_histogram, seen.visible, 1 - kWarnShare);
+  const double window = std::log2(settings.max_signal / settings.min_signal);
+  const double sensor = std::log2(dslr::electrons_at_clipping(camera.noise, camera.iso) /
+                                  dslr::read_noise_electrons(camera.noise, camera.iso));
+  out.push_back(
+      {first_known(camera.shutter_loc, camera.loc),
+       fmt::format("the scene's brightness range is wider than the sensor records: the seen "
+                   "surface spans {:.1f} stops from its darkest to its brightest {:.0f}%, but "
+                   "only the {:.1f} stops from {:.0f}% to {:.0f}% of full scale are usable (the "
+                   "sensor's dynamic range at ISO {:g} is {:.1f} stops); {:.0f}% clips and "
+                   "{:.0f}% is too dark, and no exposure fixes both: add fill light on the "
+                   "shadow side or raise the studio's ambient light, or bracket the exposures",
+                   bright - dark, 100 * kWarnShare, window, 100 * settings.min_signal,
+                   100 * settings.max_signal, camera.iso, sensor, 100 * seen.clipped / seen.visible,
+                   100 * seen.dark / seen.visible),
+       {{Setting::kLight, +1}}});
+}
+
+// Clipped or too dark surface, with how many stops of light would fix it; both at once are a
+// brightness range no exposure fits. `given`: the advice that pins settings (motion blur,
+// aperture), which the exposure remedies must not reverse.
+void advise_exposure(const ir::Scene& scene, const SeenSurface& seen,
+                     const std::vector<Advice>& given, std::vector<Advice>& out) {
+  const bool clipped = seen.clipped / seen.visible > kWarnShare;
+  const bool dark = seen.dark / seen.visible > kWarnShare;
+  if (clipped && dark) {
+    advise_brightness_range(scene, seen, out);
+  } else if (clipped) {
+    advise_over_exposure(scene, seen, given, out);
+  } else if (dark) {
+    advise_under_exposure(scene, seen, given, out);
   }
 }
 
 // A distortion that draws the frame's edge from beyond the canvas the renderers make (at most
 // twice the sensor's extent): the pixels there repeat the canvas's border, a smear that is not
 // the scene, and nothing else would tell.
-void advise_distortion(const ir::Camera& camera, DiagnosticEngine& diag) {
+void advise_distortion(const ir::Camera& camera, std::vector<Advice>& out) {
   if (camera.effects.distortion && dslr::render_geometry_for(camera, 1.0).clipped) {
-    diag.warning(first_known(camera.distortion_loc, camera.loc),
-                 "the distortion draws part of the frame from beyond the canvas the renderers "
-                 "make (at most twice the sensor's extent): pixels there repeat the canvas's "
-                 "border instead of the scene; make the coefficients smaller");
+    out.push_back({first_known(camera.distortion_loc, camera.loc),
+                   "the distortion draws part of the frame from beyond the canvas the renderers "
+                   "make (at most twice the sensor's extent): pixels there repeat the canvas's "
+                   "border instead of the scene; make the coefficients smaller",
+                   {}});
   }
 }
 
 // Motion blur from a turning table, per shot group (reported once per source line).
 void advise_motion_blur(const ir::Scene& scene, const scene::StudioScene& studio,
-                        const CoverageResult& coverage, DiagnosticEngine& diag) {
+                        const CoverageResult& coverage, std::vector<Advice>& out) {
   const ir::Camera& camera = scene.camera;
   int last_line = -1;
   for (const auto& shot : scene.shots) {
@@ -192,21 +294,25 @@ void advise_motion_blur(const ir::Scene& scene, const scene::StudioScene& studio
     // A shutter that keeps the smear under a pixel, if the language has one.
     const double fastest_denominator = 1 / limits::camera::kShutter.min;
     const double needed_denominator = std::ceil(blur_px / camera.shutter_s);
+    const bool shutter_helps = needed_denominator <= fastest_denominator;
     const std::string remedy =
-        needed_denominator <= fastest_denominator
-            ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
-                          needed_denominator)
-            : std::string("stop the table for each shot (no shutter is fast enough)");
-    diag.warning(shot.loc, fmt::format("the turning table smears the object by up to {:.1f} "
-                                       "px during the {:g} s exposure; {}",
-                                       blur_px, camera.shutter_s, remedy));
+        shutter_helps ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
+                                    needed_denominator)
+                      : std::string("stop the table for each shot (no shutter is fast enough)");
+    std::vector<SettingChange> changes;
+    if (shutter_helps) changes.push_back({Setting::kShutter, -1});
+    out.push_back({shot.loc,
+                   fmt::format("the turning table smears the object by up to {:.1f} px during "
+                               "the {:g} s exposure; {}",
+                               blur_px, camera.shutter_s, remedy),
+                   std::move(changes)});
   }
 }
 
 // Faces never seen (the base resting on the table cannot be, so it does not count), with the
 // shots that would see them.
 void advise_unseen_faces(const ir::Scene& scene, const scene::StudioScene& studio,
-                         const CoverageResult& coverage, DiagnosticEngine& diag) {
+                         const CoverageResult& coverage, std::vector<Advice>& out) {
   double unseen = 0, resting = 0;
   Eigen::Vector3d unseen_normal = Eigen::Vector3d::Zero();
   const auto& mesh = studio.object;
@@ -235,33 +341,36 @@ void advise_unseen_faces(const ir::Scene& scene, const scene::StudioScene& studi
           "add a ring from below (elevation -30deg) or turn the "
           "object over for a second pass";
   }
-  diag.warning(scene.shots.front().loc,
-               fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",
-                           100 * unseen / visible_total, fix));
+  out.push_back({scene.shots.front().loc,
+                 fmt::format("{:.0f}% of the object's surface is never seen by any shot; {}",
+                             100 * unseen / visible_total, fix),
+                 {}});
 }
 
 // Overlap between consecutive shots, and the object's size in the frame (the first shot short
 // of each).
 void advise_overlap_and_framing(const ir::Scene& scene, const CoverageResult& coverage,
-                                DiagnosticEngine& diag) {
+                                std::vector<Advice>& out) {
   const ir::CoverageSettings& settings = scene.coverage;
   for (size_t i = 1; i < coverage.shots.size(); ++i) {
     const ShotCoverage& shot = coverage.shots[i];
     if (shot.visible_area_m2 > 0 && shot.overlap_with_previous < settings.min_overlap) {
-      diag.warning(scene.shots[i].loc,
-                   fmt::format("{} overlaps the previous shot by only {:.0f}% of its seen "
-                               "surface (SfM wants {:.0f}% or more); take smaller steps",
-                               scene.shots[i].name, 100 * shot.overlap_with_previous,
-                               100 * settings.min_overlap));
+      out.push_back({scene.shots[i].loc,
+                     fmt::format("{} overlaps the previous shot by only {:.0f}% of its seen "
+                                 "surface (SfM wants {:.0f}% or more); take smaller steps",
+                                 scene.shots[i].name, 100 * shot.overlap_with_previous,
+                                 100 * settings.min_overlap),
+                     {}});
       break;
     }
   }
   for (const auto& shot : coverage.shots) {
     if (shot.frame_fill < settings.min_frame_fill) {
-      diag.warning(scene.shots[shot.shot].loc,
-                   fmt::format("the object fills only {:.1f}% of {}'s frame; move the camera "
-                               "closer or use a longer lens",
-                               100 * shot.frame_fill, scene.shots[shot.shot].name));
+      out.push_back({scene.shots[shot.shot].loc,
+                     fmt::format("the object fills only {:.1f}% of {}'s frame; move the camera "
+                                 "closer or use a longer lens",
+                                 100 * shot.frame_fill, scene.shots[shot.shot].name),
+                     {}});
       break;
     }
   }
@@ -276,15 +385,29 @@ double next_standard_f_number(double f_number) {
   return limits::camera::kAperture.max;
 }
 
+std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
+                                   const CoverageResult& coverage) {
+  const SeenSurface seen = seen_surface(coverage);
+  // Aperture and motion blur pin settings the exposure remedies then leave alone.
+  std::vector<Advice> aperture, motion_blur, pinned;
+  advise_aperture(scene, coverage, seen, aperture);
+  advise_motion_blur(scene, studio, coverage, motion_blur);
+  pinned = aperture;
+  pinned.insert(pinned.end(), motion_blur.begin(), motion_blur.end());
+  std::vector<Advice> out = std::move(aperture);
+  advise_exposure(scene, seen, pinned, out);
+  advise_distortion(scene.camera, out);
+  out.insert(out.end(), motion_blur.begin(), motion_blur.end());
+  advise_unseen_faces(scene, studio, coverage, out);
+  advise_overlap_and_framing(scene, coverage, out);
+  return out;
+}
+
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag) {
-  const SeenSurface seen = seen_surface(coverage);
-  advise_aperture(scene, coverage, seen, diag);
-  advise_exposure(scene, seen, diag);
-  advise_distortion(scene.camera, diag);
-  advise_motion_blur(scene, studio, coverage, diag);
-  advise_unseen_faces(scene, studio, coverage, diag);
-  advise_overlap_and_framing(scene, coverage, diag);
+  for (const Advice& advice : capture_advice(scene, studio, coverage)) {
+    diag.warning(advice.loc, advice.message);
+  }
 }
 
 }  // namespace rigc::analysis

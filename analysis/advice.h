@@ -1,15 +1,42 @@
 // Capture advice: compiler-style warnings at the scene line responsible, each with a fix.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "analysis/coverage.h"
 #include "compiler/diagnostics.h"
 #include "ir/ir.h"
+#include "ir/source_location.h"
 #include "scene/studio_scene.h"
 
 namespace rigc::analysis {
 
-// Warns about depth of field, motion blur, exposure, diffraction, unseen faces, overlap between
-// consecutive shots and an object too small in the frame.
+// A camera or studio setting an advice suggests changing.
+enum class Setting { kShutter, kFNumber, kIso, kLight };
+
+// One suggested change: the setting's value up (+1: a longer shutter, a larger f-number, a
+// higher ISO, more light) or down (-1). An advice that offers alternatives lists each.
+struct SettingChange {
+  Setting setting;
+  int direction;
+  bool operator==(const SettingChange&) const = default;
+};
+
+// One warning: where, what it says, and the changes it suggests. No advice for a scene suggests
+// a change another one reverses (capture_advice holds to it).
+struct Advice {
+  SourceLoc loc;
+  std::string message;
+  std::vector<SettingChange> changes;
+};
+
+// Depth of field, motion blur, exposure (or a brightness range no exposure fits), diffraction,
+// unseen faces, overlap between consecutive shots and an object too small in the frame.
+std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
+                                   const CoverageResult& coverage);
+
+// capture_advice as warnings.
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag);
 

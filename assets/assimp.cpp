@@ -298,46 +298,82 @@ class AssimpLoader {
   std::map<std::string, int> textures_;
 };
 
-// The material libraries an OBJ names (`mtllib a.mtl b.mtl`) that are not beside it: Assimp
-// loads the mesh without them and says nothing, so its colours and textures would be lost
-// silently.
-std::vector<std::string> missing_material_libraries(const std::string& path) {
-  std::vector<std::string> warnings;
+// The material libraries an OBJ names (`mtllib a.mtl b.mtl`), relative to its folder.
+std::vector<std::string> material_libraries(const std::string& path) {
+  std::vector<std::string> names;
   std::ifstream in(path, std::ios::binary);
   std::string line;
   while (std::getline(in, line)) {
     const std::size_t start = line.find_first_not_of(" \t");
     if (start == std::string::npos || line.compare(start, 7, "mtllib ") != 0) continue;
-    std::istringstream names(line.substr(start + 7));
+    std::istringstream words(line.substr(start + 7));
     std::string name;
-    while (names >> name) {
-      std::error_code ec;
-      if (!fs::exists(fs::path(path).parent_path() / name, ec)) {
-        warnings.push_back(fmt::format(
-            "material library '{}' is not beside the mesh: its colours and textures are not used",
-            one_line(name)));
-      }
+    while (words >> name) names.push_back(name);
+  }
+  return names;
+}
+
+// A material library that is there but not a file (a folder, a device) fails: Assimp says only
+// "File read error". One that is missing is a warning: Assimp loads the mesh without it and says
+// nothing, so its colours and textures would be lost silently.
+std::vector<std::string> check_material_libraries(const std::string& path) {
+  std::vector<std::string> warnings;
+  for (const std::string& name : material_libraries(path)) {
+    const fs::path file = fs::path(path).parent_path() / name;
+    std::error_code ec;
+    const fs::file_status status = fs::status(file, ec);
+    if (status.type() == fs::file_type::not_found || (ec && !fs::exists(status))) {
+      warnings.push_back(fmt::format(
+          "material library '{}' is not beside the mesh: its colours and textures are not used",
+          one_line(name)));
+    } else if (fs::is_directory(status)) {
+      fail("material library '{}' (mtllib) is a folder, not a file", one_line(name));
+    } else if (!fs::is_regular_file(status)) {
+      fail("material library '{}' (mtllib) is not a regular file", one_line(name));
     }
   }
   return warnings;
 }
 
+// Assimp's message in the user's terms: its validation of its own data structure speaks of
+// aiScene fields, and its STL reader of "storage representation".
+std::string assimp_message(const std::string& raw) {
+  const std::string message = one_line(raw);
+  auto has = [&](const char* text) { return message.find(text) != std::string::npos; };
+  if (message.empty()) return "could not be read (the importer gave no reason)";
+  if (has("mNumMeshes is 0") || has("contains no vertices") || has("contains no faces")) {
+    return "contains no triangles (no faces, or faces without vertices)";
+  }
+  if (has("is too small")) return "is too small to hold a mesh";
+  if (has("Failed to determine STL storage representation")) {
+    return "is neither a binary STL (its size disagrees with its triangle count) nor an ASCII "
+           "STL (starting with 'solid')";
+  }
+  const std::string prefix = "Validation failed: ";
+  if (message.rfind(prefix, 0) == 0) return "is malformed: " + message.substr(prefix.size());
+  return "could not be read: " + message;
+}
+
 }  // namespace
 
 LoadedModel load_with_assimp(const std::string& path, const std::string& ext) {
+  LoadedModel out;
   Assimp::Importer importer;
   // No JoinIdenticalVertices (slow): AssimpLoader welds vertices itself.
   const unsigned flags =
       aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-  const aiScene* scene = importer.ReadFile(path, flags);
-  if (!scene) {
-    const std::string message = one_line(importer.GetErrorString());
-    fail("could not be read: {}", message.empty() ? "unknown error" : message);
+  const aiScene* scene = nullptr;
+  if (ext == ".stl") {
+    StlFile stl = check_stl(path);
+    out.warnings = std::move(stl.warnings);
+    scene = importer.ReadFileFromMemory(stl.bytes.data(), stl.bytes.size(), flags, "stl");
+  } else {
+    out.warnings = check_material_libraries(path);
+    scene = importer.ReadFile(path, flags);
   }
+  if (!scene) fail("{}", assimp_message(importer.GetErrorString()));
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) fail("is incomplete (no meshes were read)");
-  LoadedModel out;
   AssimpLoader(path, *scene, /*use_file_normals=*/ext != ".stl", &out).run();
-  if (ext == ".obj") out.warnings = missing_material_libraries(path);
   return out;
 }
 

@@ -72,6 +72,11 @@ class MeshBuilder {
 
   void reserve_triangles(std::size_t n);
 
+  // Gives every vertex a colour (white until set); finish() then sets each material's base
+  // colour to the area-weighted mean of its triangles' vertex colours.
+  void add_colors();
+  Eigen::Vector3f& color(std::uint32_t i) { return model_->vertex_colors[i]; }
+
   void add_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::int32_t material,
                     bool flip) {
     ir::Mesh& m = model_->mesh;
@@ -92,16 +97,30 @@ class MeshBuilder {
   }
   void set_has_uvs() { has_uvs_ = true; }
 
-  // Checks the result, computes the normals the file did not give (area-weighted) and normalises.
+  // Checks the result, turns a closed mesh wound inside out the right way (with a warning),
+  // computes the normals the file did not give (area-weighted) and normalises.
   void finish();
 
  private:
   void compute_missing_normals();
+  void orient_outward();
+  void set_base_colors_from_vertices();
 
   LoadedModel* model_;
   std::vector<std::uint8_t> needs_normal_;
   bool has_uvs_ = false;
 };
+
+// An STL file's bytes as Assimp should read them, and what was mended on the way.
+struct StlFile {
+  std::vector<unsigned char> bytes;
+  std::vector<std::string> warnings;
+};
+
+// Reads an STL and checks what Assimp does not: an ASCII STL must be whole (no facet cut short,
+// an `endsolid` at the end); a binary STL's header count must match its size (when the body is
+// whole triangles the count is mended, with a warning). Throws LoadError otherwise.
+StlFile check_stl(const std::string& path);
 
 // The format readers. Each throws LoadError on a malformed or unsupported file.
 LoadedModel load_gltf(const std::string& path, bool binary);  // .gltf, or .glb when `binary`

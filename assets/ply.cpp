@@ -1,5 +1,6 @@
 // PLY, read natively: ASCII and binary (either byte order), any element order, lists anywhere,
-// polygons split into fans, and a texture named by a "comment TextureFile" header line.
+// polygons split into fans, triangle strips (`tristrips`, -1 restarting a strip), per-vertex
+// colours, and a texture named by a "comment TextureFile" header line.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -284,40 +285,71 @@ void check_element_counts(const PlyHeader& header, const char* end) {
 // ---------------------------------------------------------------------------------------------
 // The body.
 
-// Vertex property slots: x y z nx ny nz u v.
+// Vertex property slots: x y z nx ny nz u v r g b.
+constexpr int kSlots = 11;
 struct VertexSlots {
   std::vector<int> slot;  // per property: its slot, or -1 if unused
   bool has_normals = false;
   bool has_uvs = false;
+  bool has_colors = false;
+  double color_scale = 1;  // to 0..1: 1/255 for uchar colours, 1 for float ones
 };
 
+// What a colour of `type` is divided by to reach 0..1.
+double color_full_scale(PlyType type) {
+  switch (type) {
+    case PlyType::kUint8:
+    case PlyType::kInt8:
+      return 255;
+    case PlyType::kUint16:
+    case PlyType::kInt16:
+      return 65535;
+    case PlyType::kUint32:
+    case PlyType::kInt32:
+      return 4294967295.0;
+    case PlyType::kFloat32:
+    case PlyType::kFloat64:
+      return 1;
+  }
+  return 1;
+}
+
 VertexSlots vertex_slots(const PlyElement& e) {
-  static const std::vector<std::vector<std::string>> kNames = {
-      {"x"},
-      {"y"},
-      {"z"},
-      {"nx"},
-      {"ny"},
-      {"nz"},
-      {"s", "u", "texture_u", "texture_s"},
-      {"t", "v", "texture_v", "texture_t"}};
+  static const std::vector<std::vector<std::string>> kNames = {{"x"},
+                                                               {"y"},
+                                                               {"z"},
+                                                               {"nx"},
+                                                               {"ny"},
+                                                               {"nz"},
+                                                               {"s", "u", "texture_u", "texture_s"},
+                                                               {"t", "v", "texture_v", "texture_t"},
+                                                               {"red", "diffuse_red", "r"},
+                                                               {"green", "diffuse_green", "g"},
+                                                               {"blue", "diffuse_blue", "b"}};
   VertexSlots slots;
   slots.slot.assign(e.properties.size(), -1);
-  std::array<bool, 8> found{};
+  std::array<bool, kSlots> found{};
   for (std::size_t k = 0; k < e.properties.size(); ++k) {
     if (e.properties[k].is_list) continue;
-    for (int s = 0; s < 8; ++s) {
+    for (int s = 0; s < kSlots; ++s) {
       const auto& names = kNames[s];
       if (!found[s] && std::find(names.begin(), names.end(), e.properties[k].name) != names.end()) {
         slots.slot[k] = s;
         found[s] = true;
+        if (s == 8) slots.color_scale = 1 / color_full_scale(e.properties[k].type);
       }
     }
   }
   if (!found[0] || !found[1] || !found[2]) fail("vertex element has no x, y, z properties");
   slots.has_normals = found[3] && found[4] && found[5];
   slots.has_uvs = found[6] && found[7];
+  slots.has_colors = found[8] && found[9] && found[10];
   return slots;
+}
+
+// The sRGB transfer function undone: an 8-bit scanner colour to linear RGB.
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
 // Reads the elements into a LoadedModel with one material: vertices, faces, and skips the rest.
@@ -336,6 +368,8 @@ class PlyReader {
         read_vertices(e);
       } else if (e.name == "face") {
         read_faces(e);
+      } else if (e.name == "tristrips") {
+        read_strips(e);
       } else {
         skip_element(e);
       }
@@ -353,12 +387,14 @@ class PlyReader {
     const VertexSlots slots = vertex_slots(e);
     has_normals_ = slots.has_normals;
     has_uvs_ = slots.has_uvs;
+    color_scale_ = slots.has_colors ? slots.color_scale : 0;
     vertex_count_ = e.count;
     if (vertex_count_ > kMaxVertices) fail("has too many vertices ({})", vertex_count_);
     builder_.add_vertices(vertex_count_);
-    double values[8];
+    if (color_scale_ > 0) builder_.add_colors();
+    double values[kSlots];
     for (std::size_t i = 0; i < e.count; ++i) {
-      std::fill(values, values + 8, 0.0);
+      std::fill(values, values + kSlots, 0.0);
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         const PlyProperty& prop = e.properties[k];
         if (prop.is_list) {
@@ -372,7 +408,7 @@ class PlyReader {
     }
   }
 
-  // Sets vertex i from its slot values (x y z nx ny nz u v).
+  // Sets vertex i from its slot values (x y z nx ny nz u v r g b).
   void set_vertex(std::size_t i, const double* values) {
     const auto index = static_cast<std::uint32_t>(i);
     const Vector3f pos(static_cast<float>(values[0]), static_cast<float>(values[1]),
@@ -396,6 +432,16 @@ class PlyReader {
       // PLY's t = 0 is the image bottom; RigC's v = 0 is the image top.
       const Vector2f uv(static_cast<float>(values[6]), 1.0f - static_cast<float>(values[7]));
       if (uv.allFinite()) builder_.uv(index) = uv;
+    }
+    if (color_scale_ > 0) {
+      // Scanners write sRGB-encoded colours; the IR's are linear.
+      Vector3f color;
+      for (int c = 0; c < 3; ++c) {
+        const double v = values[8 + c] * color_scale_;
+        color[c] =
+            srgb_to_linear(std::isfinite(v) ? static_cast<float>(std::clamp(v, 0.0, 1.0)) : 0.0f);
+      }
+      builder_.color(index) = color;
     }
   }
 
@@ -447,6 +493,52 @@ class PlyReader {
     }
   }
 
+  // Triangle strips: one list of indices per strip, -1 starting a new strip. Every third index
+  // after the first two makes a triangle, the winding alternating along the strip; triangles
+  // with a repeated corner (used to join strips) are dropped.
+  void read_strips(const PlyElement& e) {
+    if (!seen_vertices_) fail("tristrips element comes before the vertex element");
+    for (std::size_t f = 0; f < e.count; ++f) {
+      for (const PlyProperty& prop : e.properties) {
+        if (!prop.is_list) {
+          cursor_.read(prop.type);
+          continue;
+        }
+        const double n = cursor_.read(prop.count_type);
+        if (n < 0 || n > static_cast<double>(cursor_.remaining())) {
+          fail("strip {} has a bad index count {}", f, n);
+        }
+        if (prop.name != "vertex_indices" && prop.name != "vertex_index") {
+          for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) cursor_.read(prop.type);
+          continue;
+        }
+        add_strips(f, prop, static_cast<std::size_t>(n));
+      }
+    }
+  }
+
+  void add_strips(std::size_t f, const PlyProperty& prop, std::size_t count) {
+    polygon_.clear();  // the current strip
+    for (std::size_t j = 0; j < count; ++j) {
+      const double v = cursor_.read(prop.type);
+      if (v == -1) {
+        polygon_.clear();
+        continue;
+      }
+      if (!(v >= 0 && v < static_cast<double>(vertex_count_))) {
+        fail("strip {} index {} is out of range ({} vertices)", f, v, vertex_count_);
+      }
+      polygon_.push_back(static_cast<std::uint32_t>(v));
+      const std::size_t k = polygon_.size();
+      if (k < 3) continue;
+      std::uint32_t a = polygon_[k - 3], b = polygon_[k - 2];
+      const std::uint32_t c = polygon_[k - 1];
+      if (a == b || b == c || a == c) continue;
+      if (k % 2 == 0) std::swap(a, b);  // every other triangle of a strip is wound backwards
+      builder_.add_triangle(a, b, c, 0, false);
+    }
+  }
+
   void skip_element(const PlyElement& e) {
     for (std::size_t i = 0; i < e.count; ++i) {
       for (const PlyProperty& prop : e.properties) {
@@ -470,6 +562,7 @@ class PlyReader {
   std::size_t vertex_count_ = 0;
   bool seen_vertices_ = false;
   bool has_normals_ = false, has_uvs_ = false, normals_ok_ = true;
+  double color_scale_ = 0;  // 0: the vertices have no colours
   std::vector<std::uint32_t> polygon_;
 };
 

@@ -1,0 +1,147 @@
+#include "analysis/advice.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "compiler/frontend.h"
+
+namespace rigc::analysis {
+namespace {
+
+struct Advised {
+  std::vector<Advice> advice;
+  std::string text;  // every message, one a line
+};
+
+Advised advise(const std::string& scene_text) {
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  const auto scene = compile_scene_text(scene_text, "test.yaml", ".", diag);
+  EXPECT_TRUE(scene) << messages;
+  if (!scene) return {};
+  const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
+  CoverageOptions options;
+  options.visibility_scale = 0.1;
+  const CoverageResult coverage = analyse_coverage(*scene, studio, options);
+  Advised out;
+  out.advice = capture_advice(*scene, studio, coverage);
+  for (const Advice& a : out.advice) out.text += a.message + "\n";
+  return out;
+}
+
+// A statue lit by one area light from the front left, with some ambient light, on a turning
+// or stopped table.
+struct Lighting {
+  double power_w;
+  double ambient_lx;
+  std::string shutter;
+  std::string aperture = "f/8";
+  std::string speed;  // turntable speed during the exposure; empty: stopped
+};
+
+std::string scene_text(const Lighting& l) {
+  const std::string speed = l.speed.empty() ? "" : ", speed: " + l.speed;
+  return fmt::format(R"(rigc: 1
+object:
+  primitive: {{shape: statue, detail: 3}}
+  fit: {{height: 30cm}}
+  surface: {{pattern: speckle, scale: 3mm}}
+studio:
+  turntable: {{diameter: 40cm, height: 75cm}}
+  lights:
+    - {{type: area, position: [0.8m, -0.8m, 1.2m], size: [30cm, 30cm], power: {}W}}
+  ambient: {}lx
+camera:
+  body: canon-6d
+  lens: {{focal_length: 50mm}}
+  exposure: {{aperture: {}, shutter: {}, iso: 200}}
+shots:
+  - turntable: {{steps: 8, step: 45deg{}, camera: {{distance: 90cm, height: 30cm}}}}
+)",
+                     l.power_w, l.ambient_lx, l.aperture, l.shutter, speed);
+}
+
+// Whether one advice suggests a change another one reverses; says which in *why.
+bool contradicts(const std::vector<Advice>& advice, std::string* why) {
+  for (const Advice& a : advice) {
+    for (const Advice& b : advice) {
+      for (const SettingChange& c : a.changes) {
+        const SettingChange reverse{c.setting, -c.direction};
+        if (std::find(b.changes.begin(), b.changes.end(), reverse) != b.changes.end()) {
+          *why = "'" + a.message + "'\n  against\n'" + b.message + "'";
+          return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+// One light and little ambient light: the lit side clips where the shadow side is too dark. The
+// advice names the range, not two opposite exposure changes.
+TEST(Advice, ABrightnessRangeWiderThanTheSensorIsNamedNotTwoOppositeExposures) {
+  const Advised a = advise(scene_text({400, 0.5, "1/30", "f/8", ""}));
+  EXPECT_EQ(a.text.find("over-exposure"), std::string::npos) << a.text;
+  EXPECT_EQ(a.text.find("under-exposure"), std::string::npos) << a.text;
+  EXPECT_NE(a.text.find("the scene's brightness range is wider than the sensor records"),
+            std::string::npos)
+      << a.text;
+  EXPECT_NE(a.text.find("add fill light"), std::string::npos) << a.text;
+  EXPECT_NE(a.text.find("bracket"), std::string::npos) << a.text;
+  // More ambient light narrows the range: then one exposure fits.
+  const Advised lit = advise(scene_text({400, 2000, "1/30", "f/8", ""}));
+  EXPECT_EQ(lit.text.find("brightness range"), std::string::npos) << lit.text;
+}
+
+// A turning table pins a short shutter; the under-exposure advice then does not lengthen it.
+TEST(Advice, UnderExposureOnATurningTableDoesNotLengthenTheShutter) {
+  const Advised a = advise(scene_text({20, 300, "1/250", "f/8", "10deg/s"}));
+  ASSERT_NE(a.text.find("the turning table smears"), std::string::npos) << a.text;
+  ASSERT_NE(a.text.find("under-exposure"), std::string::npos) << a.text;
+  EXPECT_EQ(a.text.find("lengthen the shutter"), std::string::npos) << a.text;
+  std::string why;
+  EXPECT_FALSE(contradicts(a.advice, &why)) << why;
+}
+
+// Over a family of scenes (light power, ambient light, shutter, aperture, table speed), no
+// advice suggests a change another reverses, and over- and under-exposure never come together.
+TEST(Advice, NoAdviceReversesAnotherOverAFamilyOfScenes) {
+  int over = 0, under = 0, range = 0, blur = 0, diffraction = 0;
+  for (const double power : {5.0, 400.0}) {
+    for (const double ambient : {0.5, 300.0}) {
+      for (const char* shutter : {"1/2000", "1/60", "2"}) {
+        for (const char* aperture : {"f/4", "f/64"}) {
+          for (const char* speed : {"", "30deg/s"}) {
+            const Lighting l{power, ambient, shutter, aperture, speed};
+            const Advised a = advise(scene_text(l));
+            const std::string name = fmt::format("{} W, {} lx, {} s, {}, '{}'", power, ambient,
+                                                 shutter, aperture, speed);
+            std::string why;
+            EXPECT_FALSE(contradicts(a.advice, &why)) << name << ":\n" << why;
+            const bool has_over = a.text.find("over-exposure") != std::string::npos;
+            const bool has_under = a.text.find("under-exposure") != std::string::npos;
+            EXPECT_FALSE(has_over && has_under) << name << ":\n" << a.text;
+            over += has_over;
+            under += has_under;
+            range += a.text.find("brightness range") != std::string::npos;
+            blur += a.text.find("turning table smears") != std::string::npos;
+            diffraction += a.text.find("diffraction-limited") != std::string::npos;
+          }
+        }
+      }
+    }
+  }
+  // The family reaches every kind of exposure advice and the settings they could reverse.
+  EXPECT_GT(over, 0);
+  EXPECT_GT(under, 0);
+  EXPECT_GT(range, 0);
+  EXPECT_GT(blur, 0);
+  EXPECT_GT(diffraction, 0);
+}
+
+}  // namespace
+}  // namespace rigc::analysis
