@@ -14,6 +14,7 @@
 #include "compiler/limits.h"
 #include "compiler/presets.h"
 #include "compiler/units.h"
+#include "compiler/yaml_limits.h"
 
 namespace rigc {
 namespace {
@@ -1113,6 +1114,11 @@ std::optional<YAML::Mark> first_invalid_utf8_scalar(const YAML::Node& root) {
 std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string& file,
                                      DiagnosticEngine& diag) {
   try {
+    // Before building the tree: an alias bomb or deep nesting would exhaust memory or the stack.
+    if (const auto problem = yaml_shape_problem(text)) {
+      diag.error({file, problem->line + 1, problem->column + 1}, problem->message);
+      return std::nullopt;
+    }
     // Every document, so that a second one is an error rather than silently left unread.
     const std::vector<YAML::Node> documents = YAML::LoadAll(text);
     if (documents.size() > 1) {
