@@ -227,7 +227,8 @@ class Checker {
     if (auto c = color(map["color"], what, limit)) out = *c;
   }
 
-  std::optional<Target> target(const YAML::Node& node, const std::string& what) {
+  std::optional<Target> target(const YAML::Node& node, const std::string& what,
+                               const limits::Quantity& limit) {
     Target result;
     result.loc = loc(node);
     if (node.IsScalar()) {
@@ -236,7 +237,7 @@ class Checker {
                               node.Scalar()));
       return std::nullopt;
     }
-    auto point = vec3(node, QuantityKind::kLength, what);
+    auto point = vec3(node, what, limit);
     if (!point) return std::nullopt;
     result.object = false;
     result.point = *point;
@@ -400,10 +401,12 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
   if (node["fit"]) read_fit(node["fit"], object);
   if (node["scale"]) read_scale(node["scale"], object);
   if (node["rotate"]) {
-    if (auto r = vec3(node["rotate"], QuantityKind::kAngle, "rotate")) object.rotate_rad = *r;
+    if (auto r = vec3(node["rotate"], "rotate", limits::object::kRotate)) object.rotate_rad = *r;
   }
   if (node["translate"]) {
-    if (auto t = vec3(node["translate"], QuantityKind::kLength, "translate")) object.translate = *t;
+    if (auto t = vec3(node["translate"], "translate", limits::object::kTranslate)) {
+      object.translate = *t;
+    }
   }
   if (node["surface"]) read_surface(node["surface"], object);
 }
@@ -653,7 +656,7 @@ void Checker::read_light_source(const YAML::Node& node, const std::string& type,
   if (light.type != ir::LightType::kDirectional) {
     if (!node["position"]) {
       if (lacks(node, "position")) error(node, fmt::format("a {} light needs a 'position'", type));
-    } else if (auto p = vec3(node["position"], QuantityKind::kLength, "light position")) {
+    } else if (auto p = vec3(node["position"], "light position", limits::studio::kLightPosition)) {
       light.position = *p;
     }
     if (!node["power"]) {
@@ -685,7 +688,7 @@ void Checker::read_light_aim(const YAML::Node& node, spec::LightSpec& light_spec
       light.direction = *d;
     }
   } else if (node["look_at"]) {
-    light_spec.look_at = target(node["look_at"], "look_at");
+    light_spec.look_at = target(node["look_at"], "look_at", limits::studio::kLightLookAt);
   } else if (light.type == ir::LightType::kSpot || light.type == ir::LightType::kArea) {
     light_spec.look_at = Target{};
     light_spec.look_at->loc = light.loc;
@@ -987,7 +990,7 @@ void Checker::read_turntable_camera(const YAML::Node& camera, spec::TurntableCam
   read(camera, "height", "camera height", limit::kTurntableCameraHeight, out.height_m);
   read(camera, "azimuth", "camera azimuth", limit::kTurntableCameraAzimuth, out.azimuth_rad);
   if (camera["aim"]) {
-    if (auto t = target(camera["aim"], "aim")) out.aim = *t;
+    if (auto t = target(camera["aim"], "aim", limit::kTurntableCameraAim)) out.aim = *t;
   }
 }
 
@@ -1002,7 +1005,7 @@ void Checker::read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& grou
     error(node, "orbit shots need a 'distance' from the object");
   }
   if (node["aim"]) {
-    if (auto t = target(node["aim"], "aim")) orbit.aim = *t;
+    if (auto t = target(node["aim"], "aim", limits::shots::kOrbitAim)) orbit.aim = *t;
   }
   const YAML::Node rings = node["rings"];
   if (!rings || !rings.IsSequence() || rings.size() == 0) {
@@ -1034,7 +1037,7 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   if (!expect_map(node, "a pose shot")) return;
   check_keys(node, {"position", "look_at", "up", "turntable"}, "a pose shot");
   if (node["position"]) {
-    if (auto p = vec3(node["position"], QuantityKind::kLength, "camera position")) {
+    if (auto p = vec3(node["position"], "camera position", limits::shots::kPosePosition)) {
       pose.position = *p;
     }
   } else {
@@ -1042,7 +1045,9 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   }
   pose.look_at.loc = loc(node);
   if (node["look_at"]) {
-    if (auto t = target(node["look_at"], "look_at")) pose.look_at = *t;
+    if (auto t = target(node["look_at"], "look_at", limits::shots::kPoseLookAt)) {
+      pose.look_at = *t;
+    }
   }
   if (node["up"]) {
     if (auto u = direction(node["up"], "up", "up must not be zero")) pose.up = *u;
