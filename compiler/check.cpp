@@ -15,6 +15,7 @@
 #include "compiler/presets.h"
 #include "compiler/units.h"
 #include "compiler/yaml_limits.h"
+#include "ir/utf8_text.h"
 
 namespace rigc {
 namespace {
@@ -1053,40 +1054,6 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
     if (auto u = direction(node["up"], "up", "up must not be zero")) pose.up = *u;
   }
   read(node, "turntable", "turntable angle", limits::shots::kPoseTurntable, pose.turntable_rad);
-}
-
-// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past
-// U+10FFFF).
-bool valid_utf8(const std::string& text) {
-  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
-  const auto* end = p + text.size();
-  while (p < end) {
-    const unsigned char c = *p;
-    int extra = 0;
-    unsigned char low = 0x80, high = 0xBF;  // the first continuation byte's range
-    if (c < 0x80) {
-      ++p;
-      continue;
-    } else if (c >= 0xC2 && c <= 0xDF) {
-      extra = 1;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      extra = 2;
-      if (c == 0xE0) low = 0xA0;
-      if (c == 0xED) high = 0x9F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      extra = 3;
-      if (c == 0xF0) low = 0x90;
-      if (c == 0xF4) high = 0x8F;
-    } else {
-      return false;
-    }
-    if (end - p <= extra || p[1] < low || p[1] > high) return false;
-    for (int k = 2; k <= extra; ++k) {
-      if (p[k] < 0x80 || p[k] > 0xBF) return false;
-    }
-    p += extra + 1;
-  }
-  return true;
 }
 
 // The mark of the first key or scalar value under `root` that is not UTF-8. yaml-cpp passes a

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "ir/utf8_text.h"
+
 namespace rigc {
 namespace {
 
@@ -38,7 +40,7 @@ void DiagnosticEngine::add_source(const std::string& file, std::string text) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     lines.push_back(line);
   }
-  source_lines_[file] = std::move(lines);
+  source_lines_[valid_utf8_text(file)] = std::move(lines);
 }
 
 void DiagnosticEngine::error(const SourceLoc& loc, std::string message) {
@@ -52,6 +54,9 @@ void DiagnosticEngine::note(const SourceLoc& loc, std::string message) {
 }
 
 void DiagnosticEngine::report(Diagnostic diagnostic) {
+  // Messages quote file and material names, which may hold any bytes; diagnostics are also JSON.
+  diagnostic.loc.file = valid_utf8_text(diagnostic.loc.file);
+  diagnostic.message = valid_utf8_text(diagnostic.message);
   if (diagnostic.severity == Severity::kError) ++error_count_;
   if (diagnostic.severity == Severity::kWarning) ++warning_count_;
   diagnostics_.push_back(diagnostic);
