@@ -36,6 +36,22 @@ std::string folder_name_problem(const std::string& name) {
     if (c == '/' || c == '\\') return "it holds a slash";
     if (c < 0x20 || c == 0x7F) return "it holds a control character";
   }
+  // C1 controls (U+0080..U+009F, UTF-8 C2 80..C2 9F) and the bidirectional controls (U+200E,
+  // U+200F, U+202A..U+202E, U+2066..U+2069), which make a folder name display as another.
+  for (std::size_t i = 0; i + 1 < name.size(); ++i) {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(name[k]); };
+    if (byte(i) == 0xC2 && byte(i + 1) >= 0x80 && byte(i + 1) <= 0x9F) {
+      return "it holds a control character";
+    }
+    if (i + 2 < name.size() && byte(i) == 0xE2) {
+      const unsigned second = byte(i + 1), third = byte(i + 2);
+      if ((second == 0x80 &&
+           (third == 0x8E || third == 0x8F || (third >= 0xAA && third <= 0xAE))) ||
+          (second == 0x81 && third >= 0xA6 && third <= 0xA9)) {
+        return "it holds a bidirectional text control";
+      }
+    }
+  }
   return {};
 }
 
@@ -1086,6 +1102,14 @@ std::optional<YAML::Mark> first_invalid_utf8_scalar(const YAML::Node& root) {
 std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string& file,
                                      DiagnosticEngine& diag) {
   try {
+    // yaml-cpp reads a NUL byte as "unknown escape character" or cuts the text there.
+    if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+      const std::size_t line_start = text.rfind('\n', nul) + 1;  // npos + 1 == 0
+      const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'));
+      diag.error({file, line, static_cast<int>(nul - line_start) + 1},
+                 "a NUL byte: a scene file is text (a NUL inside quotes is written \\0)");
+      return std::nullopt;
+    }
     // Before building the tree: an alias bomb or deep nesting would exhaust memory or the stack.
     if (const auto problem = yaml_shape_problem(text)) {
       diag.error({file, problem->line + 1, problem->column + 1}, problem->message);

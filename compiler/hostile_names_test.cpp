@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "compiler/frontend.h"
 #include "ir/utf8_text.h"
 #include "tests/test_support.h"
 
@@ -112,6 +113,59 @@ TEST(HostileNames, DiagnosticsQuotingBytesAreValidJson) {
   const json checked = parsed(check.out);
   ASSERT_TRUE(checked.contains("diagnostics"));
   EXPECT_EQ(checked["diagnostics"][0].value("file", ""), dir.file("bad\xEF\xBF\xBD.yaml"));
+}
+
+std::string compile_messages(const std::string& path) {
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  EXPECT_FALSE(compile_scene_file(path, diag)) << path;
+  return messages;
+}
+
+// "cannot read the scene file" said nothing of why.
+TEST(HostileNames, AnUnreadableSceneFileSaysWhy) {
+  TempDir dir;
+  fs::create_directories(dir.path() / "folder.yaml");
+  fs::create_symlink("loop.yaml", dir.path() / "loop.yaml");
+  fs::create_symlink("gone.yaml", dir.path() / "dangling.yaml");
+  EXPECT_NE(compile_messages(dir.file("none.yaml"))
+                .find("cannot read the scene file: it does not "
+                      "exist"),
+            std::string::npos);
+  EXPECT_NE(compile_messages(dir.file("folder.yaml")).find(": it is a folder"), std::string::npos);
+  EXPECT_NE(compile_messages(dir.file("loop.yaml")).find(": it is a loop of symbolic links"),
+            std::string::npos);
+  EXPECT_NE(compile_messages(dir.file("dangling.yaml")).find(": it is a symbolic link to nothing"),
+            std::string::npos);
+  EXPECT_NE(compile_messages("/dev/null").find(": it is not a regular file"), std::string::npos);
+}
+
+std::string text_messages(const std::string& text) {
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  EXPECT_FALSE(compile_scene_text(text, "s.yaml", ".", diag));
+  return messages;
+}
+
+// A NUL byte was "unknown escape character".
+TEST(HostileNames, ANulByteIsNamedAtItsPlace) {
+  const std::string messages = text_messages(std::string("rigc: 1\nname: \"ab\0c\"\n", 21));
+  EXPECT_EQ(messages.rfind("s.yaml:2:10: error: a NUL byte", 0), 0u) << messages;
+}
+
+// C1 controls and U+202E (right-to-left override) were accepted in names, and so in folders.
+TEST(HostileNames, ControlAndBidiCharactersAreRefusedInTheName) {
+  for (const std::string name : {"a\xC2\x85"
+                                 "b",
+                                 "evil\xE2\x80\xAEgpj.exe", "x\xE2\x81\xA6y"}) {
+    const std::string messages = text_messages("rigc: 1\nname: \"" + name + "\"\n");
+    EXPECT_NE(messages.find("the scene's name cannot name a folder (it holds a"), std::string::npos)
+        << messages;
+  }
+  EXPECT_EQ(text_messages("rigc: 1\nname: \"caf\xC3\xA9\"\n").find("name cannot"),
+            std::string::npos);
 }
 
 }  // namespace
