@@ -62,25 +62,27 @@ std::string png_header_only(std::uint32_t width, std::uint32_t height, int bits 
   return png;
 }
 
-// A texture over stb_image's 1 GB decoded says so and gives its size, instead of calling the
-// file broken; a broken one still reads as broken.
+// A texture over the pixel limit (kMostTexturePixels, 8192 x 8192) says so and gives its size
+// from its header, before any decoding; a broken one within it still reads as broken.
 TEST(MeshIoObj, ATextureTooLargeToDecodeSaysItsSize) {
   TempDir dir;
   write_file(dir.file("box.obj"),
              "mtllib box.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
              "f 1/1 2/2 3/3\n");
   write_file(dir.file("box.mtl"), "newmtl m\nmap_Kd big.png\n");
-  const std::string too_large = "more than the image decoder takes";
+  const std::string too_large = "more than the 64 megapixels a texture may have";
   write_file(dir.file("big.png"), png_header_only(20000, 20000));
   expect_load_error(dir.file("box.obj"), "big.png' is 20000 x 20000 pixels: " + too_large);
-  // The header test's edge: 2^30 / 16384 / 3 = 21845 rows of RGB.
+  // 16000 x 16000 (775 KB as a flat PNG) took 5.2 GB to render a cube.
+  write_file(dir.file("big.png"), png_header_only(16000, 16000));
+  expect_load_error(dir.file("box.obj"), "is 16000 x 16000 pixels: " + too_large);
+  // Past stb_image's own header test (1 GB in the file's channels): the size is still given.
   write_file(dir.file("big.png"), png_header_only(16384, 21846));
   expect_load_error(dir.file("box.obj"), "is 16384 x 21846 pixels: " + too_large);
-  // 16 bits: 16384 x 16384 as 16-bit RGBA is 2 GB.
-  write_file(dir.file("big.png"), png_header_only(16384, 16384, 16));
-  expect_load_error(dir.file("box.obj"), "is 16384 x 16384 pixels at 16 bits: " + too_large);
-  // Under both limits (8-bit 16384 x 21845): this truncated one fails as broken.
-  write_file(dir.file("big.png"), png_header_only(16384, 21845));
+  write_file(dir.file("big.png"), png_header_only(8193, 8192, 16));
+  expect_load_error(dir.file("box.obj"), "is 8193 x 8192 pixels: " + too_large);
+  // At the limit: this truncated one fails as broken.
+  write_file(dir.file("big.png"), png_header_only(8192, 8192));
   expect_load_error(dir.file("box.obj"), "could not be decoded (unknown or broken image format)");
 }
 

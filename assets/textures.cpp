@@ -1,5 +1,6 @@
 #include "assets/textures.h"
 
+#include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -16,8 +17,8 @@ namespace rigc::loading {
 namespace {
 
 // A PNG's size, channels and bit depth from its header (IHDR, which the format puts first), or
-// nothing if `bytes` is no PNG or the header is broken. Read only to explain a decoding failure:
-// stb_image refuses a PNG too large for it, and tinygltf reports every failure alike.
+// nothing if `bytes` is no PNG or the header is broken. Read for the size when stb_image's header
+// test refuses a PNG as too large for it.
 struct PngHeader {
   std::uint32_t width = 0, height = 0;
   int channels = 0;
@@ -47,6 +48,17 @@ std::optional<PngHeader> png_header(const std::vector<unsigned char>& bytes) {
   return header;
 }
 
+// Fails for a texture of more than kMostTexturePixels: the renderers keep every texture whole in
+// memory, several copies of it, whatever share of it a photo shows.
+void check_texture_size(std::uint64_t width, std::uint64_t height, const std::string& what) {
+  if (width * height > kMostTexturePixels) {
+    fail(
+        "{} is {} x {} pixels: more than the {} megapixels a texture may have (8192 x 8192); "
+        "scale it down",
+        what, width, height, kMostTexturePixels >> 20);
+  }
+}
+
 }  // namespace
 
 ir::Texture make_texture(std::string source, int width, int height, int channels, int bits,
@@ -55,6 +67,7 @@ ir::Texture make_texture(std::string source, int width, int height, int channels
     fail("{} has an unsupported pixel format ({}x{}, {} channels, {} bits)", what, width, height,
          channels, bits);
   }
+  check_texture_size(width, height, what);
   const std::size_t n = static_cast<std::size_t>(width) * height * channels;
   if (data.size() != n * (bits / 8)) fail("{} has truncated pixel data", what);
   ir::Texture tex;
@@ -80,24 +93,18 @@ ir::Texture decode_image(std::string source, const std::vector<unsigned char>& b
   if (bytes.empty() || bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
     fail("{} is empty or too large", what);
   }
+  // From the header, before decoding: a 775 KB PNG can hold 16000 x 16000 pixels.
+  int width = 0, height = 0, channels = 0;
+  if (stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height,
+                            &channels)) {
+    check_texture_size(static_cast<std::uint64_t>(width), static_cast<std::uint64_t>(height), what);
+  } else if (const std::optional<PngHeader> png = png_header(bytes)) {
+    check_texture_size(png->width, png->height, what);  // a size stb_image's header test refuses
+  }
   tinygltf::Image image;
   std::string err, warn;
   if (!tinygltf::LoadImageData(&image, 0, &err, &warn, 0, 0, bytes.data(),
                                static_cast<int>(bytes.size()), nullptr)) {
-    if (const std::optional<PngHeader> png = png_header(bytes)) {
-      // stb_image's two limits: its header test (under 1 GB in the file's own channels, in its
-      // integer arithmetic), and the RGBA image tinygltf asks for (under 2 GB, at 16 bits for a
-      // 16-bit file).
-      const double rgba_bytes =
-          static_cast<double>(png->width) * png->height * 4 * (png->bits == 16 ? 2 : 1);
-      if (png->width > 0 && ((std::uint32_t{1} << 30) / png->width / png->channels < png->height ||
-                             rgba_bytes > std::numeric_limits<int>::max())) {
-        fail(
-            "{} is {} x {} pixels{}: more than the image decoder takes (under 1 GB in the file's "
-            "channels and 2 GB as RGBA); scale it down (16384 x 16384 at 8 bits fits)",
-            what, png->width, png->height, png->bits == 16 ? " at 16 bits" : "");
-      }
-    }
     fail("{} could not be decoded (unknown or broken image format)", what);
   }
   return make_texture(std::move(source), image.width, image.height, image.component, image.bits,

@@ -2,12 +2,16 @@
 // decoded, or encoded image bytes (PNG, JPEG, ...) decoded here.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "ir/ir.h"
 
 namespace rigc::loading {
+
+// The most pixels a texture may have (8192 x 8192), checked from its header before decoding.
+inline constexpr std::uint64_t kMostTexturePixels = std::uint64_t{1} << 26;
 
 // Converts decoded pixels (8 or 16 bits per channel) to an 8-bit ir::Texture. `what` names the
 // image in a LoadError.

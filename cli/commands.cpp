@@ -185,7 +185,7 @@ int run_render(std::vector<std::string> args) {
       ->capture_default_str();
   // Checked as a number 0 or more: CLI11 reads "-1" into an unsigned seed as 2^64 - 1.
   app.add_option("--seed", seed, "sensor noise seed")
-      ->check(non_negative_number())
+      ->check(cli::unsigned_64_number())
       ->capture_default_str();
   bool force = false;
   app.add_flag("--force", force,

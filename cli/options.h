@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -62,6 +63,26 @@ inline const CLI::Validator& finite_number() {
 inline const CLI::Validator& non_negative_number() {
   static const CLI::Validator check = finite_number_where(
       [](double value) { return value >= 0; }, "is negative: give 0 or more", "NONNEGATIVE");
+  return check;
+}
+// A whole number 0..2^64-1 (a seed): CLI11 read 99999999999999999999 as 2^64 - 1, silently.
+inline const CLI::Validator& unsigned_64_number() {
+  static const CLI::Validator check(
+      [](std::string& text) -> std::string {
+        std::uint64_t value = 0;
+        const char* first = text.data() + (text.starts_with('+') ? 1 : 0);
+        const char* last = text.data() + text.size();
+        if (first != last && *first == '-') return "'" + text + "' is negative: give 0 or more";
+        const auto [end, error] = std::from_chars(first, last, value);
+        if (error == std::errc::result_out_of_range) {
+          return "'" + text + "' is out of range: give 0 to 18446744073709551615";
+        }
+        if (first == last || end != last || error != std::errc()) {
+          return "'" + text + "' is not a whole number 0 or more";
+        }
+        return "";
+      },
+      "UINT64");
   return check;
 }
 inline const CLI::Validator& positive_number() {

@@ -47,5 +47,29 @@ TEST(CommandLine, AnythingElseIsNamed) {
   }
 }
 
+// CLI11 read a seed of 99999999999999999999 as 2^64 - 1 without a word.
+TEST(CommandLine, ASeedOutOfRangeIsAnError) {
+  auto parse_seed = [](const std::string& text, std::uint64_t* seed) {
+    CLI::App app;
+    app.add_option("--seed", *seed)->check(unsigned_64_number());
+    std::ostringstream errors;
+    std::streambuf* old = std::cerr.rdbuf(errors.rdbuf());
+    const std::optional<int> code = parse_options(app, {"rigc", "--seed", text});
+    std::cerr.rdbuf(old);
+    return code ? errors.str() : std::string();
+  };
+  std::uint64_t seed = 0;
+  EXPECT_EQ(parse_seed("18446744073709551615", &seed), "");
+  EXPECT_EQ(seed, 18446744073709551615u);
+  EXPECT_EQ(parse_seed("0", &seed), "");
+  EXPECT_NE(parse_seed("99999999999999999999", &seed)
+                .find("'99999999999999999999' is out of range: give 0 to 18446744073709551615"),
+            std::string::npos);
+  EXPECT_NE(parse_seed("18446744073709551616", &seed).find("out of range"), std::string::npos);
+  EXPECT_NE(parse_seed("-1", &seed).find("'-1' is negative"), std::string::npos);
+  EXPECT_NE(parse_seed("1.5", &seed).find("not a whole number"), std::string::npos);
+  EXPECT_NE(parse_seed("0x10", &seed).find("not a whole number"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigc::cli

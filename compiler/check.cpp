@@ -16,6 +16,8 @@
 #include "compiler/limits.h"
 #include "compiler/presets.h"
 #include "compiler/units.h"
+#include "compiler/yaml_limits.h"
+#include "ir/utf8_text.h"
 
 namespace rigc {
 namespace {
@@ -35,6 +37,22 @@ std::string folder_name_problem(const std::string& name) {
   for (const unsigned char c : name) {
     if (c == '/' || c == '\\') return "it holds a slash";
     if (c < 0x20 || c == 0x7F) return "it holds a control character";
+  }
+  // C1 controls (U+0080..U+009F, UTF-8 C2 80..C2 9F) and the bidirectional controls (U+200E,
+  // U+200F, U+202A..U+202E, U+2066..U+2069), which make a folder name display as another.
+  for (std::size_t i = 0; i + 1 < name.size(); ++i) {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(name[k]); };
+    if (byte(i) == 0xC2 && byte(i + 1) >= 0x80 && byte(i + 1) <= 0x9F) {
+      return "it holds a control character";
+    }
+    if (i + 2 < name.size() && byte(i) == 0xE2) {
+      const unsigned second = byte(i + 1), third = byte(i + 2);
+      if ((second == 0x80 &&
+           (third == 0x8E || third == 0x8F || (third >= 0xAA && third <= 0xAE))) ||
+          (second == 0x81 && third >= 0xA6 && third <= 0xA9)) {
+        return "it holds a bidirectional text control";
+      }
+    }
   }
   return {};
 }
@@ -228,7 +246,8 @@ class Checker {
     if (auto c = color(map["color"], what, limit)) out = *c;
   }
 
-  std::optional<Target> target(const YAML::Node& node, const std::string& what) {
+  std::optional<Target> target(const YAML::Node& node, const std::string& what,
+                               const limits::Quantity& limit) {
     Target result;
     result.loc = loc(node);
     if (node.IsScalar()) {
@@ -237,7 +256,7 @@ class Checker {
                               node.Scalar()));
       return std::nullopt;
     }
-    auto point = vec3(node, QuantityKind::kLength, what);
+    auto point = vec3(node, what, limit);
     if (!point) return std::nullopt;
     result.object = false;
     result.point = *point;
@@ -401,10 +420,12 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
   if (node["fit"]) read_fit(node["fit"], object);
   if (node["scale"]) read_scale(node["scale"], object);
   if (node["rotate"]) {
-    if (auto r = vec3(node["rotate"], QuantityKind::kAngle, "rotate")) object.rotate_rad = *r;
+    if (auto r = vec3(node["rotate"], "rotate", limits::object::kRotate)) object.rotate_rad = *r;
   }
   if (node["translate"]) {
-    if (auto t = vec3(node["translate"], QuantityKind::kLength, "translate")) object.translate = *t;
+    if (auto t = vec3(node["translate"], "translate", limits::object::kTranslate)) {
+      object.translate = *t;
+    }
   }
   if (node["surface"]) read_surface(node["surface"], object);
 }
@@ -654,7 +675,7 @@ void Checker::read_light_source(const YAML::Node& node, const std::string& type,
   if (light.type != ir::LightType::kDirectional) {
     if (!node["position"]) {
       if (lacks(node, "position")) error(node, fmt::format("a {} light needs a 'position'", type));
-    } else if (auto p = vec3(node["position"], QuantityKind::kLength, "light position")) {
+    } else if (auto p = vec3(node["position"], "light position", limits::studio::kLightPosition)) {
       light.position = *p;
     }
     if (!node["power"]) {
@@ -686,7 +707,7 @@ void Checker::read_light_aim(const YAML::Node& node, spec::LightSpec& light_spec
       light.direction = *d;
     }
   } else if (node["look_at"]) {
-    light_spec.look_at = target(node["look_at"], "look_at");
+    light_spec.look_at = target(node["look_at"], "look_at", limits::studio::kLightLookAt);
   } else if (light.type == ir::LightType::kSpot || light.type == ir::LightType::kArea) {
     light_spec.look_at = Target{};
     light_spec.look_at->loc = light.loc;
@@ -988,7 +1009,7 @@ void Checker::read_turntable_camera(const YAML::Node& camera, spec::TurntableCam
   read(camera, "height", "camera height", limit::kTurntableCameraHeight, out.height_m);
   read(camera, "azimuth", "camera azimuth", limit::kTurntableCameraAzimuth, out.azimuth_rad);
   if (camera["aim"]) {
-    if (auto t = target(camera["aim"], "aim")) out.aim = *t;
+    if (auto t = target(camera["aim"], "aim", limit::kTurntableCameraAim)) out.aim = *t;
   }
 }
 
@@ -1003,7 +1024,7 @@ void Checker::read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& grou
     error(node, "orbit shots need a 'distance' from the object");
   }
   if (node["aim"]) {
-    if (auto t = target(node["aim"], "aim")) orbit.aim = *t;
+    if (auto t = target(node["aim"], "aim", limits::shots::kOrbitAim)) orbit.aim = *t;
   }
   const YAML::Node rings = node["rings"];
   if (!rings || !rings.IsSequence() || rings.size() == 0) {
@@ -1035,7 +1056,7 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   if (!expect_map(node, "a pose shot")) return;
   check_keys(node, {"position", "look_at", "up", "turntable"}, "a pose shot");
   if (node["position"]) {
-    if (auto p = vec3(node["position"], QuantityKind::kLength, "camera position")) {
+    if (auto p = vec3(node["position"], "camera position", limits::shots::kPosePosition)) {
       pose.position = *p;
     }
   } else {
@@ -1043,46 +1064,14 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   }
   pose.look_at.loc = loc(node);
   if (node["look_at"]) {
-    if (auto t = target(node["look_at"], "look_at")) pose.look_at = *t;
+    if (auto t = target(node["look_at"], "look_at", limits::shots::kPoseLookAt)) {
+      pose.look_at = *t;
+    }
   }
   if (node["up"]) {
     if (auto u = direction(node["up"], "up", "up must not be zero")) pose.up = *u;
   }
   read(node, "turntable", "turntable angle", limits::shots::kPoseTurntable, pose.turntable_rad);
-}
-
-// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past
-// U+10FFFF).
-bool valid_utf8(const std::string& text) {
-  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
-  const auto* end = p + text.size();
-  while (p < end) {
-    const unsigned char c = *p;
-    int extra = 0;
-    unsigned char low = 0x80, high = 0xBF;  // the first continuation byte's range
-    if (c < 0x80) {
-      ++p;
-      continue;
-    } else if (c >= 0xC2 && c <= 0xDF) {
-      extra = 1;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      extra = 2;
-      if (c == 0xE0) low = 0xA0;
-      if (c == 0xED) high = 0x9F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      extra = 3;
-      if (c == 0xF0) low = 0x90;
-      if (c == 0xF4) high = 0x8F;
-    } else {
-      return false;
-    }
-    if (end - p <= extra || p[1] < low || p[1] > high) return false;
-    for (int k = 2; k <= extra; ++k) {
-      if (p[k] < 0x80 || p[k] > 0xBF) return false;
-    }
-    p += extra + 1;
-  }
-  return true;
 }
 
 // The mark of the first key or scalar value under `root` that is not UTF-8. yaml-cpp passes a
@@ -1159,6 +1148,19 @@ std::vector<DocumentStart> first_two_documents(const std::string& text) {
 std::optional<YAML::Node> parse_yaml(const std::string& text, const std::string& file,
                                      DiagnosticEngine& diag) {
   try {
+    // yaml-cpp reads a NUL byte as "unknown escape character" or cuts the text there.
+    if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+      const std::size_t line_start = text.rfind('\n', nul) + 1;  // npos + 1 == 0
+      const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'));
+      diag.error({file, line, static_cast<int>(nul - line_start) + 1},
+                 "a NUL byte: a scene file is text (a NUL inside quotes is written \\0)");
+      return std::nullopt;
+    }
+    // Before building the tree: an alias bomb or deep nesting would exhaust memory or the stack.
+    if (const auto problem = yaml_shape_problem(text)) {
+      diag.error({file, problem->line + 1, problem->column + 1}, problem->message);
+      return std::nullopt;
+    }
     // Two documents at most, so that a second one is an error rather than silently left unread.
     const std::vector<DocumentStart> documents = first_two_documents(text);
     if (documents.size() > 1) {

@@ -3,8 +3,31 @@
 #include <algorithm>
 #include <iostream>
 #include <sstream>
+#include <utility>
+
+#include "ir/utf8_text.h"
 
 namespace rigc {
+namespace {
+
+// A long source line cut to the part around column `col` (1-based, 0 for none), with "..." where
+// it was cut, and the column within that part: a minified or generated line can be megabytes.
+std::pair<std::string, int> line_around(const std::string& line, int col) {
+  constexpr int kMostShown = 120;
+  if (static_cast<int>(line.size()) <= kMostShown) return {line, col};
+  const int first =
+      std::clamp(col - 1 - kMostShown / 2, 0, static_cast<int>(line.size()) - kMostShown);
+  std::string part = line.substr(first, kMostShown);
+  int shown_col = col > 0 ? col - first : 0;
+  if (first > 0) {
+    part = "..." + part;
+    if (shown_col > 0) shown_col += 3;
+  }
+  if (first + kMostShown < static_cast<int>(line.size())) part += "...";
+  return {part, shown_col};
+}
+
+}  // namespace
 
 DiagnosticEngine::DiagnosticEngine()
     : handler_([](const Diagnostic&, const std::string& rendered) { std::cerr << rendered; }) {}
@@ -17,7 +40,7 @@ void DiagnosticEngine::add_source(const std::string& file, std::string text) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     lines.push_back(line);
   }
-  source_lines_[file] = std::move(lines);
+  source_lines_[valid_utf8_text(file)] = std::move(lines);
 }
 
 void DiagnosticEngine::error(const SourceLoc& loc, std::string message) {
@@ -31,6 +54,9 @@ void DiagnosticEngine::note(const SourceLoc& loc, std::string message) {
 }
 
 void DiagnosticEngine::report(Diagnostic diagnostic) {
+  // Messages quote file and material names, which may hold any bytes; diagnostics are also JSON.
+  diagnostic.loc.file = valid_utf8_text(diagnostic.loc.file);
+  diagnostic.message = valid_utf8_text(diagnostic.message);
   if (diagnostic.severity == Severity::kError) ++error_count_;
   if (diagnostic.severity == Severity::kWarning) ++warning_count_;
   diagnostics_.push_back(diagnostic);
@@ -59,12 +85,12 @@ std::string DiagnosticEngine::render(const Diagnostic& d) const {
   auto it = source_lines_.find(d.loc.file);
   if (it != source_lines_.end() && d.loc.line > 0 &&
       d.loc.line <= static_cast<int>(it->second.size())) {
-    const std::string& line = it->second[d.loc.line - 1];
+    const auto [line, col] = line_around(it->second[d.loc.line - 1], d.loc.col);
     out << "  " << line << '\n';
-    if (d.loc.col > 0) {
+    if (col > 0) {
       std::string pad;
       // Keep tabs so the caret lines up under the same column in a terminal.
-      for (int i = 0; i < d.loc.col - 1 && i < static_cast<int>(line.size()); ++i) {
+      for (int i = 0; i < col - 1 && i < static_cast<int>(line.size()); ++i) {
         pad += line[i] == '\t' ? '\t' : ' ';
       }
       out << "  " << pad << "^\n";

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <tuple>
@@ -35,13 +36,34 @@ std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::
   return lower_scene(*checked, diag);
 }
 
-std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag) {
-  std::ifstream in(path, std::ios::binary);
+namespace {
+
+// Why the scene file at `path` cannot be read: missing, a folder, a symlink loop, not a regular
+// file, or the system's reason (permission).
+std::string why_unreadable(const std::string& path) {
   std::error_code ec;
-  if (!in || fs::is_directory(path, ec)) {
-    diag.error({path, 0, 0}, "cannot read the scene file");
+  const fs::file_status status = fs::status(path, ec);
+  if (ec == std::errc::too_many_symbolic_link_levels) return "it is a loop of symbolic links";
+  if (ec && ec != std::errc::no_such_file_or_directory) return ec.message();
+  if (!fs::exists(status)) {
+    return fs::is_symlink(fs::symlink_status(path, ec)) ? "it is a symbolic link to nothing"
+                                                        : "it does not exist";
+  }
+  if (fs::is_directory(status)) return "it is a folder";
+  if (!fs::is_regular_file(status)) return "it is not a regular file";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::generic_category().message(errno);
+  return "";
+}
+
+}  // namespace
+
+std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag) {
+  if (const std::string why = why_unreadable(path); !why.empty()) {
+    diag.error({path, 0, 0}, fmt::format("cannot read the scene file: {}", why));
     return std::nullopt;
   }
+  std::ifstream in(path, std::ios::binary);
   // Read in chunks up to the limit, so that /dev/zero as the scene file cannot exhaust memory.
   std::string text;
   std::array<char, 1 << 16> chunk;

@@ -48,6 +48,10 @@ constexpr Quantity full_turn(std::string_view path) {  // a turn either way
 constexpr Quantity distance(std::string_view path) {
   return {path, QuantityKind::kLength, 0.01, 1000};
 }
+// A coordinate of a point: within a kilometre of the turntable's centre, as distances are.
+constexpr Quantity position(std::string_view path) {
+  return {path, QuantityKind::kLength, -1000, 1000};
+}
 
 inline constexpr Integer kLanguageVersion{"rigc", 1, 1};
 // The scene's name is a folder of the default run path (out/<name>/<backend>).
@@ -66,6 +70,8 @@ inline constexpr Integer kPatternSeed{"object.surface.seed", 0, 1 << 30};
 inline constexpr Quantity kColor = unit_interval("object.surface.color");
 inline constexpr Quantity kRoughness = unit_interval("object.surface.roughness");
 inline constexpr Quantity kMetallic = unit_interval("object.surface.metallic");
+inline constexpr Quantity kRotate = full_turn("object.rotate");
+inline constexpr Quantity kTranslate = position("object.translate");
 }  // namespace object
 
 namespace studio {
@@ -95,6 +101,8 @@ inline constexpr Quantity kSpotAngle{"studio.lights.angle", QuantityKind::kAngle
 inline constexpr Quantity kSpotBlend = unit_interval("studio.lights.blend");
 inline constexpr Quantity kAmbient{"studio.ambient", QuantityKind::kIlluminance, 0, 200000};
 inline constexpr Quantity kFloorColor = unit_interval("studio.floor.color");
+inline constexpr Quantity kLightPosition = position("studio.lights.position");
+inline constexpr Quantity kLightLookAt = position("studio.lights.look_at");
 }  // namespace studio
 
 namespace camera {
@@ -138,6 +146,10 @@ inline constexpr Quantity kRingElevation{"shots.orbit.rings.elevation", Quantity
 inline constexpr Integer kRingCount{"shots.orbit.rings.count", 1, 3600};
 inline constexpr Quantity kRingStart = full_turn("shots.orbit.rings.start");
 inline constexpr Quantity kPoseTurntable = full_turn("shots.pose.turntable");
+inline constexpr Quantity kTurntableCameraAim = position("shots.turntable.camera.aim");
+inline constexpr Quantity kOrbitAim = position("shots.orbit.aim");
+inline constexpr Quantity kPosePosition = position("shots.pose.position");
+inline constexpr Quantity kPoseLookAt = position("shots.pose.look_at");
 }  // namespace shots
 
 namespace coverage {
@@ -165,6 +177,8 @@ inline constexpr std::array kQuantities = {
     object::kColor,
     object::kRoughness,
     object::kMetallic,
+    object::kRotate,
+    object::kTranslate,
     studio::kTurntableDiameter,
     studio::kTurntableHeight,
     studio::kTurntableThickness,
@@ -182,6 +196,8 @@ inline constexpr std::array kQuantities = {
     studio::kSpotBlend,
     studio::kAmbient,
     studio::kFloorColor,
+    studio::kLightPosition,
+    studio::kLightLookAt,
     camera::kSensorWidth,
     camera::kSensorHeight,
     camera::kFocalLength,
@@ -206,6 +222,10 @@ inline constexpr std::array kQuantities = {
     shots::kRingElevation,
     shots::kRingStart,
     shots::kPoseTurntable,
+    shots::kTurntableCameraAim,
+    shots::kOrbitAim,
+    shots::kPosePosition,
+    shots::kPoseLookAt,
     coverage::kMinPixelsPerMm2,
     coverage::kMaxViewAngle,
     coverage::kMaxBlur,

@@ -14,6 +14,7 @@
 #include "compiler/frontend.h"
 #include "compiler/limits.h"
 #include "ir/color.h"
+#include "ir/utf8_text.h"
 
 namespace rigc {
 namespace {
@@ -81,7 +82,8 @@ class Lowering {
   std::optional<ir::Scene> run() {
     scene_.language_version = spec_.version;
     scene_.name = spec_.name;
-    scene_.source_file = spec_.source_file;
+    // The manifest and the IR are JSON: a file name that is not UTF-8 is kept readable instead.
+    scene_.source_file = valid_utf8_text(spec_.source_file);
     scene_.studio = spec_.studio;
     scene_.camera = spec_.camera;
     scene_.coverage = spec_.coverage;

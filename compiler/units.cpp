@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <utility>
@@ -39,19 +41,18 @@ const std::vector<UnitDef>& unit_table() {
   return table;
 }
 
-// Splits "12.5cm" into 12.5 and "cm"; returns false if there is no leading number.
+// Splits "12.5cm" into 12.5 and "cm"; returns false if there is no leading decimal number.
+// std::from_chars, unlike std::stod, reads no hexadecimal: "0x10cm" would be 0x10c metres.
 bool split_number(const std::string& text, double* number, std::string* unit) {
-  size_t pos = 0;
-  try {
-    *number = std::stod(text, &pos);
-  } catch (...) {
-    return false;
-  }
-  // std::stod accepts "inf" and "nan": a quantity must be a finite number.
-  if (!std::isfinite(*number)) return false;
-  std::string rest = text.substr(pos);
-  size_t first = rest.find_first_not_of(" \t");
-  *unit = first == std::string::npos ? "" : rest.substr(first);
+  const char* first = text.data() + std::min(text.find_first_not_of(" \t"), text.size());
+  const char* last = text.data() + text.size();
+  if (first != last && *first == '+' && last - first > 1 && first[1] != '-') ++first;
+  const auto [end, error] = std::from_chars(first, last, *number, std::chars_format::general);
+  // from_chars accepts "inf" and "nan": a quantity must be a finite number.
+  if (error != std::errc() || !std::isfinite(*number)) return false;
+  std::string rest(end, last);
+  size_t start = rest.find_first_not_of(" \t");
+  *unit = start == std::string::npos ? "" : rest.substr(start);
   return true;
 }
 
@@ -175,6 +176,7 @@ QuantityParse parse_quantity(const std::string& raw, QuantityKind kind) {
         return fail(expected);
       }
       if (denominator == 0) return fail(fmt::format("division by zero in '{}'", text));
+      if (!std::isfinite(numerator / denominator)) return fail(expected);
       result.value = numerator / denominator;
       return result;
     }
@@ -195,6 +197,7 @@ QuantityParse parse_quantity(const std::string& raw, QuantityKind kind) {
       return fail(fmt::format("'{}' is {}, expected {} ({})", text, kind_description(def.kind),
                               kind_description(kind), kind_units(kind)));
     }
+    if (!std::isfinite(number * def.to_si)) return fail(expected);
     result.value = number * def.to_si;
     return result;
   }

@@ -69,6 +69,24 @@ TEST(Units, GarbageIsRejected) {
   EXPECT_FALSE(parse_quantity("", QuantityKind::kNumber).value);
 }
 
+// std::stod read "0x10cm" as 0x10c = 268 metres; a quantity is a decimal number.
+TEST(Units, HexadecimalIsNotANumber) {
+  EXPECT_FALSE(parse_quantity("0x10cm", QuantityKind::kLength).value);
+  EXPECT_FALSE(parse_quantity("0x10", QuantityKind::kNumber).value);
+  EXPECT_FALSE(parse_quantity("0x1p3", QuantityKind::kNumber).value);
+  EXPECT_DOUBLE_EQ(parse_ok("+2.5e1cm", QuantityKind::kLength), 0.25);
+  EXPECT_DOUBLE_EQ(parse_ok(" 3 m", QuantityKind::kLength), 3);
+  EXPECT_DOUBLE_EQ(parse_ok("1 / 125", QuantityKind::kTime), 1.0 / 125);
+  EXPECT_FALSE(parse_quantity("+-3", QuantityKind::kNumber).value);
+}
+
+// A finite number whose unit makes it overflow is rejected like "inf".
+TEST(Units, OverflowAfterTheUnitIsRejected) {
+  EXPECT_FALSE(parse_quantity("1e308kW", QuantityKind::kPower).value);
+  EXPECT_FALSE(parse_quantity("1e400", QuantityKind::kNumber).value);
+  EXPECT_FALSE(parse_quantity("1e308/1e-308", QuantityKind::kTime).value);
+}
+
 TEST(Units, FormatsForMessages) {
   EXPECT_EQ(format_quantity(0.8, QuantityKind::kLength), "80cm");
   EXPECT_EQ(format_quantity(0.002, QuantityKind::kLength), "2mm");

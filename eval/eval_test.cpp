@@ -485,9 +485,8 @@ TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
   const EvalOptions o = photos_without_colmap(dir);
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1) << log.str();
-  EXPECT_NE(log.str().find("cannot read the pixels of"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("b.png"), std::string::npos) << log.str();
-  EXPECT_TRUE(fs::exists(dir.path() / "eval" / "colmap" / "images_8bit" / "a.png"));
+  // The pre-check reads each photo's last row, so broken pixels are named before any conversion.
+  EXPECT_NE(log.str().find("b.png: cannot be decoded"), std::string::npos) << log.str();
 }
 
 }  // namespace

@@ -47,21 +47,58 @@ std::vector<std::string> list_images(const fs::path& dir) {
   return names;
 }
 
-// Every image's header, read before COLMAP runs: its feature extractor only logs a file it cannot
-// read, and its matcher then aborts without naming the file. False with `error` listing the
-// unreadable ones.
-bool read_headers(ImageSet& set, std::string* error) {
-  std::vector<std::string> unreadable;
-  for (const auto& name : set.names) {
-    if (auto input = OIIO::ImageInput::open((set.dir / name).string())) {
-      const OIIO::ImageSpec& spec = input->spec();
-      set.size[name] = {spec.width, spec.height};
-      if (spec.format != OIIO::TypeDesc::UINT8) set.wider_than_eight_bit.insert(name);
-      continue;
-    }
+// A photo larger than this is refused from its header: COLMAP decodes each image whole (a header
+// claiming 60000 x 60000 pixels made it allocate 10.5 GB and abort). A 150 MP medium-format frame
+// is well inside.
+constexpr double kMostPhotoPixels = 250e6;
+
+// Why OIIO cannot read the last row of an open image, or "": a file whose header is intact but
+// whose pixel data is missing or cut short. Raw photos are developed (and checked) later.
+std::string last_row_problem(OIIO::ImageInput& input, const fs::path& path) {
+  const OIIO::ImageSpec& spec = input.spec();
+  if (is_raw_photo(path) || spec.tile_width > 0) return "";
+  std::vector<float> row(static_cast<std::size_t>(spec.width) * spec.nchannels);
+  if (input.read_scanline(spec.y + spec.height - 1, 0, OIIO::TypeDesc::FLOAT, row.data())) {
+    return "";
+  }
+  std::string why = input.geterror();
+  std::replace(why.begin(), why.end(), '\n', ' ');
+  return fmt::format("cannot be decoded ({})", why.empty() ? "its pixel data is cut short" : why);
+}
+
+// Why the image at `path` cannot go to COLMAP, or "" with its size set in `set`. `decode` also
+// reads its last row, for photos that rigc did not write itself.
+std::string image_problem(ImageSet& set, const std::string& name, bool decode) {
+  const fs::path path = set.dir / name;
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) {
     std::string why = OIIO::geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
-    unreadable.push_back(fmt::format("{}: {}", (set.dir / name).string(), why));
+    return why;
+  }
+  const OIIO::ImageSpec& spec = input->spec();
+  if (static_cast<double>(spec.width) * spec.height > kMostPhotoPixels) {
+    return fmt::format(
+        "its header says {} x {} pixels, more than the {:.0f} megapixels a photo "
+        "may have",
+        spec.width, spec.height, kMostPhotoPixels / 1e6);
+  }
+  if (decode) {
+    if (std::string problem = last_row_problem(*input, path); !problem.empty()) return problem;
+  }
+  set.size[name] = {spec.width, spec.height};
+  if (spec.format != OIIO::TypeDesc::UINT8) set.wider_than_eight_bit.insert(name);
+  return "";
+}
+
+// Every image's header (and for photos its data), read before COLMAP runs: its feature extractor
+// only logs a file it cannot read, its matcher then aborts without naming the file, and a header
+// claiming gigapixels exhausts memory. False with `error` listing the unreadable ones.
+bool read_headers(ImageSet& set, bool decode, std::string* error) {
+  std::vector<std::string> unreadable;
+  for (const auto& name : set.names) {
+    const std::string why = image_problem(set, name, decode);
+    if (!why.empty()) unreadable.push_back(fmt::format("{}: {}", (set.dir / name).string(), why));
   }
   if (unreadable.empty()) return true;
   *error =
@@ -97,7 +134,7 @@ std::optional<ImageSet> find_images(const fs::path& run_dir, bool photos, std::s
         fmt::format("{} has {} image(s); SfM needs at least 2", set.dir.string(), set.names.size());
     return std::nullopt;
   }
-  if (!read_headers(set, error)) return std::nullopt;
+  if (!read_headers(set, photos, error)) return std::nullopt;
   return set;
 }
 

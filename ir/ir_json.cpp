@@ -1,5 +1,7 @@
 #include "ir/ir_json.h"
 
+#include "ir/utf8_text.h"
+
 namespace rigc {
 namespace {
 
@@ -247,6 +249,26 @@ json coverage_json(const ir::CoverageSettings& cov) {
           {"min_frame_fill", cov.min_frame_fill}};
 }
 
+// Replaces the bytes of every key and string under `node` that are not UTF-8: the IR's file names
+// and material names come from the file system and from MTL files, and json::dump throws on them.
+void make_text_valid_utf8(json& node) {
+  if (node.is_string()) {
+    std::string& text = node.get_ref<std::string&>();
+    if (!valid_utf8(text)) text = valid_utf8_text(text);
+  } else if (node.is_array()) {
+    for (auto& item : node) {
+      if (!item.is_primitive() || item.is_string()) make_text_valid_utf8(item);
+    }
+  } else if (node.is_object()) {
+    json fixed = json::object();
+    for (auto& [key, value] : node.items()) {
+      make_text_valid_utf8(value);
+      fixed[valid_utf8_text(key)] = std::move(value);
+    }
+    node = std::move(fixed);
+  }
+}
+
 }  // namespace
 
 json ir_to_json(const ir::Scene& scene, bool include_geometry) {
@@ -266,6 +288,7 @@ json ir_to_json(const ir::Scene& scene, bool include_geometry) {
   out["camera"] = camera_json(scene.camera);
   out["shots"] = shots_json(scene.shots);
   out["coverage"] = coverage_json(scene.coverage);
+  make_text_valid_utf8(out);
   return out;
 }
 
