@@ -13,7 +13,7 @@
 
 #include "io/child_processes.h"
 #include "studio/server.h"
-#include "studio/studio_test_scene.h"
+#include "studio/studio_test_server.h"
 #include "tests/test_support.h"
 
 namespace rigc::studio {
@@ -21,28 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class StudioReference : public ::testing::Test {
+class StudioReference : public StudioServerTest {
  protected:
-  void SetUp() override {
-    scene_file_ = dir_.path() / "scene.yaml";
-    std::ofstream(scene_file_) << kStudioTestScene;
-    std::string error;
-    session_ = Session::open(scene_file_, &error, dir_.path() / "run");
-    ASSERT_TRUE(session_) << error;
-    server_ = std::make_unique<StudioServer>(*session_, ServerOptions{});
-    const int port = server_->bind(&error);
-    ASSERT_GT(port, 0) << error;
-    thread_ = std::thread([this] { server_->run(); });
-    while (!server_->is_running()) std::this_thread::yield();
-    client_ = std::make_unique<httplib::Client>("127.0.0.1", port);
-    client_->set_read_timeout(60);
-    client_->set_default_headers({{"X-Rigc-Token", server_->token()}});
-  }
-  void TearDown() override {
-    if (server_) server_->stop();
-    if (thread_.joinable()) thread_.join();
-  }
-
   httplib::Result start(const std::string& backend, int width) {
     return client_->Post("/api/reference",
                          nlohmann::json{{"backend", backend}, {"width", width}}.dump(),
@@ -58,13 +38,6 @@ class StudioReference : public ::testing::Test {
     } while (status["state"] == "running" && std::chrono::steady_clock::now() < until);
     return status;
   }
-
-  testing::TempDir dir_;
-  fs::path scene_file_;
-  std::unique_ptr<Session> session_;
-  std::unique_ptr<StudioServer> server_;
-  std::thread thread_;
-  std::unique_ptr<httplib::Client> client_;
 };
 
 TEST_F(StudioReference, PovrayRendersTheViewBesideThePreviewWhileTheLiveViewGoesOn) {

@@ -12,7 +12,7 @@
 
 #include "analysis/coverage.h"
 #include "compiler/frontend.h"
-#include "studio/studio_test_scene.h"
+#include "studio/studio_test_server.h"
 #include "tests/test_support.h"
 
 namespace rigc::studio {
@@ -25,28 +25,8 @@ std::string read(const std::filesystem::path& path) {
   return text.str();
 }
 
-class StudioApi : public ::testing::Test {
+class StudioApi : public StudioServerTest {
  protected:
-  void SetUp() override {
-    scene_file_ = dir_.path() / "scene.yaml";
-    std::ofstream(scene_file_) << kStudioTestScene;
-    std::string error;
-    session_ = Session::open(scene_file_, &error, dir_.path() / "run");
-    ASSERT_TRUE(session_) << error;
-    server_ = std::make_unique<StudioServer>(*session_, ServerOptions{});
-    const int port = server_->bind(&error);
-    ASSERT_GT(port, 0) << error;
-    thread_ = std::thread([this] { server_->run(); });
-    while (!server_->is_running()) std::this_thread::yield();
-    client_ = std::make_unique<httplib::Client>("127.0.0.1", port);
-    client_->set_read_timeout(60);
-    client_->set_default_headers({{"X-Rigc-Token", server_->token()}});
-  }
-  void TearDown() override {
-    if (server_) server_->stop();
-    if (thread_.joinable()) thread_.join();
-  }
-
   nlohmann::json state() {
     const auto res = client_->Get("/api/state");
     EXPECT_TRUE(res && res->status == 200);
@@ -60,13 +40,6 @@ class StudioApi : public ::testing::Test {
     EXPECT_TRUE(res && res->status == 200);
     return std::stod(res->get_header_value("X-Rigc-Mean"));
   }
-
-  testing::TempDir dir_;
-  std::filesystem::path scene_file_;
-  std::unique_ptr<Session> session_;
-  std::unique_ptr<StudioServer> server_;
-  std::thread thread_;
-  std::unique_ptr<httplib::Client> client_;
 };
 
 TEST_F(StudioApi, FrameIsAJpegOfTheRequestedWidthWithItsHistogram) {
