@@ -7,8 +7,8 @@
 
 namespace rigc {
 
-// `include_geometry` = false leaves out vertex and triangle arrays (for summaries). Text that is not
-// UTF-8 (a file or material name) has its stray bytes replaced by U+FFFD.
+// `include_geometry` = false leaves out vertex and triangle arrays (for summaries). Text that is
+// not UTF-8 (a file or material name) has its stray bytes replaced by U+FFFD.
 nlohmann::json ir_to_json(const ir::Scene& scene, bool include_geometry = true);
 
 }  // namespace rigc
