@@ -6,6 +6,8 @@
 #include <open3d/io/PointCloudIO.h>
 #include <open3d/io/TriangleMeshIO.h>
 #include <open3d/utility/Logging.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <bit>
@@ -156,39 +158,60 @@ std::optional<PlyCloudLayout> ply_cloud_layout(std::istream& in) {
   return layout;
 }
 
+// The point of one binary PLY vertex record.
+Vec3 ply_record_point(const char* record, const PlyCloudLayout& layout) {
+  Vec3 p;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (layout.is_double[axis]) {
+      std::memcpy(&p[axis], record + layout.offset[axis], sizeof(double));
+    } else {
+      float f;
+      std::memcpy(&f, record + layout.offset[axis], sizeof(float));
+      p[axis] = f;
+    }
+  }
+  return p;
+}
+
 // Binary little-endian PLY clouds read straight from the file (Open3D's reader calls back per
-// value: 11 s for 5M points). nullopt for any other PLY (then Open3D reads it); false with
-// `error` for a file cut short.
+// value: 11 s for 5M points), in chunks converted in parallel. nullopt for any other PLY (then
+// Open3D reads it); false with `error` for a file cut short.
 std::optional<bool> read_binary_ply_cloud(const fs::path& path, ReconstructionGeometry& g,
                                           std::string* error) {
   if constexpr (std::endian::native != std::endian::little) return std::nullopt;
   std::ifstream in(path, std::ios::binary);
   const auto layout = ply_cloud_layout(in);
   if (!layout || layout->count == 0) return std::nullopt;
-  std::vector<char> data(layout->count * layout->stride);
-  if (!in.read(data.data(), static_cast<std::streamsize>(data.size()))) {
+  // A header may claim more points than the file holds: check before allocating for them.
+  std::error_code ec;
+  const auto file_size = fs::file_size(path, ec);
+  const auto header_size = static_cast<std::uintmax_t>(in.tellg());
+  if (ec || layout->count > (file_size - header_size) / layout->stride) {
     *error = fmt::format("holds fewer than the {} points its header announces", layout->count);
     return false;
   }
-  g.points.reserve(layout->count);
-  for (std::size_t i = 0; i < layout->count; ++i) {
-    const char* record = data.data() + i * layout->stride;
-    Vec3 p;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (layout->is_double[axis]) {
-        std::memcpy(&p[axis], record + layout->offset[axis], sizeof(double));
-      } else {
-        float f;
-        std::memcpy(&f, record + layout->offset[axis], sizeof(float));
-        p[axis] = f;
-      }
+  const std::size_t chunk = std::max<std::size_t>(1, (8 << 20) / layout->stride);
+  std::vector<char> data(std::min(layout->count, chunk) * layout->stride);
+  g.points.resize(layout->count);
+  for (std::size_t first = 0; first < layout->count; first += chunk) {
+    const std::size_t n = std::min(chunk, layout->count - first);
+    if (!in.read(data.data(), static_cast<std::streamsize>(n * layout->stride))) {
+      *error = fmt::format("holds fewer than the {} points its header announces", layout->count);
+      g.points.clear();
+      return false;
     }
-    if (p.allFinite()) {
-      g.points.push_back(p);
-    } else {
-      ++g.dropped;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                          g.points[first + i] =
+                              ply_record_point(data.data() + i * layout->stride, *layout);
+                        }
+                      });
   }
+  const auto finite_end = std::remove_if(g.points.begin(), g.points.end(),
+                                         [](const Vec3& p) { return !p.allFinite(); });
+  g.dropped = static_cast<std::size_t>(g.points.end() - finite_end);
+  g.points.erase(finite_end, g.points.end());
   g.has_colors = layout->colors;
   g.has_normals = layout->normals;
   if (g.points.empty()) *error = "holds no finite point";

@@ -6,6 +6,7 @@
 #include <open3d/io/PointCloudIO.h>
 #include <open3d/io/TriangleMeshIO.h>
 
+#include <cmath>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -235,6 +236,26 @@ TEST(EvalReconstruction, LoadsMeshesAndCloudsInEveryFormat) {
   rigc::testing::write_text(dir.file("cut.ply"), whole.substr(0, whole.size() - 100));
   EXPECT_FALSE(load_reconstruction(dir.file("cut.ply"), &error));
   EXPECT_NE(error.find("cut.ply: holds fewer than the 100 points"), std::string::npos) << error;
+  // A header that claims a trillion points is refused before anything is allocated for them.
+  rigc::testing::write_text(dir.file("huge.ply"),
+                            "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n"
+                            "property float x\nproperty float y\nproperty float z\nend_header\n" +
+                                std::string(120, '\0'));
+  EXPECT_FALSE(load_reconstruction(dir.file("huge.ply"), &error));
+  EXPECT_NE(error.find("holds fewer than the 1000000000000 points"), std::string::npos) << error;
+  // Non-finite points are left out and counted.
+  std::string nan_cloud =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  for (float v : {0.1f, 0.2f, 0.3f, std::nanf(""), 0.f, 0.f, 0.4f, 0.5f, 0.6f}) {
+    nan_cloud.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  rigc::testing::write_text(dir.file("nan.ply"), nan_cloud);
+  const auto with_nan = load_reconstruction(dir.file("nan.ply"), &error);
+  ASSERT_TRUE(with_nan) << error;
+  ASSERT_EQ(with_nan->points.size(), 2u);
+  EXPECT_EQ(with_nan->dropped, 1u);
+  EXPECT_NEAR(with_nan->points[1].z(), 0.6, 1e-6);
   // Bad files: named, never a crash.
   rigc::testing::write_text(dir.file("junk.ply"), "ply\nnot really\n");
   EXPECT_FALSE(load_reconstruction(dir.file("junk.ply"), &error));
