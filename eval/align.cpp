@@ -22,6 +22,45 @@ Eigen::AlignedBox3d object_crop(const Surface& surface) {
   return crop;
 }
 
+std::vector<std::size_t> indices_inside(const std::vector<Vec3>& points,
+                                        const Eigen::AlignedBox3d& box) {
+  const std::size_t block = 1 << 16;
+  std::vector<std::vector<std::size_t>> per_block((points.size() + block - 1) / block);
+  tbb::parallel_for(std::size_t{0}, per_block.size(), [&](std::size_t b) {
+    for (std::size_t i = b * block; i < std::min(points.size(), (b + 1) * block); ++i) {
+      if (box.contains(points[i])) per_block[b].push_back(i);
+    }
+  });
+  std::vector<std::size_t> inside;
+  for (const auto& indices : per_block) inside.insert(inside.end(), indices.begin(), indices.end());
+  return inside;
+}
+
+std::vector<Vec3> gather(const std::vector<Vec3>& points, const std::vector<std::size_t>& indices) {
+  std::vector<Vec3> out(indices.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, indices.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        out[k] = points[indices[k]];
+                      }
+                    });
+  return out;
+}
+
+namespace {
+
+// Applies `s` to every point, in parallel.
+void apply_in_place(const Similarity& s, std::vector<Vec3>& points) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        points[i] = s.apply(points[i]);
+                      }
+                    });
+}
+
+}  // namespace
+
 Vec3 camera_centre(const Mat4& camera_from_world) {
   return -camera_from_world.topLeftCorner<3, 3>().transpose() *
          camera_from_world.topRightCorner<3, 1>();
@@ -256,12 +295,15 @@ class Aligner {
   // Point-to-plane ICP of the points near the object onto the visible samples (all samples when
   // none is visible), applied when it found correspondences for 30 % of them.
   void refine_with_icp() {
+    // ICP needs no more than 100k points to settle a rigid transform: every nth point near the
+    // object.
+    const std::vector<std::size_t> near_object = indices_inside(a_.points, crop_);
+    const std::size_t limit = 100000;
+    const std::size_t stride = std::max<std::size_t>(1, (near_object.size() + limit - 1) / limit);
     std::vector<Vec3> inside;
-    for (const auto& p : a_.points) {
-      if (crop_.contains(p)) inside.push_back(p);
+    for (std::size_t k = 0; k < near_object.size(); k += stride) {
+      inside.push_back(a_.points[near_object[k]]);
     }
-    // ICP needs no more than 100k points to settle a rigid transform.
-    inside = every_nth(inside, 100000);
     const SurfaceSamples& s = a_.samples;
     const bool none_visible = s.visible.empty();
     const std::vector<Vec3>& target = none_visible ? s.all : s.visible;
@@ -273,8 +315,9 @@ class Aligner {
               {"translation_change_mm", icp.transform.topRightCorner<3, 1>().norm() * 1000},
               {"rotation_change_deg", rotation_angle_deg(icp.transform.topLeftCorner<3, 3>())}};
     if (icp.fitness >= 0.3) {
-      a_.transform = Similarity::from_matrix(icp.transform) * a_.transform;
-      for (auto& p : a_.points) p = Similarity::from_matrix(icp.transform).apply(p);
+      const Similarity step = Similarity::from_matrix(icp.transform);
+      a_.transform = step * a_.transform;
+      apply_in_place(step, a_.points);
       j["applied"] = true;
     } else {
       j["applied"] = false;

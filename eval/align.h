@@ -52,6 +52,13 @@ Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& m
 // (reconstructed points beyond it are background).
 Eigen::AlignedBox3d object_crop(const Surface& surface);
 
+// Indices of the `points` inside `box`, in order (filtered in parallel: clouds of millions).
+std::vector<std::size_t> indices_inside(const std::vector<Vec3>& points,
+                                        const Eigen::AlignedBox3d& box);
+
+// points[indices[k]] for every k, in parallel.
+std::vector<Vec3> gather(const std::vector<Vec3>& points, const std::vector<std::size_t>& indices);
+
 // Where a camera of pose camera_from_world is, in the world.
 Vec3 camera_centre(const Mat4& camera_from_world);
 double rotation_angle_deg(const Eigen::Matrix3d& r);

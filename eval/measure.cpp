@@ -77,13 +77,10 @@ class Measurer {
   // The points inside object_crop, and with --poisson for each the mean centre of the cameras
   // observing it (Poisson orients its normals towards them).
   void keep_points_near_object() {
-    const Eigen::AlignedBox3d crop = object_crop(surface_);
-    const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
-    m_.points.reserve(a_.points.size());
-    for (std::size_t i = 0; i < a_.points.size(); ++i) {
-      if (!crop.contains(a_.points[i])) continue;
-      m_.points.push_back(a_.points[i]);
-      if (tracks) view_points_.push_back(mean_observer(model_.points[i]));
+    const std::vector<std::size_t> inside = indices_inside(a_.points, object_crop(surface_));
+    m_.points = gather(a_.points, inside);
+    if (o_.poisson && model_.points.size() == a_.points.size()) {
+      for (std::size_t i : inside) view_points_.push_back(mean_observer(model_.points[i]));
     }
   }
 
