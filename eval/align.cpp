@@ -22,29 +22,35 @@ Eigen::AlignedBox3d object_crop(const Surface& surface) {
   return crop;
 }
 
-std::vector<std::size_t> indices_inside(const std::vector<Vec3>& points,
-                                        const Eigen::AlignedBox3d& box) {
-  const std::size_t block = 1 << 16;
-  std::vector<std::vector<std::size_t>> per_block((points.size() + block - 1) / block);
-  tbb::parallel_for(std::size_t{0}, per_block.size(), [&](std::size_t b) {
+std::vector<Vec3> points_inside(const std::vector<Vec3>& points, const Eigen::AlignedBox3d& box,
+                                std::size_t limit, std::vector<std::size_t>* indices) {
+  // Counted per block first, so that each block writes its share straight into the output.
+  const std::size_t block = 1 << 16, blocks = (points.size() + block - 1) / block;
+  std::vector<std::size_t> first_rank(blocks + 1, 0);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    std::size_t n = 0;
     for (std::size_t i = b * block; i < std::min(points.size(), (b + 1) * block); ++i) {
-      if (box.contains(points[i])) per_block[b].push_back(i);
+      n += box.contains(points[i]);
+    }
+    first_rank[b + 1] = n;
+  });
+  for (std::size_t b = 0; b < blocks; ++b) first_rank[b + 1] += first_rank[b];
+  const std::size_t inside = first_rank[blocks];
+  const std::size_t stride = inside <= limit ? 1 : (inside + limit - 1) / limit;
+  std::vector<Vec3> kept((inside + stride - 1) / stride);
+  if (indices) indices->assign(kept.size(), 0);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    std::size_t rank = first_rank[b];
+    for (std::size_t i = b * block; i < std::min(points.size(), (b + 1) * block); ++i) {
+      if (!box.contains(points[i])) continue;
+      if (rank % stride == 0) {
+        kept[rank / stride] = points[i];
+        if (indices) (*indices)[rank / stride] = i;
+      }
+      ++rank;
     }
   });
-  std::vector<std::size_t> inside;
-  for (const auto& indices : per_block) inside.insert(inside.end(), indices.begin(), indices.end());
-  return inside;
-}
-
-std::vector<Vec3> gather(const std::vector<Vec3>& points, const std::vector<std::size_t>& indices) {
-  std::vector<Vec3> out(indices.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, indices.size(), 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
-                        out[k] = points[indices[k]];
-                      }
-                    });
-  return out;
+  return kept;
 }
 
 namespace {
@@ -295,15 +301,8 @@ class Aligner {
   // Point-to-plane ICP of the points near the object onto the visible samples (all samples when
   // none is visible), applied when it found correspondences for 30 % of them.
   void refine_with_icp() {
-    // ICP needs no more than 100k points to settle a rigid transform: every nth point near the
-    // object.
-    const std::vector<std::size_t> near_object = indices_inside(a_.points, crop_);
-    const std::size_t limit = 100000;
-    const std::size_t stride = std::max<std::size_t>(1, (near_object.size() + limit - 1) / limit);
-    std::vector<Vec3> inside;
-    for (std::size_t k = 0; k < near_object.size(); k += stride) {
-      inside.push_back(a_.points[near_object[k]]);
-    }
+    // ICP needs no more than 100k points near the object to settle a rigid transform.
+    const std::vector<Vec3> inside = points_inside(a_.points, crop_, 100000);
     const SurfaceSamples& s = a_.samples;
     const bool none_visible = s.visible.empty();
     const std::vector<Vec3>& target = none_visible ? s.all : s.visible;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -52,12 +53,12 @@ Alignment align_to_ground_truth(const EvalOptions& options, const SparseModel& m
 // (reconstructed points beyond it are background).
 Eigen::AlignedBox3d object_crop(const Surface& surface);
 
-// Indices of the `points` inside `box`, in order (filtered in parallel: clouds of millions).
-std::vector<std::size_t> indices_inside(const std::vector<Vec3>& points,
-                                        const Eigen::AlignedBox3d& box);
-
-// points[indices[k]] for every k, in parallel.
-std::vector<Vec3> gather(const std::vector<Vec3>& points, const std::vector<std::size_t>& indices);
+// The `points` inside `box`, in order, filtered in parallel (clouds of millions). With more than
+// `limit` inside, every nth of them so that at most `limit` are kept. `indices`, when given, gets
+// each kept point's index in `points`.
+std::vector<Vec3> points_inside(const std::vector<Vec3>& points, const Eigen::AlignedBox3d& box,
+                                std::size_t limit = std::numeric_limits<std::size_t>::max(),
+                                std::vector<std::size_t>* indices = nullptr);
 
 // Where a camera of pose camera_from_world is, in the world.
 Vec3 camera_centre(const Mat4& camera_from_world);

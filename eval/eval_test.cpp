@@ -17,6 +17,7 @@
 
 #include "assets/mesh_io.h"
 #include "compiler/frontend.h"
+#include "eval/align.h"
 #include "eval/colmap.h"
 #include "eval/eval_test_support.h"
 #include "eval/geometry.h"
@@ -59,6 +60,33 @@ TEST(EvalAlign, RansacRecoversKnownSimilarityDespiteOutliers) {
   EXPECT_NEAR(id.scale, 1, 1e-12);
   EXPECT_LT((id.apply(Vec3(1, 2, 3)) - Vec3(1, 2, 3)).norm(), 1e-9);
   EXPECT_LT((Similarity::from_matrix(truth.matrix()).matrix() - truth.matrix()).norm(), 1e-12);
+}
+
+TEST(EvalAlign, PointsInsideKeepsTheSerialFiltersPointsInOrder) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Vec3> points(300000);
+  for (auto& p : points) p = Vec3(u(rng), u(rng), u(rng));
+  const Eigen::AlignedBox3d box(Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5));
+  std::vector<Vec3> inside;
+  std::vector<std::size_t> inside_index;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (box.contains(points[i])) {
+      inside.push_back(points[i]);
+      inside_index.push_back(i);
+    }
+  }
+  ASSERT_GT(inside.size(), 30000u);
+  std::vector<std::size_t> indices;
+  EXPECT_EQ(points_inside(points, box, std::numeric_limits<std::size_t>::max(), &indices), inside);
+  EXPECT_EQ(indices, inside_index);
+  // A limit keeps every nth, from the first.
+  const std::size_t stride = (inside.size() + 9999) / 10000;
+  const std::vector<Vec3> strided = points_inside(points, box, 10000);
+  ASSERT_EQ(strided.size(), (inside.size() + stride - 1) / stride);
+  EXPECT_LE(strided.size(), 10000u);
+  for (std::size_t k = 0; k < strided.size(); ++k) EXPECT_EQ(strided[k], inside[k * stride]);
+  EXPECT_TRUE(points_inside({}, box).empty());
 }
 
 TEST(EvalAlign, TooFewPairsIsNoAlignment) {

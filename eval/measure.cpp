@@ -77,11 +77,11 @@ class Measurer {
   // The points inside object_crop, and with --poisson for each the mean centre of the cameras
   // observing it (Poisson orients its normals towards them).
   void keep_points_near_object() {
-    const std::vector<std::size_t> inside = indices_inside(a_.points, object_crop(surface_));
-    m_.points = gather(a_.points, inside);
-    if (o_.poisson && model_.points.size() == a_.points.size()) {
-      for (std::size_t i : inside) view_points_.push_back(mean_observer(model_.points[i]));
-    }
+    const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
+    std::vector<std::size_t> kept;
+    m_.points = points_inside(a_.points, object_crop(surface_),
+                              std::numeric_limits<std::size_t>::max(), tracks ? &kept : nullptr);
+    for (std::size_t i : kept) view_points_.push_back(mean_observer(model_.points[i]));
   }
 
   // Where a point was seen from: the mean centre of its track's cameras (aligned), or above the
