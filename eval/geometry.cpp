@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <nanoflann.hpp>
 #include <random>
@@ -576,10 +577,11 @@ std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
 
 namespace {
 
-// nanoflann's view of a point vector (no copy).
+// nanoflann's view of a span of a point vector (no copy).
 struct CloudAdaptor {
-  const std::vector<Vec3>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
+  const Vec3* points;
+  std::size_t count;
+  std::size_t kdtree_get_point_count() const { return count; }
   double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][axis]; }
   template <class Box>
   bool kdtree_get_bbox(Box&) const {
@@ -587,27 +589,43 @@ struct CloudAdaptor {
   }
 };
 
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>,
+                                        CloudAdaptor, 3, std::size_t>;
+
 }  // namespace
 
 std::vector<double> nearest_distances(const std::vector<Vec3>& queries,
                                       const std::vector<Vec3>& cloud) {
   std::vector<double> out(queries.size(), std::numeric_limits<double>::infinity());
   if (cloud.empty() || queries.empty()) return out;
-  using KdTree =
-      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>,
-                                          CloudAdaptor, 3, std::size_t>;
-  const CloudAdaptor adaptor{cloud};
-  const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(20));  // builds
-  // Queries are const on the tree; each writes only its own entry.
+  // nanoflann builds a tree on one thread: large clouds get one tree per part, built side by
+  // side, and each query takes the nearest of the parts' answers (the same distance).
+  const std::size_t parts = std::clamp<std::size_t>(cloud.size() / 500000, 1, 8);
+  const std::size_t part_size = (cloud.size() + parts - 1) / parts;
+  std::vector<CloudAdaptor> adaptors;
+  for (std::size_t first = 0; first < cloud.size(); first += part_size) {
+    adaptors.push_back({cloud.data() + first, std::min(part_size, cloud.size() - first)});
+  }
+  std::vector<std::unique_ptr<KdTree>> trees(adaptors.size());
+  tbb::parallel_for(std::size_t{0}, adaptors.size(), [&](std::size_t k) {
+    trees[k] = std::make_unique<KdTree>(3, adaptors[k],
+                                        nanoflann::KDTreeSingleIndexAdaptorParams(20));  // builds
+  });
+  // Queries are const on the trees; each writes only its own entry.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                        std::size_t nearest = 0;
-                        double squared = 0;
-                        nanoflann::KNNResultSet<double, std::size_t> result(1);
-                        result.init(&nearest, &squared);
-                        tree.findNeighbors(result, queries[i].data(), nanoflann::SearchParams());
-                        out[i] = std::sqrt(squared);
+                        double best = std::numeric_limits<double>::infinity();
+                        for (const auto& tree : trees) {
+                          std::size_t nearest = 0;
+                          double squared = 0;
+                          nanoflann::KNNResultSet<double, std::size_t> result(1);
+                          result.init(&nearest, &squared);
+                          tree->findNeighbors(result, queries[i].data(), nanoflann::SearchParams());
+                          best = std::min(best, squared);
+                        }
+                        out[i] = std::sqrt(best);
                       }
                     });
   return out;

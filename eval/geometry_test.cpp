@@ -91,13 +91,17 @@ TEST(EvalDistance, NearestDistancesMatchBruteForce) {
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<Vec3> queries, cloud;
   for (int i = 0; i < 300; ++i) queries.emplace_back(u(rng), u(rng), u(rng));
-  for (int i = 0; i < 2000; ++i) cloud.emplace_back(u(rng), u(rng), u(rng));
-  const std::vector<double> d = nearest_distances(queries, cloud);
-  ASSERT_EQ(d.size(), queries.size());
-  for (std::size_t i = 0; i < queries.size(); ++i) {
-    double best = std::numeric_limits<double>::infinity();
-    for (const Vec3& c : cloud) best = std::min(best, (queries[i] - c).norm());
-    EXPECT_DOUBLE_EQ(d[i], best);
+  // Small clouds get one tree; large ones a tree per part (here three), queried in turn.
+  for (const int cloud_size : {2000, 1600000}) {
+    cloud.clear();
+    for (int i = 0; i < cloud_size; ++i) cloud.emplace_back(u(rng), u(rng), u(rng));
+    const std::vector<double> d = nearest_distances(queries, cloud);
+    ASSERT_EQ(d.size(), queries.size());
+    for (std::size_t i = 0; i<queries.size(); i += cloud_size> 2000 ? 10 : 1) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const Vec3& c : cloud) best = std::min(best, (queries[i] - c).norm());
+      EXPECT_DOUBLE_EQ(d[i], best) << cloud_size;
+    }
   }
   EXPECT_TRUE(std::isinf(nearest_distances(queries, {}).front()));
 }
