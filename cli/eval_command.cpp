@@ -63,6 +63,10 @@ void add_eval_options(CLI::App& app, eval::EvalOptions& o) {
   app.add_option("--tau", o.tau_mm, "F-score distance threshold in mm")
       ->check(positive_number())
       ->capture_default_str();
+  app.add_option("--min-track", o.min_track_length,
+                 "measure only COLMAP points seen in at least this many images (2: all of them)")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
   app.add_option("--samples", o.ground_truth_samples,
                  "ground-truth surface samples before the visibility test")
       ->check(CLI::Range(1000, 20000000))

@@ -43,6 +43,10 @@ bool EvalOptions::check(std::string* error) const {
   if (!(std::isfinite(tau_mm) && tau_mm > 0)) {
     return refuse(fmt::format("the F-score threshold is {} mm; it must be positive", tau_mm));
   }
+  if (min_track_length < 2 || min_track_length > 1000) {
+    return refuse(fmt::format("the minimum track length is {}; it must be in 2 .. 1000 (images)",
+                              min_track_length));
+  }
   if (ground_truth_samples < 1) {
     return refuse(
         fmt::format("{} ground-truth samples; at least 1 is needed", ground_truth_samples));
@@ -130,9 +134,13 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);
   }
   const auto t_rigc = Clock::now();
-  const auto model = read_sparse_model(colmap.model_txt, &error);
+  auto model = read_sparse_model(colmap.model_txt, &error);
   if (!model) return report.fail("reconstruction", error, 2);
-  report.add_reconstruction(*model, colmap, o.quiet);
+  const std::size_t points_in_model = model->points.size();
+  std::erase_if(model->points, [&](const Point3D& p) {
+    return p.track_images.size() < static_cast<std::size_t>(o.min_track_length);
+  });
+  report.add_reconstruction(*model, colmap, points_in_model, o);
   std::set<std::string> registered;
   for (const auto& image : model->images) registered.insert(image.name);
   report.sections()["unregistered"] =

@@ -34,7 +34,10 @@ struct EvalOptions {
   bool icp = true;
   bool poisson = false;  // also mesh the points (Open3D's screened Poisson) and compare the mesh
   int poisson_depth = 9;
-  double tau_mm = 1.0;                // F-score threshold
+  double tau_mm = 1.0;  // F-score threshold
+  // COLMAP's points seen in fewer images are left out: a point triangulated from two views has
+  // no third to check it, and the rare false match among them lies centimetres off the surface.
+  int min_track_length = 3;
   int ground_truth_samples = 200000;  // surface samples before the visibility test
   double color_range_mm = 0;          // heat-map colour range; 0 = 3 x RMS of the distances
   bool quiet = false;

@@ -22,6 +22,7 @@
 #include "eval/eval_test_support.h"
 #include "eval/geometry.h"
 #include "eval/metrics.h"
+#include "eval/reconstruction_test_support.h"
 #include "run/manifest.h"
 #include "tests/test_support.h"
 
@@ -400,6 +401,54 @@ EvalOptions photos_without_colmap(const rigc::testing::TempDir& dir) {
 
 // COLMAP's extractor only logs a file it cannot read, and its matcher then aborts without naming
 // it: eval reads every image's header first and names the ones that fail.
+// The run's exact ground truth as the "COLMAP model", with one false match added: a point
+// triangulated from two views, centimetres off the surface. Only --min-track 2 measures it.
+TEST(EvalCommand, TwoViewPointsAreLeftOutOfTheMeasurement) {
+  rigc::testing::TempDir dir;
+  const auto run = test_inputs::make_statue_run(dir.path());
+  ASSERT_TRUE(run);
+  const fs::path model = dir.path() / "eval" / "colmap" / "model_txt";
+  fs::create_directories(model);
+  for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
+    fs::copy_file(run->dir / "sparse" / name, model / name);
+  }
+  std::string error;
+  const auto truth = read_colmap_points(model / "points3D.txt", &error);
+  ASSERT_TRUE(truth) << error;
+  long long_tracks = 0, all = static_cast<long>(truth->size()) + 1;
+  for (const auto& p : *truth) long_tracks += p.track_images.size() >= 3;
+  ASSERT_GT(long_tracks, 1000);
+  // Inside the statue's body, centimetres from its surface.
+  Vec3 blunder = Vec3::Zero();
+  for (const auto& p : *truth) blunder += p.position / static_cast<double>(truth->size());
+  const Point3D& near = truth->front();
+  std::ofstream(model / "points3D.txt", std::ios::app)
+      << fmt::format("999999 {} {} {} 128 128 128 0.5 {} 0 {} 0\n", blunder.x(), blunder.y(),
+                     blunder.z(), near.track_images.at(0), near.track_images.at(1));
+
+  EvalOptions o;
+  o.run_dir = run->dir.string();
+  o.output_dir = (dir.path() / "eval").string();
+  o.reuse_colmap = true;
+  o.quiet = true;
+  o.ground_truth_samples = 20000;
+  std::ostringstream log;
+  EvalSummary three;
+  ASSERT_EQ(evaluate(o, log, &three), 0) << log.str();
+  EXPECT_EQ(three.points, long_tracks);
+  EXPECT_LT(three.std_mm, 0.05);
+  EXPECT_EQ(three.report["reconstruction"]["points_in_model"], all);
+  o.min_track_length = 2;
+  EvalSummary two;
+  ASSERT_EQ(evaluate(o, log, &two), 0) << log.str();
+  EXPECT_EQ(two.points, all - static_cast<long>(std::count_if(
+                                  truth->begin(), truth->end(),
+                                  [](const Point3D& p) { return p.track_images.size() < 2; })));
+  const auto& d = two.report["signed_distance_mm"];
+  EXPECT_GT(std::max(-d["min"].get<double>(), d["max"].get<double>()), 10) << "the false match";
+  EXPECT_GT(two.std_mm, 10 * three.std_mm);
+}
+
 TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
   rigc::testing::TempDir dir;
   fs::create_directories(dir.path() / "photos");

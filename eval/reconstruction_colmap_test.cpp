@@ -67,7 +67,9 @@ TEST(EvalReconstructionColmap, ColmapsOwnPointsMeasureAsEvalDoes) {
   const auto points = read_colmap_points(model / "points3D.txt", &error);
   ASSERT_TRUE(points) << error;
   open3d::geometry::PointCloud cloud;
+  // The points eval measures: those seen in at least o.min_track_length images.
   for (const auto& p : *points) {
+    if (p.track_images.size() < static_cast<std::size_t>(o.min_track_length)) continue;
     cloud.points_.push_back(p.position);
     cloud.colors_.push_back(Eigen::Vector3d(p.rgb[0], p.rgb[1], p.rgb[2]) / 255);
   }

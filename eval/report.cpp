@@ -88,23 +88,31 @@ void EvalReport::add_photos(const PhotoSetup& photos) {
       {"masks", photos.masks.report}, {"cameras", cameras}, {"capture_order", photos.order_basis}};
 }
 
-void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& colmap, bool quiet) {
+void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& colmap,
+                                    std::size_t points_in_model, const EvalOptions& options) {
   summary_.reconstructed = true;
   summary_.registered = static_cast<int>(model.images.size());
   summary_.points = static_cast<long>(model.points.size());
-  report_["reconstruction"] = {{"status", "ok"},
-                               {"model", colmap.model_txt.string()},
-                               {"images", image_count_},
-                               {"registered_images", model.images.size()},
-                               {"points", model.points.size()},
-                               {"mean_track_length", model.mean_track_length()},
-                               {"mean_reprojection_error_px", model.mean_reprojection_error()}};
-  if (quiet) return;
+  report_["reconstruction"] = {
+      {"status", "ok"},
+      {"model", colmap.model_txt.string()},
+      {"images", image_count_},
+      {"registered_images", model.images.size()},
+      {"points", model.points.size()},
+      {"points_in_model", points_in_model},
+      {"min_track_length", options.min_track_length},
+      {"points_left_out",
+       fmt::format("{} seen in fewer than {} images", points_in_model - model.points.size(),
+                   options.min_track_length)},
+      {"mean_track_length", model.mean_track_length()},
+      {"mean_reprojection_error_px", model.mean_reprojection_error()}};
+  if (options.quiet) return;
   log_ << fmt::format(
-      "rigc eval: COLMAP: {}/{} images registered, {} points, track {:.2f}, reprojection "
-      "{:.3f} px ({:.1f} s)\n",
-      model.images.size(), image_count_, model.points.size(), model.mean_track_length(),
-      model.mean_reprojection_error(), colmap.seconds);
+      "rigc eval: COLMAP: {}/{} images registered, {} points ({} seen in {}+ images, measured), "
+      "track {:.2f}, reprojection {:.3f} px ({:.1f} s)\n",
+      model.images.size(), image_count_, points_in_model, model.points.size(),
+      options.min_track_length, model.mean_track_length(), model.mean_reprojection_error(),
+      colmap.seconds);
 }
 
 void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
