@@ -66,6 +66,32 @@ std::string last_row_problem(OIIO::ImageInput& input, const fs::path& path) {
   return fmt::format("cannot be decoded ({})", why.empty() ? "its pixel data is cut short" : why);
 }
 
+// Why a JPEG or PNG file does not end as a whole one does, or "": libjpeg decodes a JPEG cut short
+// with a warning and grey rows, so its last row reads well. A JPEG ends with the end-of-image
+// marker FF D9 (after which some writers pad with zero bytes), a PNG with its IEND chunk. Reads
+// the last 4 KB only.
+std::string cut_short_problem(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  const bool jpeg = ext == ".jpg" || ext == ".jpeg";
+  if (!jpeg && ext != ".png") return "";
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in.tellg();
+  const std::streamoff tail_size = std::min<std::streamoff>(size, 4096);
+  std::string tail(static_cast<std::size_t>(std::max<std::streamoff>(tail_size, 0)), '\0');
+  in.seekg(size - tail_size);
+  if (!in.read(tail.data(), tail_size)) return "";  // unreadable: OpenImageIO says why
+  if (jpeg) {
+    const std::size_t end = tail.find_last_not_of('\0');
+    if (end != std::string::npos && end >= 1 && tail.compare(end - 1, 2, "\xFF\xD9") == 0)
+      return "";
+    return "is cut short (a JPEG ends with the end-of-image marker FF D9; this one does not)";
+  }
+  static const std::string kIend("\0\0\0\0IEND\xAE\x42\x60\x82", 12);
+  if (tail.size() >= kIend.size() && tail.ends_with(kIend)) return "";
+  return "is cut short (a PNG ends with its IEND chunk; this one does not)";
+}
+
 // Why the image at `path` cannot go to COLMAP, or "" with its size set in `set`. `decode` also
 // reads its last row, for photos that rigc did not write itself.
 std::string image_problem(ImageSet& set, const std::string& name, bool decode) {
@@ -84,6 +110,7 @@ std::string image_problem(ImageSet& set, const std::string& name, bool decode) {
         spec.width, spec.height, kMostPhotoPixels / 1e6);
   }
   if (decode) {
+    if (std::string problem = cut_short_problem(path); !problem.empty()) return problem;
     if (std::string problem = last_row_problem(*input, path); !problem.empty()) return problem;
   }
   set.size[name] = {spec.width, spec.height};
