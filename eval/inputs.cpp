@@ -10,7 +10,9 @@
 #include "assets/mesh_io.h"
 #include "compiler/frontend.h"
 #include "eval/raw_photos.h"
+#include "io/input_files.h"
 #include "run/manifest.h"
+#include "run/scene_inputs.h"
 
 namespace rigc::eval {
 
@@ -162,6 +164,9 @@ std::optional<ImageSet> find_images(const fs::path& run_dir, bool photos, std::s
     return std::nullopt;
   }
   if (!read_headers(set, photos, error)) return std::nullopt;
+  for (const auto& name : set.names) {
+    protect_input_file(set.dir / name, photos ? "a photo" : "an image of the run");
+  }
   return set;
 }
 
@@ -216,6 +221,7 @@ bool load_scene_object(const std::string& scene_path, const fs::path& run_dir, c
         fmt::format("cannot compile the scene {} for its ground truth:\n{}", scene_path, messages);
     return false;
   }
+  run::protect_scene_inputs(scene_path, *scene);
   gt.positions = ir::object_frame_positions(scene->object);
   gt.triangles = scene->object.mesh.triangles;
   gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
@@ -239,6 +245,7 @@ bool load_ground_truth_mesh(const EvalOptions& o, const fs::path& run_dir, bool 
   if (!o.ground_truth.empty()) {
     auto model = load_model(o.ground_truth, error);
     if (!model) return false;
+    protect_input_file(o.ground_truth, "the ground-truth mesh");
     gt.positions = std::move(model->mesh.positions);
     gt.triangles = std::move(model->mesh.triangles);
     gt.description = fmt::format("{} (its own frame)", o.ground_truth);
@@ -269,8 +276,14 @@ bool load_planned_cameras(const fs::path& run_dir, const ImageSet& images, Groun
                           std::string* error) {
   const fs::path sparse = run_dir / "sparse";
   auto planned = run::read_colmap_images(sparse / "images.txt", error);
+  if (!planned) return false;
   auto cameras = run::read_colmap_cameras(sparse / "cameras.txt", error);
-  if (!planned || !cameras || cameras->empty()) return false;
+  if (!cameras || !run::check_camera_ids(*planned, *cameras, sparse / "images.txt", error)) {
+    return false;
+  }
+  for (const char* file : {"images.txt", "cameras.txt", "points3D.txt"}) {
+    protect_input_file(sparse / file, "the run's ground-truth cameras");
+  }
   for (const auto& im : *planned) gt.poses[im.name] = im.camera_from_world;
   gt.camera = cameras->front();
   for (const auto& [name, size] : images.size) {
