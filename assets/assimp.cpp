@@ -22,6 +22,7 @@
 
 #include "assets/model_loading.h"
 #include "assets/textures.h"
+#include "io/file_status.h"
 
 namespace rigc::loading {
 namespace {
@@ -149,14 +150,17 @@ class AssimpLoader {
     std::replace(clean.begin(), clean.end(), '\\', '/');
     const fs::path dir = fs::path(path_).parent_path();
     fs::path file = fs::path(clean).is_absolute() ? fs::path(clean) : dir / clean;
-    std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) {
+    if (names_nothing(file)) {
       const fs::path beside = dir / fs::path(clean).filename();
-      if (!fs::is_regular_file(beside, ec)) {
+      if (names_nothing(beside)) {
         fail("texture '{}' of material '{}' not found (looked for {})", reference, material,
              file.lexically_normal().string());
       }
       file = beside;
+    }
+    if (const std::string why = why_not_readable(file); !why.empty()) {
+      fail("texture '{}' of material '{}': {} {}", reference, material,
+           file.lexically_normal().string(), why);
     }
     return file.lexically_normal();
   }

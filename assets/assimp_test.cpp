@@ -86,6 +86,23 @@ TEST(MeshIoObj, ATextureTooLargeToDecodeSaysItsSize) {
   expect_load_error(dir.file("box.obj"), "could not be decoded (unknown or broken image format)");
 }
 
+// A map_Kd naming a folder or a device says which, not "not found".
+TEST(MeshIoObj, ATextureThatIsAFolderOrADeviceSaysSo) {
+  TempDir dir;
+  write_file(dir.file("box.obj"),
+             "mtllib box.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+             "f 1/1 2/2 3/3\n");
+  write_file(dir.file("box.mtl"), "newmtl m\nmap_Kd tex.png\n");
+  fs::create_directory(dir.file("tex.png"));
+  expect_load_error(dir.file("box.obj"), "tex.png is a folder");
+  fs::remove(dir.file("tex.png"));
+  fs::create_symlink("/dev/zero", dir.file("tex.png"));
+  expect_load_error(dir.file("box.obj"), "tex.png is not a regular file");
+  fs::remove(dir.file("tex.png"));
+  fs::create_symlink("tex.png", dir.file("tex.png"));
+  expect_load_error(dir.file("box.obj"), "tex.png is a loop of symbolic links");
+}
+
 TEST(MeshIoObj, AMissingMaterialLibraryLoadsWithAWarning) {
   EXPECT_TRUE(load_ok(kModels + "OBJ/spider.obj").warnings.empty()) << "its spider.mtl is there";
   TempDir dir;

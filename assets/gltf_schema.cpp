@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "assets/model_loading.h"
+#include "io/file_status.h"
 
 namespace rigc::loading {
 namespace {
@@ -261,11 +262,35 @@ std::string gltf_json_text(const std::string& path, bool binary) {
   return text;
 }
 
+// The files the buffers and images name beside the model must be regular files: tinygltf reads a
+// folder as a file of absurd size (out of memory) and calls a device "missing". A file that does
+// not exist is left to tinygltf's message; percent-encoded names too (tinygltf decodes them).
+void check_external_files(const json& root, const std::filesystem::path& folder) {
+  for (const char* key : {"buffers", "images"}) {
+    const auto found = root.find(key);
+    if (found == root.end()) continue;
+    const json& list = *found;  // an array of objects (checked above)
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const auto uri = list[i].find("uri");
+      if (uri == list[i].end() || !uri->is_string()) continue;
+      const std::string name = uri->get<std::string>();
+      if (name.starts_with("data:") || name.find('%') != std::string::npos) continue;
+      const std::filesystem::path file = folder / name;
+      if (names_nothing(file)) continue;
+      if (const std::string why = why_not_readable(file); !why.empty()) {
+        fail("{} {} '{}' {}", key == std::string("images") ? "image" : "buffer", i, name, why);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void check_gltf_schema(const std::string& path, bool binary) {
   const json root = json::parse(gltf_json_text(path, binary), nullptr, /*allow_exceptions=*/false);
-  if (!root.is_discarded()) GltfSchemaCheck().run(root);
+  if (root.is_discarded()) return;
+  GltfSchemaCheck().run(root);
+  check_external_files(root, std::filesystem::path(path).parent_path());
 }
 
 }  // namespace rigc::loading

@@ -176,6 +176,34 @@ TEST(MeshIoGltf, RejectsAccessorsPastTheBuffer) {
   EXPECT_EQ(error.rfind(dir.file("short.gltf") + ": ", 0), 0u) << error;
 }
 
+TEST(MeshIoGltf, ErrorCutsALongDataUri) {
+  TempDir dir;
+  // tinygltf's message for a data URI that disagrees with its byteLength holds the whole URI.
+  const std::string uri = "data:application/octet-stream;base64," + std::string(400'000, 'A');
+  write_file(dir.file("uri.gltf"), R"({"asset": {"version": "2.0"}, "buffers": [{"uri": ")" + uri +
+                                       R"(", "byteLength": 7}]})");
+  std::string error;
+  EXPECT_FALSE(load_model(dir.file("uri.gltf"), &error));
+  EXPECT_LT(error.size(), 600u) << error.substr(0, 600);
+  EXPECT_NE(error.find("data:application/octet-stream;base64,AAAA"), std::string::npos) << error;
+  EXPECT_NE(error.find("... (400037 characters)"), std::string::npos) << error;
+}
+
+TEST(MeshIoGltf, ImageThatIsAFolderOrADeviceSaysSo) {
+  TempDir dir;
+  const std::string src = kModels + "glTF2/BoxTextured-glTF/";
+  std::string gltf = ::rigc::testing::read_text(src + "BoxTextured.gltf");
+  fs::copy_file(src + "BoxTextured0.bin", dir.file("BoxTextured0.bin"));
+  fs::create_directory(dir.file("CesiumLogoFlat.png"));
+  write_file(dir.file("BoxTextured.gltf"), gltf);
+  expect_load_error(dir.file("BoxTextured.gltf"), "image 0 'CesiumLogoFlat.png' is a folder");
+  fs::create_symlink("/dev/zero", dir.file("zero.png"));
+  const std::size_t at = gltf.find("CesiumLogoFlat.png");
+  ASSERT_NE(at, std::string::npos);
+  write_file(dir.file("BoxTextured.gltf"), gltf.replace(at, 18, "zero.png"));
+  expect_load_error(dir.file("BoxTextured.gltf"), "image 0 'zero.png' is not a regular file");
+}
+
 TEST(MeshIoGltf, MissingImageIsAnErrorNamingIt) {
   TempDir dir;
   const std::string src = kModels + "glTF2/BoxTextured-glTF/";

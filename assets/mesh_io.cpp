@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "assets/model_loading.h"
+#include "io/file_status.h"
 
 namespace rigc {
 
@@ -16,16 +17,12 @@ using loading::one_line;
 
 std::optional<LoadedModel> load_model(const std::string& path, std::string* error) {
   auto set_error = [&](const std::string& message) {
-    if (error) *error = one_line(fmt::format("{}: {}", path, message));
+    if (error)
+      *error = fmt::format("{}: {}", one_line(path), loading::cut_long_words(one_line(message)));
   };
   try {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) {
-      set_error("file not found");
-      return std::nullopt;
-    }
-    if (!fs::is_regular_file(path, ec)) {
-      set_error("is not a regular file");
+    if (const std::string why = why_not_readable(path); !why.empty()) {
+      set_error(why);
       return std::nullopt;
     }
     const std::string ext = loading::lower(fs::path(path).extension().string());

@@ -14,7 +14,8 @@ namespace {
 using ::rigc::testing::TempDir;
 
 TEST(MeshIoLoad, ReportsMissingAndUnsupportedFiles) {
-  expect_load_error("/nonexistent/model.glb", "file not found");
+  expect_load_error("/nonexistent/model.glb", "does not exist");
+  expect_load_error("/dev/zero", "is not a regular file");
   expect_load_error(kModels + "3DS/fels.3ds", "unsupported model format '.3ds'");
   TempDir dir;
   write_file(dir.file("garbage.glb"), "this is not a glb file at all");

@@ -30,6 +30,24 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
+std::string cut_long_words(const std::string& text) {
+  std::string out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t space = text.find(' ', start);
+    const std::size_t end = space == std::string::npos ? text.size() : space;
+    if (end - start > kLongestWord) {
+      out.append(text, start, 60);
+      out += fmt::format("... ({} characters)", end - start);
+    } else {
+      out.append(text, start, end - start);
+    }
+    if (space != std::string::npos) out += ' ';
+    start = end + 1;
+  }
+  return out;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;

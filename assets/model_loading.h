@@ -37,6 +37,11 @@ template <typename... Args>
 // Library messages come as several lines; diagnostics want one.
 std::string one_line(const std::string& text);
 
+// `text` with every word (a run without spaces) longer than kLongestWord cut to its first 60
+// characters and "...": libraries echo whole data URIs (megabytes of base64) in their messages.
+inline constexpr std::size_t kLongestWord = 200;
+std::string cut_long_words(const std::string& text);
+
 std::string lower(std::string s);
 
 // The whole file; a LoadError if it cannot be opened or read.

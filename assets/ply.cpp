@@ -18,6 +18,7 @@
 
 #include "assets/model_loading.h"
 #include "assets/textures.h"
+#include "io/file_status.h"
 
 namespace rigc::loading {
 namespace {
@@ -580,8 +581,9 @@ LoadedModel load_ply(const std::string& path) {
   reader.read(header);
   if (!header.texture_file.empty()) {
     const fs::path file = (fs::path(path).parent_path() / header.texture_file).lexically_normal();
-    std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) fail("texture '{}' not found", file.string());
+    if (const std::string why = why_not_readable(file); !why.empty()) {
+      fail("texture '{}' {}", file.string(), why);
+    }
     out.textures.push_back(decode_image(file.string(), read_file_bytes(file),
                                         fmt::format("texture '{}'", file.string())));
     out.materials[0].base_color_texture = 0;

@@ -71,6 +71,19 @@ TEST(MeshIoPly, RejectsMalformedFiles) {
   expect_load_error(dir.file("magic.ply"), "not a PLY file");
 }
 
+TEST(MeshIoPly, ATextureFileThatIsAFolderSaysSo) {
+  TempDir dir;
+  write_file(dir.file("tex.ply"),
+             "ply\nformat ascii 1.0\ncomment TextureFile tex.png\nelement vertex 3\n"
+             "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+             "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  fs::create_directory(dir.file("tex.png"));
+  expect_load_error(dir.file("tex.ply"), "tex.png' is a folder");
+  fs::remove(dir.file("tex.png"));
+  fs::create_symlink("/dev/zero", dir.file("tex.png"));
+  expect_load_error(dir.file("tex.ply"), "tex.png' is not a regular file");
+}
+
 TEST(MeshIoPly, ReadsBigEndianAndPolygons) {
   TempDir dir;
   std::string bytes =

@@ -2,11 +2,13 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/options.h"
 #include "cli/verbs.h"
 #include "eval/eval.h"
+#include "io/input_files.h"
 
 namespace rigc::cli {
 
@@ -115,6 +117,12 @@ int run_eval_command(std::vector<std::string> args) {
   if (o.run_dir.empty() == o.photos_dir.empty()) {
     std::cerr << "rigc eval: error: give a run folder or --photos DIR (one of them)\n";
     return 1;
+  }
+  // The files eval reads that gather_inputs (eval/inputs.cpp) does not: no output replaces them.
+  protect_input_file(o.reconstruction, "the reconstruction");
+  protect_input_file(o.cameras, "the reconstruction's cameras");
+  if (!o.run_dir.empty()) {
+    protect_input_file(std::filesystem::path(o.run_dir) / "manifest.json", "the run's manifest");
   }
   EvalSummary summary;
   return evaluate(o, std::cerr, &summary);

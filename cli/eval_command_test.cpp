@@ -27,6 +27,26 @@ namespace fs = std::filesystem;
 using test_inputs::write_cube_ply;
 using test_inputs::write_small_image;
 
+// eval registered no inputs: evaluating an earlier evaluation's cloud into the same folder wrote
+// the new cloud over the one being measured.
+TEST(EvalCommand, NeverWritesOverItsInputs) {
+  rigc::testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  for (const char* name : {"a.jpg", "b.jpg"}) write_small_image(dir.file("photos/") + name);
+  write_cube_ply(dir.file("cube.ply"));
+  fs::create_directories(dir.path() / "eval");
+  const std::string cloud = dir.file("eval/cloud_signed_distance.ply");
+  fs::copy_file(dir.file("cube.ply"), cloud);
+  const std::string before = rigc::testing::read_text(cloud);
+  const auto result = rigc::testing::run_rigc(
+      {"eval", "--photos", dir.file("photos"), "--ground-truth", dir.file("cube.ply"),
+       "--reconstruction", cloud, "--no-align", "--mesh-samples", "1000", "-o", dir.file("eval")});
+  EXPECT_NE(result.err.find("it is the reconstruction, an input of this command"),
+            std::string::npos)
+      << result.err;
+  EXPECT_EQ(rigc::testing::read_text(cloud), before);
+}
+
 TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   rigc::testing::TempDir dir;
   EXPECT_EQ(cli::run_eval_command({"rigc eval", dir.file("nothing")}), 1);

@@ -12,6 +12,7 @@
 #include "io/input_files.h"
 #include "plan/plan_scene.h"
 #include "plan/report.h"
+#include "run/scene_inputs.h"
 
 namespace rigc::cli {
 namespace {
@@ -173,6 +174,7 @@ int run_plan_command(std::vector<std::string> args) {
     if (!error.empty()) std::cerr << "rigc: error: " << error << '\n';
     return kExitUserError;
   }
+  run::protect_scene_inputs(request.scene_path, outcome->scene);
   plan::print_plan_report(*outcome, std::cout);
   if (!write_file_atomically(request.output_path, outcome->planned_text, &error)) {
     std::cerr << "rigc: error: " << error << '\n';

@@ -35,6 +35,26 @@ TEST(CliPlan, WritesThePlannedSceneBesideTheScene) {
   EXPECT_EQ(check.exit_code, 0) << check.err;
 }
 
+// plan registered only its scene file as an input: -o the scene's mesh wrote the plan over it.
+TEST(CliPlan, NeverWritesOverTheScenesMesh) {
+  TempDir dir;
+  const std::string cube =
+      "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+      "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\n"
+      "f 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  write_text(dir.file("cube.obj"), cube);
+  std::string text = small_paper_scene();
+  const std::string primitive = "primitive: {shape: statue, detail: 4, seed: 7}";
+  ASSERT_NE(text.find(primitive), std::string::npos);
+  text.replace(text.find(primitive), primitive.size(), "mesh: cube.obj");
+  write_text(dir.file("s.yaml"), text);
+  const auto result = run_rigc({"plan", dir.file("s.yaml"), "-o", dir.file("cube.obj"),
+                                "--visibility-scale", "0.1", "--rings", "30deg"});
+  EXPECT_NE(result.err.find("it is the scene's mesh, an input of this command"), std::string::npos)
+      << result.err;
+  EXPECT_EQ(read_text(dir.file("cube.obj")), cube);
+}
+
 TEST(CliPlan, BadRequestsAreUserErrors) {
   TempDir dir;
   write_text(dir.file("paper.yaml"), small_paper_scene());

@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
+#include "io/input_files.h"
 #include "sweep/local_executor.h"
 #include "sweep/results.h"
 #include "sweep/slurm_executor.h"
@@ -158,6 +159,8 @@ int run_sweep_command(std::vector<std::string> args) {
   const auto spec =
       a.vary.empty() ? sweep::read_sweep_file(a.input, diag) : spec_from_options(a, diag);
   if (!spec) return kExitUserError;
+  protect_input_file(a.input, a.vary.empty() ? "the sweep file" : "the scene file");
+  protect_input_file(spec->scene_path, "the scene file");
   const auto scene_text = read_scene_text(spec->scene_path);
   if (!scene_text) {
     std::cerr << fmt::format("rigc: error: cannot read the scene file {}\n", spec->scene_path);

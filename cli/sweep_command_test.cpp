@@ -97,6 +97,21 @@ TEST(CliSweep, AFailingVariantIsReportedAndTheOthersComplete) {
   EXPECT_NE(status.out.find("1/2 variants done"), std::string::npos) << status.out;
 }
 
+// sweep registered no inputs: a scene file named like one of its outputs was written over.
+TEST(CliSweep, NeverWritesOverItsInputs) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  fs::create_directories(out);
+  write_text(out + "/results.md", small_scene());
+  const auto status =
+      run_rigc({"sweep", out + "/results.md", "--vary", "shots[0].turntable.steps=3,4", "--scale",
+                "0.05", "-o", out, "--status"});
+  EXPECT_NE(status.exit_code, 0);
+  EXPECT_NE(status.err.find("it is the scene file, an input of this command"), std::string::npos)
+      << status.err;
+  EXPECT_EQ(read_text(out + "/results.md"), small_scene());
+}
+
 TEST(CliSweep, BadSweepsAreUserErrorsBeforeAnythingRuns) {
   TempDir dir;
   write_text(dir.file("scene.yaml"), small_scene());

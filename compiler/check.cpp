@@ -17,6 +17,7 @@
 #include "compiler/presets.h"
 #include "compiler/units.h"
 #include "compiler/yaml_limits.h"
+#include "io/file_status.h"
 #include "ir/utf8_text.h"
 
 namespace rigc {
@@ -437,11 +438,8 @@ void Checker::read_mesh(const YAML::Node& node, spec::ObjectSpec& object) {
   fs::path resolved = fs::path(*path);
   if (resolved.is_relative()) resolved = fs::path(base_dir_) / resolved;
   object.mesh_path_resolved = resolved.lexically_normal().string();
-  std::error_code ec;
-  if (!fs::exists(resolved, ec)) {
-    error(node, fmt::format("mesh file '{}' does not exist", resolved.string()));
-  } else if (fs::is_directory(resolved, ec)) {
-    error(node, fmt::format("mesh '{}' is a folder, not a file", resolved.string()));
+  if (const std::string why = why_not_readable(resolved); !why.empty()) {
+    error(node, fmt::format("mesh file '{}' {}", resolved.string(), why));
   } else {
     std::string ext = resolved.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);

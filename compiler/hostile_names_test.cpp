@@ -149,6 +149,27 @@ std::string text_messages(const std::string& text) {
   return messages;
 }
 
+// A mesh that is a symbolic link loop said "does not exist".
+TEST(HostileNames, AnUnreadableMeshSaysWhy) {
+  TempDir dir;
+  fs::create_symlink("loop.obj", dir.path() / "loop.obj");
+  fs::create_directories(dir.path() / "folder.obj");
+  fs::create_symlink("/dev/zero", dir.path() / "zero.obj");
+  const auto messages = [&](const std::string& mesh) {
+    DiagnosticEngine diag;
+    std::string out;
+    diag.set_handler([&](const Diagnostic&, const std::string& m) { out += m; });
+    EXPECT_FALSE(compile_scene_text("rigc: 1\nobject: {mesh: " + mesh + ", fit: {size: 1cm}}\n",
+                                    "s.yaml", dir.path().string(), diag));
+    return out;
+  };
+  EXPECT_NE(messages("loop.obj").find("loop.obj' is a loop of symbolic links"), std::string::npos)
+      << messages("loop.obj");
+  EXPECT_NE(messages("folder.obj").find("folder.obj' is a folder"), std::string::npos);
+  EXPECT_NE(messages("zero.obj").find("zero.obj' is not a regular file"), std::string::npos);
+  EXPECT_NE(messages("gone.obj").find("gone.obj' does not exist"), std::string::npos);
+}
+
 // A NUL byte was "unknown escape character".
 TEST(HostileNames, ANulByteIsNamedAtItsPlace) {
   const std::string messages = text_messages(std::string("rigc: 1\nname: \"ab\0c\"\n", 21));

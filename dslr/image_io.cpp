@@ -59,6 +59,18 @@ std::string lowercase_extension(const fs::path& path) {
   return extension;
 }
 
+// EXIF's ASCII tags (Make, Model) hold 7-bit text: each UTF-8 character outside it, and each
+// control character, becomes one '?' (camera names come from the user's scene).
+std::string exif_ascii(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x80 && byte < 0xC0) continue;  // a UTF-8 continuation byte
+    out += byte >= 0x20 && byte < 0x7F ? c : '?';
+  }
+  return out;
+}
+
 }  // namespace
 
 bool write_image(const fs::path& path, const DevelopResult& result, const ir::Camera& camera,
@@ -81,8 +93,8 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
     spec.attribute("Compression",
                    "jpeg:" + std::to_string(std::clamp(camera.jpeg_quality, 1, 100)));
   }
-  spec.attribute("Make", camera.make);
-  spec.attribute("Model", camera.model);
+  spec.attribute("Make", exif_ascii(camera.make));
+  spec.attribute("Model", exif_ascii(camera.model));
   spec.attribute("Software", "RigC " RIGC_VERSION);
   const double focal_mm = camera.focal_length_m * 1000;
   spec.attribute("Exif:FocalLength", static_cast<float>(focal_mm));

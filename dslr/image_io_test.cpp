@@ -63,6 +63,22 @@ TEST(DslrWrite, JpegCarriesTheExifACameraWouldWrite) {
   EXPECT_NEAR(pixels[0], image.encoded[0], 3);  // JPEG at quality 95
 }
 
+// EXIF ASCII is 7-bit: a camera named in UTF-8 (or with a control character) is written with '?'
+// for each character outside it, read back the same by OpenImageIO and libexif readers.
+TEST(DslrWrite, ExifTextIsSevenBitAscii) {
+  rigc::testing::TempDir dir;
+  ir::Camera camera = canon_6d();
+  camera.make = "Caf\xC3\xA9 \xE2\x80\xAE\x01Zw\xC3\xB6lf";
+  camera.model = "\xF0\x9F\x93\xB7 EOS";
+  const std::string path = dir.file("shot_000.jpg");
+  std::string error;
+  ASSERT_TRUE(write_image(path, small_image(camera), camera, &error)) << error;
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  EXPECT_EQ(in->spec().get_string_attribute("Make"), "Caf? ??Zw?lf");
+  EXPECT_EQ(in->spec().get_string_attribute("Model"), "? EOS");
+}
+
 // A JPEG holds 8-bit codes: an 8-bit result's codes as they are, a 16-bit one's scaled down
 // (65535 -> 255). A smooth ramp survives quality 100 within a code or two.
 TEST(DslrWrite, JpegPixelsAreTheEightBitCodes) {

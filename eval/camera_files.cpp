@@ -274,14 +274,20 @@ std::optional<CameraFile> read_camera_file(const fs::path& path, std::string* er
     if (fs::exists(dir / "images.txt")) {
       file.format = "COLMAP text";
       images = run::read_colmap_images(dir / "images.txt", error);
+      if (!images) return std::nullopt;
       auto cameras = run::read_colmap_cameras(dir / "cameras.txt", error);
-      if (!cameras) return std::nullopt;
+      if (!cameras || !run::check_camera_ids(*images, *cameras, dir / "images.txt", error)) {
+        return std::nullopt;
+      }
       file.cameras = std::move(*cameras);
     } else if (fs::exists(dir / "images.bin")) {
       file.format = "COLMAP binary";
       images = read_colmap_images_bin(dir / "images.bin", error);
+      if (!images) return std::nullopt;
       auto cameras = read_colmap_cameras_bin(dir / "cameras.bin", error);
-      if (!cameras) return std::nullopt;
+      if (!cameras || !run::check_camera_ids(*images, *cameras, dir / "images.bin", error)) {
+        return std::nullopt;
+      }
       file.cameras = std::move(*cameras);
     } else {
       *error = fmt::format("{} holds no COLMAP model (images.txt or images.bin)", dir.string());

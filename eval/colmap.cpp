@@ -206,7 +206,9 @@ std::optional<SparseModel> read_sparse_model(const fs::path& dir, std::string* e
   auto cameras = run::read_colmap_cameras(dir / "cameras.txt", error);
   if (!cameras) return std::nullopt;
   auto images = run::read_colmap_images(dir / "images.txt", error);
-  if (!images) return std::nullopt;
+  if (!images || !run::check_camera_ids(*images, *cameras, dir / "images.txt", error)) {
+    return std::nullopt;
+  }
   auto points = read_colmap_points(dir / "points3D.txt", error);
   if (!points) return std::nullopt;
   model.cameras = std::move(*cameras);

@@ -562,8 +562,9 @@ TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
   const EvalOptions o = photos_without_colmap(dir);
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1) << log.str();
-  // The pre-check reads each photo's last row, so broken pixels are named before any conversion.
-  EXPECT_NE(log.str().find("b.png: cannot be decoded"), std::string::npos) << log.str();
+  // The pre-check reads each photo's end (and last row), so a photo cut short is named before any
+  // conversion.
+  EXPECT_NE(log.str().find("b.png: is cut short"), std::string::npos) << log.str();
 }
 
 }  // namespace

@@ -10,7 +10,9 @@
 #include "assets/mesh_io.h"
 #include "compiler/frontend.h"
 #include "eval/raw_photos.h"
+#include "io/input_files.h"
 #include "run/manifest.h"
+#include "run/scene_inputs.h"
 
 namespace rigc::eval {
 
@@ -66,6 +68,32 @@ std::string last_row_problem(OIIO::ImageInput& input, const fs::path& path) {
   return fmt::format("cannot be decoded ({})", why.empty() ? "its pixel data is cut short" : why);
 }
 
+// Why a JPEG or PNG file does not end as a whole one does, or "": libjpeg decodes a JPEG cut short
+// with a warning and grey rows, so its last row reads well. A JPEG ends with the end-of-image
+// marker FF D9 (after which some writers pad with zero bytes), a PNG with its IEND chunk. Reads
+// the last 4 KB only.
+std::string cut_short_problem(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  const bool jpeg = ext == ".jpg" || ext == ".jpeg";
+  if (!jpeg && ext != ".png") return "";
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in.tellg();
+  const std::streamoff tail_size = std::min<std::streamoff>(size, 4096);
+  std::string tail(static_cast<std::size_t>(std::max<std::streamoff>(tail_size, 0)), '\0');
+  in.seekg(size - tail_size);
+  if (!in.read(tail.data(), tail_size)) return "";  // unreadable: OpenImageIO says why
+  if (jpeg) {
+    const std::size_t end = tail.find_last_not_of('\0');
+    if (end != std::string::npos && end >= 1 && tail.compare(end - 1, 2, "\xFF\xD9") == 0)
+      return "";
+    return "is cut short (a JPEG ends with the end-of-image marker FF D9; this one does not)";
+  }
+  static const std::string kIend("\0\0\0\0IEND\xAE\x42\x60\x82", 12);
+  if (tail.size() >= kIend.size() && tail.ends_with(kIend)) return "";
+  return "is cut short (a PNG ends with its IEND chunk; this one does not)";
+}
+
 // Why the image at `path` cannot go to COLMAP, or "" with its size set in `set`. `decode` also
 // reads its last row, for photos that rigc did not write itself.
 std::string image_problem(ImageSet& set, const std::string& name, bool decode) {
@@ -84,6 +112,7 @@ std::string image_problem(ImageSet& set, const std::string& name, bool decode) {
         spec.width, spec.height, kMostPhotoPixels / 1e6);
   }
   if (decode) {
+    if (std::string problem = cut_short_problem(path); !problem.empty()) return problem;
     if (std::string problem = last_row_problem(*input, path); !problem.empty()) return problem;
   }
   set.size[name] = {spec.width, spec.height};
@@ -135,6 +164,9 @@ std::optional<ImageSet> find_images(const fs::path& run_dir, bool photos, std::s
     return std::nullopt;
   }
   if (!read_headers(set, photos, error)) return std::nullopt;
+  for (const auto& name : set.names) {
+    protect_input_file(set.dir / name, photos ? "a photo" : "an image of the run");
+  }
   return set;
 }
 
@@ -189,6 +221,7 @@ bool load_scene_object(const std::string& scene_path, const fs::path& run_dir, c
         fmt::format("cannot compile the scene {} for its ground truth:\n{}", scene_path, messages);
     return false;
   }
+  run::protect_scene_inputs(scene_path, *scene);
   gt.positions = ir::object_frame_positions(scene->object);
   gt.triangles = scene->object.mesh.triangles;
   gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
@@ -212,6 +245,7 @@ bool load_ground_truth_mesh(const EvalOptions& o, const fs::path& run_dir, bool 
   if (!o.ground_truth.empty()) {
     auto model = load_model(o.ground_truth, error);
     if (!model) return false;
+    protect_input_file(o.ground_truth, "the ground-truth mesh");
     gt.positions = std::move(model->mesh.positions);
     gt.triangles = std::move(model->mesh.triangles);
     gt.description = fmt::format("{} (its own frame)", o.ground_truth);
@@ -242,8 +276,14 @@ bool load_planned_cameras(const fs::path& run_dir, const ImageSet& images, Groun
                           std::string* error) {
   const fs::path sparse = run_dir / "sparse";
   auto planned = run::read_colmap_images(sparse / "images.txt", error);
+  if (!planned) return false;
   auto cameras = run::read_colmap_cameras(sparse / "cameras.txt", error);
-  if (!planned || !cameras || cameras->empty()) return false;
+  if (!cameras || !run::check_camera_ids(*planned, *cameras, sparse / "images.txt", error)) {
+    return false;
+  }
+  for (const char* file : {"images.txt", "cameras.txt", "points3D.txt"}) {
+    protect_input_file(sparse / file, "the run's ground-truth cameras");
+  }
   for (const auto& im : *planned) gt.poses[im.name] = im.camera_from_world;
   gt.camera = cameras->front();
   for (const auto& [name, size] : images.size) {

@@ -92,5 +92,28 @@ TEST(EvalInputs, APhotoWithoutItsPixelDataCannotBeDecoded) {
   EXPECT_NE(log.find("a.png: cannot be decoded"), std::string::npos) << log;
 }
 
+// A JPEG cut short decodes (libjpeg warns and fills grey rows), and passed the check; a PNG
+// without its IEND chunk too. Zero bytes after a JPEG's end marker are padding, not damage.
+TEST(EvalInputs, APhotoCutShortIsNamed) {
+  testing::TempDir dir;
+  fs::create_directories(dir.path() / "photos");
+  write_small_image(dir.file("photos/a.jpg"));
+  write_small_image(dir.file("photos/b.png"));
+  write_small_image(dir.file("photos/c.jpg"));
+  const std::string jpeg = testing::read_text(dir.file("photos/a.jpg"));
+  testing::write_text(dir.file("photos/a.jpg"), jpeg.substr(0, jpeg.size() - 40));
+  const std::string png = testing::read_text(dir.file("photos/b.png"));
+  testing::write_text(dir.file("photos/b.png"), png.substr(0, png.size() - 12));
+  testing::write_text(dir.file("photos/c.jpg"), jpeg + std::string(300, '\0'));
+  const std::string log = evaluate_photos(dir);
+  EXPECT_NE(log.find("2 of the 3 images cannot be read"), std::string::npos) << log;
+  EXPECT_NE(log.find("a.jpg: is cut short (a JPEG ends with the end-of-image marker FF D9"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("b.png: is cut short (a PNG ends with its IEND chunk"), std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("c.jpg"), std::string::npos) << log;
+}
+
 }  // namespace
 }  // namespace rigc::eval

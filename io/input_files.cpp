@@ -15,6 +15,7 @@ using FileId = std::pair<dev_t, ino_t>;
 
 struct Registry {
   std::mutex mutex;
+  bool enabled = false;
   std::map<FileId, std::string> inputs;
 };
 
@@ -31,12 +32,18 @@ std::optional<FileId> file_id(const std::filesystem::path& path) {
 
 }  // namespace
 
+void enable_input_protection() {
+  Registry& r = registry();
+  std::lock_guard lock(r.mutex);
+  r.enabled = true;
+}
+
 void protect_input_file(const std::filesystem::path& path, const std::string& what) {
   const auto id = file_id(path);
   if (!id) return;
   Registry& r = registry();
   std::lock_guard lock(r.mutex);
-  r.inputs.emplace(*id, what);
+  if (r.enabled) r.inputs.emplace(*id, what);
 }
 
 std::optional<std::string> protected_input_at(const std::filesystem::path& path) {

@@ -10,8 +10,12 @@
 
 namespace rigc {
 
-// Records the file at `path` (following symbolic links), if there is one, as an input;
-// `what` names it in messages ("the scene's mesh"). Thread-safe.
+// Turns the protection on: rigc's main() does, so that a library call (eval's input checks, in
+// the test binary too) records nothing for a process that did not ask.
+void enable_input_protection();
+
+// Records the file at `path` (following symbolic links), if there is one and protection is on, as
+// an input; `what` names it in messages ("the scene's mesh"). Thread-safe.
 void protect_input_file(const std::filesystem::path& path, const std::string& what);
 
 // What the file at `path` (following symbolic links) is when it is a recorded input, for

@@ -283,11 +283,14 @@ std::optional<std::vector<ColmapImage>> read_colmap_images(const fs::path& path,
           return false;
         }
         Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
-        if (!(q.norm() > 0)) {
-          *message = "the quaternion is zero";
+        if (!(std::abs(q.norm() - 1) <= kQuaternionTolerance)) {
+          *message = fmt::format(
+              "the quaternion QW QX QY QZ has length {:.6g}; a rotation's is 1 (within {})",
+              q.norm(), kQuaternionTolerance);
           return false;
         }
         q.normalize();
+        image.line = number;
         image.camera_from_world.block<3, 3>(0, 0) = q.toRotationMatrix();
         image.camera_from_world.block<3, 1>(0, 3) = ir::Vec3(v[4], v[5], v[6]);
         images.push_back(std::move(image));
@@ -340,8 +343,14 @@ std::string camera_problem(const ColmapCamera& camera) {
   for (double p : camera.params) {
     if (!std::isfinite(p)) return "a camera parameter is not a finite number";
   }
+  const double most_focal = kMostFocalLengthPerSide * std::max(camera.width, camera.height);
   for (int i = 0; i < focals; ++i) {
     if (!(camera.params[i] > 0)) return "the focal length must be above 0";
+    if (camera.params[i] > most_focal) {
+      return fmt::format(
+          "the focal length {:.6g} px is more than {} times the image's larger side ({} px)",
+          camera.params[i], kMostFocalLengthPerSide, std::max(camera.width, camera.height));
+    }
   }
   return {};
 }
@@ -351,6 +360,7 @@ std::string camera_problem(const ColmapCamera& camera) {
 std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const fs::path& path,
                                                              std::string* error) {
   std::vector<ColmapCamera> cameras;
+  std::set<int> ids;
   const bool ok = read_lines(
       path, error, [&](std::istream&, const std::string& line, int&, std::string* message) {
         const auto words = split_words(line);
@@ -369,6 +379,10 @@ std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const fs::path& pat
         }
         *message = camera_problem(camera);
         if (!message->empty()) return false;
+        if (!ids.insert(camera.camera_id).second) {
+          *message = fmt::format("camera {} is listed twice", camera.camera_id);
+          return false;
+        }
         cameras.push_back(std::move(camera));
         return true;
       });
@@ -378,6 +392,24 @@ std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const fs::path& pat
     return std::nullopt;
   }
   return cameras;
+}
+
+bool check_camera_ids(const std::vector<ColmapImage>& images,
+                      const std::vector<ColmapCamera>& cameras, const fs::path& images_path,
+                      std::string* error) {
+  std::set<int> ids;
+  for (const ColmapCamera& camera : cameras) ids.insert(camera.camera_id);
+  for (const ColmapImage& image : images) {
+    if (ids.count(image.camera_id)) continue;
+    if (error != nullptr) {
+      const std::string at = image.line > 0 ? fmt::format("{}:{}", images_path.string(), image.line)
+                                            : images_path.string();
+      *error = fmt::format("{}: image '{}' uses camera {}, which the cameras file does not define",
+                           at, image.name, image.camera_id);
+    }
+    return false;
+  }
+  return true;
 }
 
 ir::Vec2 project_opencv(const std::vector<double>& params, const ir::Mat4& camera_from_world,

@@ -60,6 +60,7 @@ struct ColmapImage {
   int camera_id = 0;
   std::string name;
   ir::Mat4 camera_from_world = ir::Mat4::Identity();  // from the normalised quaternion and T
+  int line = 0;  // of the image in images.txt (0 when read from elsewhere)
 };
 
 struct ColmapCamera {
@@ -72,10 +73,22 @@ struct ColmapCamera {
 
 // Readers for COLMAP's text format (comments and blank lines skipped; an image's POINTS2D line is
 // read and ignored). nullopt with a one-line `error` naming file and line on malformed input.
+// A quaternion whose length is within kQuaternionTolerance of 1 (text written with few digits) is
+// normalised; a longer or shorter one is an error, as it is no rotation the file's writer meant.
+// A camera's focal lengths are at most kMostFocalLengthPerSide times its larger side (a field of
+// view under 0.6 degrees), its CAMERA_IDs distinct.
 std::optional<std::vector<ColmapImage>> read_colmap_images(const std::filesystem::path& path,
                                                            std::string* error);
 std::optional<std::vector<ColmapCamera>> read_colmap_cameras(const std::filesystem::path& path,
                                                              std::string* error);
+inline constexpr double kQuaternionTolerance = 1e-3;
+inline constexpr double kMostFocalLengthPerSide = 100;
+
+// Every image's CAMERA_ID is among `cameras`; false with "IMAGES_PATH:LINE: image 'NAME' uses
+// camera 7, which ... does not define" otherwise.
+bool check_camera_ids(const std::vector<ColmapImage>& images,
+                      const std::vector<ColmapCamera>& cameras,
+                      const std::filesystem::path& images_path, std::string* error);
 
 // COLMAP's projection of a world point, pixel centres at +0.5. `params` in COLMAP order:
 // PINHOLE (4: fx fy cx cy), OPENCV (8: + k1 k2 p1 p2) or FULL_OPENCV (12: + k3 k4 k5 k6).

@@ -171,6 +171,9 @@ TEST(BackendColmap, CameraLinesCOLMAPCannotUseAreErrorsAtTheirLine) {
       {"1 SIMPLE_RADIAL 821 547 0 410.5 273.5 0", "focal length must be above 0"},
       {"1 OPENCV 821 547 1146", "OPENCV takes 8 parameters, not 1"},
       {"1 FOOCAM 821 547 1146 1144 410.5 273.5", "unknown camera model 'FOOCAM'"},
+      {"1 OPENCV 821 547 1e308 1144 410.5 273.5 -0.02 0 0 0",
+       "focal length 1e+308 px is more than 100 times the image's larger side (821 px)"},
+      {"1 SIMPLE_PINHOLE 821 547 82101 410.5 273.5", "focal length 82101 px is more than"},
   };
   std::string error;
   for (const Case& c : cases) {
@@ -200,6 +203,50 @@ TEST(BackendColmap, ImagesWithNonFinitePosesOrRepeatedNamesAreErrors) {
                             "1 1 0 0 0 0 0 0 1 a.jpg\n\n2 1 0 0 0 0 0 1 1 a.jpg\n\n");
   EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
   EXPECT_NE(error.find("images.txt:3: image 'a.jpg' is listed twice"), std::string::npos) << error;
+}
+
+TEST(BackendColmap, RepeatedCameraIdsAreAnError) {
+  TempDir dir;
+  std::string error;
+  rigc::testing::write_text(dir.file("cameras.txt"),
+                            "1 PINHOLE 100 80 90 90 50 40\n1 PINHOLE 100 80 91 91 50 40\n");
+  EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value());
+  EXPECT_NE(error.find("cameras.txt:2: camera 1 is listed twice"), std::string::npos) << error;
+}
+
+// A quaternion a little off unit length (few digits) is normalised; one far off is refused.
+TEST(BackendColmap, NonUnitQuaternionsAreNormalisedNearOneAndRefusedFarFromIt) {
+  TempDir dir;
+  std::string error;
+  rigc::testing::write_text(dir.file("images.txt"), "1 0.7071 0.7071 0 0 0 0 0 1 a.jpg\n\n");
+  const auto images = read_colmap_images(dir.path() / "images.txt", &error);
+  ASSERT_TRUE(images.has_value()) << error;
+  const Eigen::Matrix3d r = (*images)[0].camera_from_world.block<3, 3>(0, 0);
+  EXPECT_NEAR((r * r.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12);
+  EXPECT_NEAR(r(2, 1), 1, 1e-12);  // 90 degrees about x
+  for (const std::string q : {"2 0 0 0", "0.5 0 0 0", "0 0 0 0"}) {
+    rigc::testing::write_text(dir.file("images.txt"), "# header\n1 " + q + " 0 0 0 1 a.jpg\n\n");
+    EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value()) << q;
+    EXPECT_NE(error.find("images.txt:2: the quaternion QW QX QY QZ has length"), std::string::npos)
+        << error;
+  }
+}
+
+TEST(BackendColmap, AnImageOfAnUndefinedCameraIsAnErrorAtItsLine) {
+  TempDir dir;
+  std::string error;
+  rigc::testing::write_text(dir.file("cameras.txt"), "1 PINHOLE 100 80 90 90 50 40\n");
+  rigc::testing::write_text(dir.file("images.txt"),
+                            "# header\n1 1 0 0 0 0 0 0 1 a.jpg\n\n2 1 0 0 0 0 0 0 7 b.jpg\n\n");
+  const auto cameras = read_colmap_cameras(dir.path() / "cameras.txt", &error);
+  const auto images = read_colmap_images(dir.path() / "images.txt", &error);
+  ASSERT_TRUE(cameras && images) << error;
+  EXPECT_FALSE(check_camera_ids(*images, *cameras, dir.path() / "images.txt", &error));
+  EXPECT_NE(error.find("images.txt:4: image 'b.jpg' uses camera 7, which the cameras file does "
+                       "not define"),
+            std::string::npos)
+      << error;
+  EXPECT_TRUE(check_camera_ids({(*images)[0]}, *cameras, dir.path() / "images.txt", &error));
 }
 
 TEST(BackendColmap, ProjectOpencvCentreAndHandComputedPoint) {

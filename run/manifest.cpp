@@ -119,13 +119,9 @@ json Manifest::to_json() const {
 }
 
 bool Manifest::save(const fs::path& path, std::string* error) const {
-  std::string text;
-  try {
-    text = to_json().dump(2) + "\n";
-  } catch (const std::exception& e) {  // e.g. invalid UTF-8 in a string
-    if (error != nullptr) *error = std::string("cannot write ") + path.string() + ": " + e.what();
-    return false;
-  }
+  // Text from the user's files (a scene or texture name) may hold bytes that are not UTF-8: each
+  // becomes U+FFFD rather than an exception.
+  const std::string text = to_json().dump(2, ' ', false, json::error_handler_t::replace) + "\n";
   return write_file_atomically(path, text, error);
 }
 

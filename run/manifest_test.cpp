@@ -62,6 +62,22 @@ TEST(BackendManifest, SaveLoadAndIsDone) {
   EXPECT_FALSE(loaded.is_done("shot_000", "abc", run.path()));
 }
 
+// Bytes that are not UTF-8 in a name made nlohmann::json throw at save.
+TEST(BackendManifest, SavesTextThatIsNotUtf8) {
+  TempDir run;
+  Manifest manifest;
+  manifest.set_inputs({{"scene", "bad\xff.yaml"}});
+  ShotRecord record = sample_record("abc");
+  record.files = {"images/shot\xfe.jpg"};
+  manifest.record(record);
+  std::string error;
+  ASSERT_TRUE(manifest.save(run.path() / "manifest.json", &error)) << error;
+  const Manifest loaded = Manifest::load(run.path() / "manifest.json");
+  EXPECT_EQ(loaded.inputs()["scene"], "bad\xEF\xBF\xBD.yaml");
+  ASSERT_NE(loaded.find("shot_000"), nullptr);
+  EXPECT_EQ(loaded.find("shot_000")->files.at(0), "images/shot\xEF\xBF\xBD.jpg");
+}
+
 TEST(BackendManifest, MissingOrCorruptFileGivesAnEmptyManifest) {
   TempDir run;
   EXPECT_TRUE(Manifest::load(run.path() / "missing.json").shots().empty());

@@ -8,6 +8,10 @@ namespace rigc::run {
 
 void protect_scene_inputs(const std::string& scene_path, const ir::Scene& scene) {
   protect_input_file(scene_path, "the scene file");
+  protect_scene_files(scene);
+}
+
+void protect_scene_files(const ir::Scene& scene) {
   const std::string& mesh = scene.object.source;
   if (!mesh.empty() && !mesh.starts_with("primitive:")) {
     protect_input_file(mesh, "the scene's mesh");

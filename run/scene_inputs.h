@@ -12,4 +12,7 @@ namespace rigc::run {
 // texture files.
 void protect_scene_inputs(const std::string& scene_path, const ir::Scene& scene);
 
+// The same but the scene file: for a scene compiled from text (a sweep's variant).
+void protect_scene_files(const ir::Scene& scene);
+
 }  // namespace rigc::run

@@ -11,6 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/files.h"
 #include "run/manifest.h"
+#include "run/scene_inputs.h"
 #include "sweep/scene_edit.h"
 
 namespace rigc::sweep {
@@ -200,6 +201,7 @@ bool build_variants(const SweepSpec& spec, const std::string& scene_text, const 
       continue;
     }
     v.key = variant_key(spec, v, run::scene_content_hash(*scene));
+    run::protect_scene_files(*scene);
   }
   return ok;
 }
