@@ -105,11 +105,7 @@ Outcome Session::start_reference(const ReferenceRequest& request) {
   if (!(request.width >= 64 && request.width <= 4096) || request.samples < 0) {
     return Outcome::fail("a reference is 64..4096 pixels wide, with samples >= 0");
   }
-  std::shared_ptr<const ir::Scene> view;
-  {
-    std::lock_guard lock(mutex_);
-    view = view_scene_;
-  }
+  const std::shared_ptr<const ir::Scene> view = view_scene();
   const double scale = std::min(1.0, static_cast<double>(request.width) / view->camera.width_px);
   std::string error;
   std::optional<Frame> preview = frame(scale, &error);
@@ -132,32 +128,36 @@ std::string Session::read_disk(std::string* error) const {
   return text.str();
 }
 
-// Compiles `text`; when it compiles it becomes the session's scene (the view is recompiled on
-// it), otherwise the last good scene stays and the diagnostics are the message. What `change`
-// cannot have touched is kept.
+// Compiles `text`; when it compiles it becomes the session's scene, otherwise the last good
+// scene stays and the diagnostics are the message. What `change` cannot have touched is kept.
+// Unless only shots changed, the view is compiled with it in one go: appended as the last shot
+// (the compiler places, focuses and refuses it there as in a scene of its own).
 Outcome Session::apply_text(std::string text, Change change) {
-  Compiled compiled = compile_text(text, file_);
-  if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
-  auto scene = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
-  auto studio =
-      change != Change::kAnything && studio_
-          ? studio_
-          : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
-  const std::string previous = text_;
-  auto previous_scene = scene_;
-  auto previous_studio = studio_;
+  std::optional<ir::Shot> view_shot;
+  std::optional<ir::Scene> compiled_scene;
+  if (view_shot_ && change != Change::kShots) {
+    std::string error;
+    std::string entry = view_pose_text(view_);
+    entry = entry.substr(1, entry.size() - 2);
+    const auto with_view = append_to_list(text, {"shots"}, entry, &error);
+    if (!with_view) return Outcome::fail(error);
+    Compiled compiled = compile_text(*with_view, file_);
+    if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+    view_shot = as_view_shot(compiled.scene->shots.back());
+    compiled.scene->shots.pop_back();
+    compiled_scene = std::move(compiled.scene);
+  } else {
+    Compiled compiled = compile_text(text, file_);
+    if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+    compiled_scene = std::move(compiled.scene);
+  }
+  auto scene = std::make_shared<const ir::Scene>(std::move(*compiled_scene));
+  studio_ = change != Change::kAnything && studio_
+                ? studio_
+                : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
   text_ = std::move(text);
   scene_ = scene;
-  studio_ = studio;
-  if (view_scene_ && change != Change::kShots) {
-    const Outcome viewed = compile_view(view_);
-    if (!viewed.ok) {
-      text_ = previous;
-      scene_ = previous_scene;
-      studio_ = previous_studio;
-      return viewed;
-    }
-  }
+  if (view_shot) view_shot_ = std::move(view_shot);
   if (change != Change::kShots) ++analysis_generation_;
   ++revision_;
   return {};
@@ -169,7 +169,7 @@ std::string Session::view_pose_text(const View& view) const {
                      view.turntable_rad * 180 / std::numbers::pi);
 }
 
-// The view is compiled as the scene's only shot, so the compiler places it, focuses it and
+// The view is compiled as the scene's only shot, so that the compiler places it, focuses it and
 // refuses it (below the floor, inside the table) with its own message.
 Outcome Session::compile_view(const View& view) {
   std::string error;
@@ -179,10 +179,25 @@ Outcome Session::compile_view(const View& view) {
   if (!text) return Outcome::fail(error);
   Compiled compiled = compile_text(*text, file_);
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
-  view_scene_ = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
+  view_shot_ = as_view_shot(compiled.scene->shots.front());
   view_ = view;
   ++revision_;
   return {};
+}
+
+// The view's shot as a scene of its own would hold it: the first.
+ir::Shot Session::as_view_shot(ir::Shot shot) {
+  shot.index = 0;
+  shot.name = "shot_000";
+  return shot;
+}
+
+// The scene with the view as its only shot (for the reference check).
+std::shared_ptr<const ir::Scene> Session::view_scene() {
+  std::lock_guard lock(mutex_);
+  auto view = std::make_shared<ir::Scene>(*scene_);
+  view->shots = {*view_shot_};
+  return view;
 }
 
 Outcome Session::set_value(const ScenePath& path, const std::string& value) {
@@ -353,7 +368,7 @@ nlohmann::json lights_json(const std::vector<ir::Light>& lights) {
 nlohmann::json Session::state() {
   std::lock_guard lock(mutex_);
   const ir::Scene& scene = *scene_;
-  const ir::Shot& view_shot = view_scene_->shots.front();
+  const ir::Shot& view_shot = *view_shot_;
   const auto focus = scene_focus_auto(text_);
   nlohmann::json bodies = nlohmann::json::array();
   for (const auto& preset : body_presets()) bodies.push_back(preset.name);
@@ -392,7 +407,8 @@ nlohmann::json Session::state() {
 bool Session::render_linear(const ir::Scene& scene,
                             const std::shared_ptr<const scene::StudioScene>& studio,
                             const ir::Shot& shot, const run::RenderSettings& settings,
-                            run::RenderedShot* rendered, bool* reused, std::string* error) {
+                            std::shared_ptr<const run::RenderedShot>* rendered, bool* reused,
+                            std::string* error) {
   RenderCache key;
   key.studio = studio;
   key.world_from_camera = shot.world_from_camera;
@@ -414,24 +430,31 @@ bool Session::render_linear(const ir::Scene& scene,
   *reused = hit != render_cache_.end();
   if (*reused) {
     *rendered = hit->rendered;
-    rendered->stage_ms.clear();
     return true;
   }
-  if (!preview_->render(scene, *studio, shot, settings, {}, rendered, error)) return false;
-  key.rendered = *rendered;
+  auto fresh = std::make_shared<run::RenderedShot>();
+  if (!render_preview(scene, *studio, shot, settings, fresh.get(), error)) return false;
+  key.rendered = *rendered = std::move(fresh);
   render_cache_.push_front(std::move(key));
   // The live view's two sizes (moving and at rest) of the current view.
   if (render_cache_.size() > 2) render_cache_.pop_back();
   return true;
 }
 
+bool Session::render_preview(const ir::Scene& scene, const scene::StudioScene& studio,
+                             const ir::Shot& shot, const run::RenderSettings& settings,
+                             run::RenderedShot* rendered, std::string* error) {
+  return preview_->render(scene, studio, shot, settings, {}, rendered, error);
+}
+
 std::optional<Frame> Session::frame(double scale, std::string* error) {
-  std::shared_ptr<const ir::Scene> scene, view;
+  std::shared_ptr<const ir::Scene> scene;
   std::shared_ptr<const scene::StudioScene> studio;
+  ir::Shot shot;
   {
     std::lock_guard lock(mutex_);
     scene = scene_;
-    view = view_scene_;
+    shot = *view_shot_;
     studio = studio_;
   }
   ++frames_rendering_;
@@ -445,22 +468,21 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   } done{frames_rendering_, last_frame_end_};
   std::lock_guard render_lock(render_mutex_);
   const auto start = Clock::now();
-  const ir::Shot& shot = view->shots.front();
   run::RenderSettings settings;
   settings.scale = scale;
   if (!settings.check(error)) return std::nullopt;
-  run::RenderedShot rendered;
+  std::shared_ptr<const run::RenderedShot> rendered;
   Frame frame;
   if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render, error)) {
     return std::nullopt;
   }
   error->clear();
-  std::map<std::string, double> stages = rendered.stage_ms;
+  std::map<std::string, double> stages;
+  if (!frame.reused_render) stages = rendered->stage_ms;
+  bool reused_optics = false;
   dslr::DevelopResult developed =
-      run::develop_shot(*scene, shot, std::move(rendered), settings, false, error, &stages);
-  if (developed.encoded_bytes.empty()) {
-    developed.encoded_bytes.assign(developed.encoded.begin(), developed.encoded.end());
-  }
+      live_develop_.develop(scene->camera, std::move(rendered), shot, settings.seed, scale,
+                            &reused_optics, error, &stages);
   if (developed.encoded_bytes.empty()) {
     if (error->empty()) *error = "the DSLR model produced no image";
     return std::nullopt;

@@ -21,6 +21,7 @@
 #include "run/backend.h"
 #include "scene/studio_scene.h"
 #include "studio/frame_encoding.h"
+#include "studio/live_develop.h"
 #include "studio/reference_check.h"
 #include "studio/scene_edit.h"
 
@@ -116,12 +117,14 @@ class Session {
     double turntable_angle_rad = 0, turntable_velocity_rad_s = 0, shutter_s = 0;
     dslr::RenderGeometry canvas;
     int subframes = 1;
-    run::RenderedShot rendered;
+    std::shared_ptr<const run::RenderedShot> rendered;
   };
 
   Outcome apply_text(std::string text, Change change);
   Outcome push_text(const std::string& text, Change change);
   Outcome compile_view(const View& view);
+  static ir::Shot as_view_shot(ir::Shot shot);
+  std::shared_ptr<const ir::Scene> view_scene();
   std::string view_pose_text(const View& view) const;
   std::string read_disk(std::string* error) const;
   nlohmann::json coverage_json(const ir::Scene& scene,
@@ -133,8 +136,12 @@ class Session {
       const analysis::CoverageOptions& options);
   bool render_linear(const ir::Scene& scene,
                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                     const run::RenderSettings& settings, run::RenderedShot* rendered, bool* reused,
+                     const run::RenderSettings& settings,
+                     std::shared_ptr<const run::RenderedShot>* rendered, bool* reused,
                      std::string* error);
+  bool render_preview(const ir::Scene& scene, const scene::StudioScene& studio,
+                      const ir::Shot& shot, const run::RenderSettings& settings,
+                      run::RenderedShot* rendered, std::string* error);
 
   std::mutex mutex_;
   // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
@@ -151,7 +158,7 @@ class Session {
   std::string file_error_;                  // the file on disk does not compile: its diagnostics
   std::shared_ptr<const ir::Scene> scene_;  // text_ compiled, with every shot
   std::shared_ptr<const scene::StudioScene> studio_;
-  std::shared_ptr<const ir::Scene> view_scene_;  // text_ with the view as its only shot
+  std::optional<ir::Shot> view_shot_;  // the view, compiled as the only shot of text_
   View view_;
   int captures_ = 0;
   int revision_ = 0;  // counts the changes, so the page knows when to refresh
@@ -162,6 +169,7 @@ class Session {
   std::atomic<std::int64_t> last_frame_end_{0};  // steady clock ticks
   AnalysisCache coverage_cache_, advice_cache_;  // under analysis_mutex_
   std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
+  LiveDevelop live_develop_;                     // under render_mutex_
   std::unique_ptr<run::Backend> preview_;
   std::unique_ptr<ReferenceCheck> reference_;
 };
