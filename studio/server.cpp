@@ -274,7 +274,12 @@ void StudioServer::add_page_routes() {
       send_json(res, *result);
     });
   };
-  analysis("/api/coverage", &Session::coverage);
+  // ?capture=1: the page waits for it after a capture; it goes before background analyses.
+  server_->Get("/api/coverage", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto result = session_.coverage(req.get_param_value("capture") != "1");
+    if (!result) return send_error(res, 409, "the scene changed during the analysis");
+    send_json(res, *result);
+  });
   analysis("/api/advice", &Session::advice);
   server_->Get("/api/mesh", [this](const httplib::Request&, httplib::Response& res) {
     send_json(res, session_.mesh());

@@ -12,7 +12,7 @@
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
-#include "backends/registry.h"
+#include "backends/preview/preview_backend.h"
 #include "compiler/diagnostics.h"
 #include "compiler/frontend.h"
 #include "compiler/presets.h"
@@ -20,6 +20,7 @@
 #include "io/atomic_file.h"
 #include "plan/plan_scene.h"
 #include "plan/scene_text.h"
+#include "raster/shadow_map_cache.h"
 #include "run/run_loop.h"
 #include "scene/motion_blur.h"
 #include "studio/frame_encoding.h"
@@ -93,7 +94,6 @@ std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* 
     *error = viewed.message;
     return nullptr;
   }
-  session->preview_ = backends::find_backend("preview")->make();
   if (run_folder.empty()) run_folder = fs::path("out") / session->scene_->name / "studio";
   session->reference_ = std::make_unique<ReferenceCheck>(run_folder);
   return session;
@@ -407,8 +407,7 @@ nlohmann::json Session::state() {
 bool Session::render_linear(const ir::Scene& scene,
                             const std::shared_ptr<const scene::StudioScene>& studio,
                             const ir::Shot& shot, const run::RenderSettings& settings,
-                            std::shared_ptr<const run::RenderedShot>* rendered, bool* reused,
-                            std::string* error) {
+                            std::shared_ptr<const run::RenderedShot>* rendered, bool* reused) {
   RenderCache key;
   key.studio = studio;
   key.world_from_camera = shot.world_from_camera;
@@ -433,7 +432,7 @@ bool Session::render_linear(const ir::Scene& scene,
     return true;
   }
   auto fresh = std::make_shared<run::RenderedShot>();
-  if (!render_preview(scene, *studio, shot, settings, fresh.get(), error)) return false;
+  render_preview(scene, studio, shot, settings.scale, fresh.get());
   key.rendered = *rendered = std::move(fresh);
   render_cache_.push_front(std::move(key));
   // The live view's two sizes (moving and at rest) of the current view.
@@ -441,10 +440,15 @@ bool Session::render_linear(const ir::Scene& scene,
   return true;
 }
 
-bool Session::render_preview(const ir::Scene& scene, const scene::StudioScene& studio,
-                             const ir::Shot& shot, const run::RenderSettings& settings,
-                             run::RenderedShot* rendered, std::string* error) {
-  return preview_->render(scene, studio, shot, settings, {}, rendered, error);
+// The preview's frame, with the shadow maps kept while the studio (and its lights) stays.
+void Session::render_preview(const ir::Scene& scene,
+                             const std::shared_ptr<const scene::StudioScene>& studio,
+                             const ir::Shot& shot, double scale, run::RenderedShot* rendered) {
+  if (shadow_studio_ != studio || !shadow_cache_) {
+    shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
+    shadow_studio_ = studio;
+  }
+  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get());
 }
 
 std::optional<Frame> Session::frame(double scale, std::string* error) {
@@ -473,7 +477,7 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   if (!settings.check(error)) return std::nullopt;
   std::shared_ptr<const run::RenderedShot> rendered;
   Frame frame;
-  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render, error)) {
+  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render)) {
     return std::nullopt;
   }
   error->clear();
@@ -499,14 +503,16 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   return frame;
 }
 
-// The coverage of `scene`'s shots with `options`. The cached analysis serves when only shots
-// changed since it started (generation): the shots it has beyond those `scene` begins with are
-// taken back, and `scene`'s further shots added. Nullopt when a newer change started another
-// generation meanwhile (the analysis stops at its next shot).
-std::optional<analysis::CoverageResult> Session::analyse(
-    AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
-    const std::shared_ptr<const scene::StudioScene>& studio, int generation,
-    const analysis::CoverageOptions& options) {
+// The coverage of `scene`'s shots with `options`. A kept analysis of the same scene but for its
+// shots (`key`: the scene text without them) serves: the shots it has beyond those `scene`
+// begins with are taken back, and `scene`'s further shots added. Nullopt when a newer change
+// started another generation meanwhile (the analysis stops at its next shot, and is kept for
+// when its scene comes back), or when a capture waits for a background coverage. A background
+// analysis yields to the live view between shots.
+std::optional<analysis::CoverageResult> Session::analyse(std::deque<AnalysisCache>& caches,
+                                                         const Analysed& what,
+                                                         const analysis::CoverageOptions& options,
+                                                         bool background) {
   const auto same_shot = [](const ir::Shot& a, const ir::Shot& b) {
     return a.world_from_camera == b.world_from_camera &&
            a.object_from_camera == b.object_from_camera &&
@@ -514,57 +520,75 @@ std::optional<analysis::CoverageResult> Session::analyse(
            a.turntable_velocity_rad_s == b.turntable_velocity_rad_s &&
            a.focus_distance_m == b.focus_distance_m;
   };
-  if (cache.run && cache.generation == generation) {
+  const auto& shots = what.scene->shots;
+  auto hit = std::find_if(caches.begin(), caches.end(),
+                          [&](const AnalysisCache& c) { return c.key == what.key; });
+  if (hit == caches.end()) {
+    caches.push_front({what.key, nullptr});
+    if (caches.size() > kKeptAnalyses) caches.pop_back();
+    hit = caches.begin();
+  }
+  AnalysisCache& cache = *hit;
+  if (cache.run) {
     const auto& kept = cache.run->shots();
     size_t common = 0;
-    while (common < kept.size() && common < scene->shots.size() &&
-           same_shot(kept[common], scene->shots[common])) {
+    while (common < kept.size() && common < shots.size() &&
+           same_shot(kept[common], shots[common])) {
       ++common;
     }
     while (cache.run && static_cast<size_t>(cache.run->shot_count()) > common) {
       if (!cache.run->remove_last_shot()) cache.run.reset();
     }
-  } else {
-    cache.run.reset();
   }
   if (!cache.run) {
-    cache.run = std::make_unique<analysis::IncrementalCoverage>(scene, studio, options);
-    cache.generation = generation;
+    cache.run = std::make_unique<analysis::IncrementalCoverage>(what.scene, what.studio, options);
   }
-  for (size_t s = cache.run->shot_count(); s < scene->shots.size(); ++s) {
-    if (analysis_generation_ != generation) return std::nullopt;
-    // The live view first: while frames come (a slider or the camera moving), the next shot
-    // waits until they pause.
-    const auto live_view_busy = [&] {
-      const Clock::duration since_frame =
-          Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
-      return frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200);
-    };
-    while (live_view_busy() && analysis_generation_ == generation) {
+  // The live view first: while frames come (a slider or the camera moving), the next shot of a
+  // background analysis waits until they pause, unless a capture waits for the coverage.
+  const auto live_view_busy = [&] {
+    const Clock::duration since_frame =
+        Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
+    return urgent_requests_ == 0 &&
+           (frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200));
+  };
+  for (size_t s = cache.run->shot_count(); s < shots.size(); ++s) {
+    if (analysis_generation_ != what.generation) return std::nullopt;
+    // A background analysis hands the kept work to a waiting capture's (it goes on from here).
+    if (background && urgent_requests_ > 0 && &caches == &coverage_caches_) return std::nullopt;
+    while (background && live_view_busy() && analysis_generation_ == what.generation) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    cache.run->add_shot(scene->shots[s]);
+    cache.run->add_shot(shots[s]);
   }
   return cache.run->result();
 }
 
-// The coverage `rigc coverage` computes (its default options).
-std::optional<nlohmann::json> Session::coverage() {
-  std::shared_ptr<const ir::Scene> scene;
-  std::shared_ptr<const scene::StudioScene> studio;
-  int generation = 0;
-  {
-    std::lock_guard lock(mutex_);
-    scene = scene_;
-    studio = studio_;
-    generation = analysis_generation_;
-  }
-  std::lock_guard analysis_lock(analysis_mutex_);
+// What the analyses see now: the scene, its studio, the generation and the cache key.
+Session::Analysed Session::analysed() {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  const auto without_shots = plan::replace_shots_section(text_, "shots:\n", &error);
+  return {scene_, studio_, analysis_generation_, without_shots ? *without_shots : text_};
+}
+
+// The coverage `rigc coverage` computes (its default options). A capture's (not `background`)
+// goes first: background analyses stop yielding to the live view while it waits.
+std::optional<nlohmann::json> Session::coverage(bool background) {
+  const Analysed what = analysed();
+  struct Urgent {
+    std::atomic<int>& count;
+    bool on;
+    ~Urgent() {
+      if (on) --count;
+    }
+  } urgent{urgent_requests_, !background};
+  if (!background) ++urgent_requests_;
+  std::lock_guard coverage_lock(coverage_mutex_);
   const auto start = Clock::now();
-  const auto result = analyse(coverage_cache_, scene, studio, generation, {});
+  const auto result = analyse(coverage_caches_, what, {}, background);
   if (!result) return std::nullopt;
   const double ms = ms_since(start);
-  nlohmann::json out = coverage_json(*scene, *result);
+  nlohmann::json out = coverage_json(*what.scene, *result);
   out["analysis_ms"] = ms;
   return out;
 }
@@ -587,15 +611,8 @@ nlohmann::json Session::coverage_json(const ir::Scene& scene,
 
 // The warnings `rigc check` prints, at the same reduced resolution.
 std::optional<nlohmann::json> Session::advice() {
-  std::shared_ptr<const ir::Scene> scene;
-  std::shared_ptr<const scene::StudioScene> studio;
-  int generation = 0;
-  {
-    std::lock_guard lock(mutex_);
-    scene = scene_;
-    studio = studio_;
-    generation = analysis_generation_;
-  }
+  const Analysed what = analysed();
+  std::shared_ptr<const ir::Scene> scene = what.scene;
   std::lock_guard analysis_lock(analysis_mutex_);
   DiagnosticEngine diag;
   diag.add_source(file_.string(), text_snapshot(scene));
@@ -609,9 +626,9 @@ std::optional<nlohmann::json> Session::advice() {
   });
   analysis::CoverageOptions options;
   options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-  const auto coverage = analyse(advice_cache_, scene, studio, generation, options);
+  const auto coverage = analyse(advice_caches_, what, options, true);
   if (!coverage) return std::nullopt;
-  analysis::report_capture_advice(*scene, *studio, *coverage, diag);
+  analysis::report_capture_advice(*scene, *what.studio, *coverage, diag);
   return out;
 }
 

@@ -18,6 +18,7 @@
 
 #include "analysis/coverage.h"
 #include "ir/ir.h"
+#include "raster/shadow_map_cache.h"
 #include "run/backend.h"
 #include "scene/studio_scene.h"
 #include "studio/frame_encoding.h"
@@ -92,7 +93,7 @@ class Session {
   std::optional<Frame> frame(double scale, std::string* error);
   // The coverage of the scene's shots; nullopt when the scene changed (other than in its shots)
   // while it was being analysed.
-  std::optional<nlohmann::json> coverage();
+  std::optional<nlohmann::json> coverage(bool background = true);
   std::optional<nlohmann::json> advice();
   nlohmann::json mesh();
   int sensor_width_px();
@@ -106,9 +107,18 @@ class Session {
   Session() = default;
   // A coverage analysis kept between requests: shots added or taken back reuse it.
   struct AnalysisCache {
+    std::string key;  // the scene text without its shots
     std::unique_ptr<analysis::IncrementalCoverage> run;
-    int generation = -1;
   };
+  // Analyses kept for the last scenes (a setting turned back and forth).
+  static constexpr size_t kKeptAnalyses = 3;
+  struct Analysed {
+    std::shared_ptr<const ir::Scene> scene;
+    std::shared_ptr<const scene::StudioScene> studio;
+    int generation = 0;
+    std::string key;
+  };
+  Analysed analysed();
   // A linear frame the preview rendered, and what it depends on besides the exposure, focus and
   // white balance (which the DSLR model applies after it).
   struct RenderCache {
@@ -130,23 +140,22 @@ class Session {
   nlohmann::json coverage_json(const ir::Scene& scene,
                                const analysis::CoverageResult& coverage) const;
   std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
-  std::optional<analysis::CoverageResult> analyse(
-      AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
-      const std::shared_ptr<const scene::StudioScene>& studio, int generation,
-      const analysis::CoverageOptions& options);
+  std::optional<analysis::CoverageResult> analyse(std::deque<AnalysisCache>& caches,
+                                                  const Analysed& what,
+                                                  const analysis::CoverageOptions& options,
+                                                  bool background);
   bool render_linear(const ir::Scene& scene,
                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
                      const run::RenderSettings& settings,
-                     std::shared_ptr<const run::RenderedShot>* rendered, bool* reused,
-                     std::string* error);
-  bool render_preview(const ir::Scene& scene, const scene::StudioScene& studio,
-                      const ir::Shot& shot, const run::RenderSettings& settings,
-                      run::RenderedShot* rendered, std::string* error);
+                     std::shared_ptr<const run::RenderedShot>* rendered, bool* reused);
+  void render_preview(const ir::Scene& scene,
+                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
+                      double scale, run::RenderedShot* rendered);
 
   std::mutex mutex_;
-  // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
-  // takes seconds) does not hold up the live view.
-  std::mutex render_mutex_, analysis_mutex_;
+  // One frame at a time; beside it one coverage and one advice analysis (and plan), so that
+  // neither analysis holds up the live view or the other.
+  std::mutex render_mutex_, analysis_mutex_, coverage_mutex_;
   std::filesystem::path file_;
   std::string disk_text_;  // the file as last read or saved
   std::string text_;       // the scene as the user changed it
@@ -167,10 +176,14 @@ class Session {
   std::atomic<int> analysis_generation_{0};
   std::atomic<int> frames_rendering_{0};  // the analysis yields to the live view between shots
   std::atomic<std::int64_t> last_frame_end_{0};  // steady clock ticks
-  AnalysisCache coverage_cache_, advice_cache_;  // under analysis_mutex_
+  std::atomic<int> urgent_requests_{0};          // captures waiting for their coverage
+  std::deque<AnalysisCache> coverage_caches_;    // under coverage_mutex_, newest first
+  std::deque<AnalysisCache> advice_caches_;      // under analysis_mutex_, newest first
   std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
   LiveDevelop live_develop_;                     // under render_mutex_
-  std::unique_ptr<run::Backend> preview_;
+  // Shadow maps of shadow_studio_'s lights, kept while the camera moves (under render_mutex_).
+  std::shared_ptr<const scene::StudioScene> shadow_studio_;
+  std::unique_ptr<raster::ShadowMapCache> shadow_cache_;
   std::unique_ptr<ReferenceCheck> reference_;
 };
 
