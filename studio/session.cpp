@@ -66,6 +66,16 @@ bool scene_focus_auto(const std::string& text) {
   }
 }
 
+// The scene's lens preset (`camera.lens.preset`), or "" when it gives a focal length only.
+std::string scene_lens_preset(const std::string& text) {
+  try {
+    const YAML::Node preset = YAML::Load(text)["camera"]["lens"]["preset"];
+    return preset && preset.IsScalar() ? preset.Scalar() : std::string();
+  } catch (const YAML::Exception&) {
+    return {};
+  }
+}
+
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -201,14 +211,24 @@ std::shared_ptr<const ir::Scene> Session::view_scene() {
 }
 
 Outcome Session::set_value(const ScenePath& path, const std::string& value) {
+  return set_values({{path, value}});
+}
+
+Outcome Session::set_values(const std::vector<std::pair<ScenePath, std::string>>& values) {
   std::lock_guard lock(mutex_);
-  if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
-    return Outcome::fail("only camera.* and studio.* values can be set");
+  std::string text = text_;
+  Change change = Change::kCamera;
+  for (const auto& [path, value] : values) {
+    if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
+      return Outcome::fail("only camera.* and studio.* values can be set");
+    }
+    std::string error;
+    const auto edited = studio::set_value(text, path, value, &error);
+    if (!edited) return Outcome::fail(error);
+    text = *edited;
+    if (path[0] != "camera") change = Change::kAnything;
   }
-  std::string error;
-  const auto text = studio::set_value(text_, path, value, &error);
-  if (!text) return Outcome::fail(error);
-  return push_text(*text, path[0] == "camera" ? Change::kCamera : Change::kAnything);
+  return push_text(text, change);
 }
 
 Outcome Session::add_light(const std::string& entry) {
@@ -372,6 +392,14 @@ nlohmann::json Session::state() {
   const auto focus = scene_focus_auto(text_);
   nlohmann::json bodies = nlohmann::json::array();
   for (const auto& preset : body_presets()) bodies.push_back(preset.name);
+  nlohmann::json lenses = nlohmann::json::array();
+  for (const auto& lens : lens_presets()) {
+    lenses.push_back({{"name", lens.name},
+                      {"model", lens.model},
+                      {"focal_mm", {lens.shortest_focal_m * 1000, lens.longest_focal_m * 1000}},
+                      {"f_numbers", {lens.widest_f_number, lens.narrowest_f_number}},
+                      {"min_focus_m", lens.min_focus_m}});
+  }
   const Eigen::Vector3d center =
       (ir::world_from_object(scene, view_.turntable_rad) *
        ((scene.object.bounds_min_object + scene.object.bounds_max_object) / 2).homogeneous())
@@ -398,7 +426,9 @@ nlohmann::json Session::state() {
             {"green_screen", scene.studio.backdrop.green_screen},
             {"ambient_lx", scene.studio.ambient_lx},
             {"lights", lights_json(scene.studio.lights)}}},
-          {"bodies", bodies}};
+          {"bodies", bodies},
+          {"lens", scene_lens_preset(text_)},
+          {"lenses", lenses}};
 }
 
 // The preview's linear frame of `shot`, or the one kept from an earlier frame that differs only

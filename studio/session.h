@@ -77,6 +77,8 @@ class Session {
   nlohmann::json state();
   // Sets the value at `path` (camera.* or studio.* only) to scene-language text.
   Outcome set_value(const ScenePath& path, const std::string& value);
+  // Several values in one change (a lens preset with a focal length it takes), compiled once.
+  Outcome set_values(const std::vector<std::pair<ScenePath, std::string>>& values);
   Outcome add_light(const std::string& entry);
   Outcome remove_light(size_t index);
   Outcome set_view(const View& view);

@@ -149,6 +149,13 @@ function fillPanels() {
     [...state.bodies, 'custom'].forEach((name) => body.add(new Option(name, name)));
   }
   body.value = c.body;
+  const lens = $('lens');
+  if (lens.options.length !== state.lenses.length + 1) {
+    lens.innerHTML = '';
+    lens.add(new Option('focal length only', ''));
+    state.lenses.forEach((l) => lens.add(new Option(l.name, l.name)));
+  }
+  lens.value = state.lens;
   setSlider('aperture', APERTURES.length - 1, nearestIndex(APERTURES, c.aperture), `f/${c.aperture}`);
   setSlider('shutter', SHUTTERS.length - 1, nearestIndex(SHUTTERS, c.shutter_s), shutterText(c.shutter_s));
   setSlider('iso', ISOS.length - 1, nearestIndex(ISOS, c.iso), `${c.iso}`);
@@ -223,6 +230,19 @@ async function setScene(path, value, released) {
   if (released) scheduleAnalysis();
 }
 
+// A lens preset with a focal length it takes: a prime's own, the current one kept in a zoom's
+// range. ("focal length only" marks a scene without a preset; taking one out is an edit of the
+// file.)
+async function setLens(name) {
+  const lens = state.lenses.find((l) => l.name === name);
+  if (!lens) { await refreshState(); return; }
+  const [shortest, longest] = lens.focal_mm;
+  const focal = Math.round(Math.min(longest, Math.max(shortest, state.camera.focal_length_mm)));
+  const changes = [{ path: 'camera.lens.preset', value: name },
+    { path: 'camera.lens.focal_length', value: `${focal}mm` }];
+  if (await post('api/set', { changes })) changed(); else await refreshState();
+}
+
 function bindSlider(id, list, path, format) {
   const input = $(id);
   const send = (released) => {
@@ -249,6 +269,7 @@ function bindPanels() {
   bindRange('wb', 'camera.white_balance', (v) => `${v}K`);
   bindRange('table', 'studio.turntable.diameter', (v) => `${Math.round(100 * v)}cm`);
   $('body').addEventListener('change', () => setScene('camera.body', $('body').value, true));
+  $('lens').addEventListener('change', () => setLens($('lens').value));
   $('focus-auto').addEventListener('change', () => setScene('camera.focus',
     $('focus-auto').checked ? 'auto' : `${state.view.focus_distance_m.toFixed(2)}m`, true));
   $('wb-auto').addEventListener('change', () => setScene('camera.white_balance',
