@@ -43,8 +43,8 @@ TEST(StudioLiveDevelop, KeptOpticsGiveTheDslrModelsImageAfterExposureChanges) {
   const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const ir::Shot& shot = scene.shots.front();
   const double scale = 0.08;
-  auto rendered = std::make_shared<const run::RenderedShot>(
-      preview::render_linear(scene, studio, shot, scale));
+  auto rendered =
+      std::make_shared<const run::RenderedShot>(preview::render_linear(scene, studio, shot, scale));
   LiveDevelop live;
   const double isos[] = {100, 400, 1600};
   for (int i = 0; i < 3; ++i) {
