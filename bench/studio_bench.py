@@ -50,7 +50,8 @@ def bench_capture(driver, captures):
         driver.execute_script('capture()')
         wait_for(driver, f'return window.rigcBench.capture.length > {i}', what='the coverage')
         settle(driver)
-    return driver.execute_script('return window.rigcBench.capture')
+    return driver.execute_script('return window.rigcBench.capture'), \
+        driver.execute_script('return window.rigcBench.captureParts')
 
 
 DRAG_JS = """
@@ -108,9 +109,13 @@ def main():
               f"({drag['frames']} in {drag['seconds']} s; view change -> frame p50 "
               f"{percentile(drag['ms'], 50):.0f} ms)")
         settle(driver)
-        captures = bench_capture(driver, args.captures)
+        captures, parts = bench_capture(driver, args.captures)
         print(f'capture -> coverage view updated: median {statistics.median(captures):.0f} ms, '
               f'max {max(captures):.0f} ms ({len(captures)} captures)')
+        for key in ('capture', 'coverage', 'analysis', 'draw'):
+            values = [p[key] for p in parts if key in p]
+            if values:
+                print(f'  of it {key}: median {statistics.median(values):.0f} ms')
     finally:
         driver.quit()
         proc.send_signal(2)

@@ -299,6 +299,8 @@ class Checker {
   void read_sensor(const YAML::Node& sensor, ir::Camera& camera);
   void read_exif_text(const YAML::Node& node, ir::Camera& camera);
   void read_lens(const YAML::Node& lens, ir::Camera& camera);
+  void read_lens_preset(const YAML::Node& lens, ir::Camera& camera);
+  void check_lens_limits(const YAML::Node& node, const spec::SceneSpec& scene);
   void read_distortion(const YAML::Node& distortion, ir::Camera& camera);
   void read_exposure(const YAML::Node& exposure, ir::Camera& camera);
   void read_focus(const YAML::Node& focus, spec::SceneSpec& scene);
@@ -317,6 +319,7 @@ class Checker {
   std::string file_;
   std::string base_dir_;
   DiagnosticEngine& diag_;
+  std::optional<LensPreset> lens_preset_;  // the camera's `lens: {preset: ...}`
 };
 
 std::optional<spec::SceneSpec> Checker::run(const YAML::Node& root) {
@@ -765,6 +768,7 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
     error(node, "the camera needs an 'exposure' {aperture, shutter, iso}");
   }
   if (const YAML::Node focus = node["focus"]) read_focus(focus, scene);
+  check_lens_limits(node, scene);
   if (const YAML::Node wb = node["white_balance"]) read_white_balance(wb, camera);
   if (const YAML::Node effects = node["effects"]) read_effects(effects, camera);
   if (const YAML::Node output = node["output"]) read_output(output, camera);
@@ -846,14 +850,70 @@ void Checker::read_exif_text(const YAML::Node& node, ir::Camera& camera) {
 void Checker::read_lens(const YAML::Node& lens, ir::Camera& camera) {
   namespace limit = limits::camera;
   if (!expect_map(lens, "lens")) return;
-  check_keys(lens, {"focal_length", "distortion", "vignetting"}, "lens");
+  check_keys(lens, {"preset", "focal_length", "distortion", "vignetting"}, "lens");
   if (lens["focal_length"]) {
     read(lens, "focal_length", "focal length", limit::kFocalLength, camera.focal_length_m);
-  } else if (lacks(lens, "focal_length")) {
-    error(lens, "lens needs a 'focal_length' (e.g. 50mm)");
+  } else if (!lens["preset"] && lacks(lens, "focal_length")) {
+    error(lens, "lens needs a 'focal_length' (e.g. 50mm) or a 'preset'");
   }
+  if (lens["preset"]) read_lens_preset(lens, camera);
   if (const YAML::Node distortion = lens["distortion"]) read_distortion(distortion, camera);
   read(lens, "vignetting", "vignetting", limit::kVignetting, camera.vignetting);
+}
+
+// A lens preset: a prime's focal length when none is given; a given one within its range.
+void Checker::read_lens_preset(const YAML::Node& lens, ir::Camera& camera) {
+  const YAML::Node node = lens["preset"];
+  auto name = scalar(node, "lens preset");
+  if (!name) return;
+  lens_preset_ = find_lens_preset(*name);
+  if (!lens_preset_) {
+    std::vector<std::string> names;
+    for (const auto& p : lens_presets()) names.push_back(p.name);
+    error(node, fmt::format("unknown lens '{}'", *name) +
+                    did_you_mean(*name, names, fmt::format(" (known: {})", comma_list(names))));
+    return;
+  }
+  const LensPreset& preset = *lens_preset_;
+  const auto mm = [](double m) { return fmt::format("{:g}mm", m * 1000); };
+  const std::string range = preset.zoom()
+                                ? mm(preset.shortest_focal_m) + "-" + mm(preset.longest_focal_m)
+                                : mm(preset.shortest_focal_m);
+  if (!lens["focal_length"]) {
+    if (preset.zoom()) {
+      error(lens, fmt::format("the zoom lens {} needs a 'focal_length' in {}", preset.name, range));
+    }
+    camera.focal_length_m = preset.shortest_focal_m;
+    return;
+  }
+  constexpr double kTolerance_m = 0.05e-3;  // focal lengths are written to the millimetre
+  if (camera.focal_length_m < preset.shortest_focal_m - kTolerance_m ||
+      camera.focal_length_m > preset.longest_focal_m + kTolerance_m) {
+    error(lens["focal_length"], fmt::format("focal length {} is outside the lens {}'s {}",
+                                            mm(camera.focal_length_m), preset.name, range));
+  }
+}
+
+// The aperture and a fixed focus distance within what the preset lens can do.
+void Checker::check_lens_limits(const YAML::Node& node, const spec::SceneSpec& scene) {
+  if (!lens_preset_) return;
+  const LensPreset& lens = *lens_preset_;
+  const ir::Camera& camera = scene.camera;
+  const YAML::Node aperture = node["exposure"] ? node["exposure"]["aperture"] : YAML::Node();
+  constexpr double kStopRounding = 0.02;  // f-numbers are written rounded (f/1.8 for f/1.78)
+  if (aperture && camera.aperture_f_number < lens.widest_f_number * (1 - kStopRounding)) {
+    error(aperture, fmt::format("f/{:g} is wider than the lens {} opens (f/{:g} at the widest)",
+                                camera.aperture_f_number, lens.name, lens.widest_f_number));
+  } else if (aperture && camera.aperture_f_number > lens.narrowest_f_number * (1 + kStopRounding)) {
+    error(aperture, fmt::format("f/{:g} is narrower than the lens {} closes (f/{:g} at the "
+                                "narrowest)",
+                                camera.aperture_f_number, lens.name, lens.narrowest_f_number));
+  }
+  if (node["focus"] && !scene.focus_auto && scene.focus_distance_m < lens.min_focus_m) {
+    error(node["focus"], fmt::format("focus at {:.3g}m is closer than the lens {} focuses "
+                                     "({:g}m at the closest)",
+                                     scene.focus_distance_m, lens.name, lens.min_focus_m));
+  }
 }
 
 void Checker::read_distortion(const YAML::Node& distortion, ir::Camera& camera) {

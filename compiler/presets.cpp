@@ -64,4 +64,31 @@ std::optional<BodyPreset> find_body_preset(const std::string& name) {
   return std::nullopt;
 }
 
+const std::vector<LensPreset>& lens_presets() {
+  // The makers' published specifications: focal length, maximum and minimum aperture, closest
+  // focusing distance.
+  static const std::vector<LensPreset> presets = {
+      {"canon-ef-50mm-f1.8-stm", "Canon EF 50mm f/1.8 STM", 0.050, 0.050, 1.8, 22, 0.35},
+      {"canon-ef-85mm-f1.8-usm", "Canon EF 85mm f/1.8 USM", 0.085, 0.085, 1.8, 22, 0.85},
+      {"canon-ef-100mm-f2.8l-macro-is-usm", "Canon EF 100mm f/2.8L Macro IS USM", 0.100, 0.100, 2.8,
+       32, 0.30},
+      {"canon-ef-24-70mm-f2.8l-ii-usm", "Canon EF 24-70mm f/2.8L II USM", 0.024, 0.070, 2.8, 22,
+       0.38},
+      {"canon-ef-24-105mm-f4l-is-ii-usm", "Canon EF 24-105mm f/4L IS II USM", 0.024, 0.105, 4, 22,
+       0.45},
+      {"sigma-35mm-f1.4-dg-hsm-art", "Sigma 35mm F1.4 DG HSM | Art", 0.035, 0.035, 1.4, 16, 0.30},
+      {"nikon-af-s-50mm-f1.8g", "Nikon AF-S NIKKOR 50mm f/1.8G", 0.050, 0.050, 1.8, 16, 0.45},
+      {"sony-fe-90mm-f2.8-macro-g-oss", "Sony FE 90mm F2.8 Macro G OSS", 0.090, 0.090, 2.8, 22,
+       0.28},
+  };
+  return presets;
+}
+
+std::optional<LensPreset> find_lens_preset(const std::string& name) {
+  for (const auto& preset : lens_presets()) {
+    if (preset.name == name) return preset;
+  }
+  return std::nullopt;
+}
+
 }  // namespace rigc

@@ -3,12 +3,15 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <optional>
 
 #include "dslr/buffer_pool.h"
 #include "raster/frame_shader.h"
 #include "raster/lighting.h"
 #include "raster/screen_setup.h"
 #include "raster/shadow_map.h"
+#include "raster/shadow_map_cache.h"
 #include "raster/tile_raster.h"
 
 namespace rigc::raster {
@@ -33,7 +36,8 @@ dslr::LinearFrame blank_frame(const dslr::Intrinsics& canvas) {
 }  // namespace
 
 dslr::LinearFrame render_frame(const ir::Scene& scene, const scene::StudioScene& studio,
-                               const FrameRequest& request, RasterTimings* timings) {
+                               const FrameRequest& request, RasterTimings* timings,
+                               ShadowMapCache* shadow_cache) {
   // Tells this frame's per-thread caches from those any earlier frame left behind.
   static std::atomic<std::uint64_t> frames_started{0};
   const std::uint64_t frame_serial = ++frames_started;
@@ -41,8 +45,15 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const scene::StudioScene&
   const FrameContext context(scene, studio, request);
 
   const auto shadow_start = Clock::now();
-  const FrameShadowMaps shadow_maps(scene, studio, context.object_rot, context.object_t,
-                                    request.shadow_map_size);
+  std::shared_ptr<const FrameShadowMaps> kept_maps;
+  std::optional<FrameShadowMaps> own_maps;
+  if (shadow_cache) {
+    kept_maps =
+        shadow_cache->maps(scene, studio, request.turntable_angle_rad, request.shadow_map_size);
+  } else {
+    own_maps.emplace(scene, studio, context.object_rot, context.object_t, request.shadow_map_size);
+  }
+  const FrameShadowMaps& shadow_maps = shadow_cache ? *kept_maps : *own_maps;
   if (timings) timings->shadow_ms += ms_since(shadow_start);
 
   const auto setup_start = Clock::now();

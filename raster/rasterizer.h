@@ -33,9 +33,13 @@ struct RasterTimings {
   std::int64_t quads_with_block_albedos = 0;  // quads that took a failed block's albedos
 };
 
-// Renders radiance (cd/m² per channel), camera-space depth and the object mask.
+class ShadowMapCache;
+
+// Renders radiance (cd/m² per channel), camera-space depth and the object mask. With a
+// `shadow_cache` (see shadow_map_cache.h), shadow maps kept from earlier frames serve.
 dslr::LinearFrame render_frame(const ir::Scene& scene, const scene::StudioScene& studio,
-                               const FrameRequest& request, RasterTimings* timings = nullptr);
+                               const FrameRequest& request, RasterTimings* timings = nullptr,
+                               ShadowMapCache* shadow_cache = nullptr);
 
 // Illuminance (lux, per linear RGB channel) that a light casts on a surface point with normal n,
 // shadows ignored: the same radiometry the renderer shades with.

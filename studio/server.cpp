@@ -274,7 +274,12 @@ void StudioServer::add_page_routes() {
       send_json(res, *result);
     });
   };
-  analysis("/api/coverage", &Session::coverage);
+  // ?capture=1: the page waits for it after a capture; it goes before background analyses.
+  server_->Get("/api/coverage", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto result = session_.coverage(req.get_param_value("capture") != "1");
+    if (!result) return send_error(res, 409, "the scene changed during the analysis");
+    send_json(res, *result);
+  });
   analysis("/api/advice", &Session::advice);
   server_->Get("/api/mesh", [this](const httplib::Request&, httplib::Response& res) {
     send_json(res, session_.mesh());
@@ -282,19 +287,28 @@ void StudioServer::add_page_routes() {
 }
 
 void StudioServer::add_edit_routes() {
+  // {"path": "camera.lens.focal_length", "value": "35mm"}, or {"changes": [such, ...]} for
+  // several values in one change.
   server_->Post("/api/set", [this](const httplib::Request& req, httplib::Response& res) {
     const auto body = json_body(req, res);
     if (!body) return;
-    if (!body->contains("path") || !(*body)["path"].is_string() || !body->contains("value") ||
-        !(*body)["value"].is_string()) {
-      return send_error(res, 400,
-                        "set takes {\"path\": \"camera.lens.focal_length\", "
-                        "\"value\": \"35mm\"}");
+    const nlohmann::json changes =
+        body->contains("changes") ? (*body)["changes"] : nlohmann::json::array({*body});
+    std::vector<std::pair<ScenePath, std::string>> values;
+    for (const auto& change : changes) {
+      if (!change.is_object() || !change.contains("path") || !change["path"].is_string() ||
+          !change.contains("value") || !change["value"].is_string() || changes.size() > 8) {
+        return send_error(res, 400,
+                          "set takes {\"path\": \"camera.lens.focal_length\", "
+                          "\"value\": \"35mm\"} or {\"changes\": [such, ...]} (at most 8)");
+      }
+      ScenePath path;
+      std::stringstream parts(change["path"].get<std::string>());
+      for (std::string part; std::getline(parts, part, '.');) path.push_back(part);
+      values.emplace_back(std::move(path), change["value"].get<std::string>());
     }
-    ScenePath path;
-    std::stringstream parts((*body)["path"].get<std::string>());
-    for (std::string part; std::getline(parts, part, '.');) path.push_back(part);
-    send_outcome(res, session_.set_value(path, (*body)["value"]));
+    if (values.empty()) return send_error(res, 400, "set takes at least one change");
+    send_outcome(res, session_.set_values(values));
   });
   server_->Post("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
     const auto body = json_body(req, res);

@@ -69,6 +69,30 @@ TEST_F(StudioApi, ALongerShutterBrightensTheFrameAndChangesTheState) {
   EXPECT_GT(frame_mean(), before * 1.3);
 }
 
+TEST_F(StudioApi, ALensPresetIsSetWithAFocalLengthItTakesAndRefusedOtherwise) {
+  const nlohmann::json lenses = state()["lenses"];
+  ASSERT_GE(lenses.size(), 6u);
+  EXPECT_EQ(state()["lens"], "");
+  const auto zoom = post(
+      "/api/set", {{"changes",
+                    {{{"path", "camera.lens.preset"}, {"value", "canon-ef-24-70mm-f2.8l-ii-usm"}},
+                     {{"path", "camera.lens.focal_length"}, {"value", "35mm"}}}}});
+  ASSERT_TRUE(zoom);
+  ASSERT_EQ(zoom->status, 200) << zoom->body;
+  EXPECT_EQ(state()["lens"], "canon-ef-24-70mm-f2.8l-ii-usm");
+  EXPECT_NEAR(state()["camera"]["focal_length_mm"].get<double>(), 35, 1e-9);
+  // 85 mm is beyond the zoom: refused at the line, and the last good scene stays.
+  const auto outside = post("/api/set", {{"path", "camera.lens.focal_length"}, {"value", "85mm"}});
+  ASSERT_TRUE(outside);
+  EXPECT_EQ(outside->status, 422);
+  const std::string message = nlohmann::json::parse(outside->body)["error"];
+  EXPECT_NE(message.find("scene.yaml:18:24:"), std::string::npos) << message;
+  EXPECT_NE(message.find("is outside the lens canon-ef-24-70mm-f2.8l-ii-usm's 24mm-70mm"),
+            std::string::npos)
+      << message;
+  EXPECT_NEAR(state()["camera"]["focal_length_mm"].get<double>(), 35, 1e-9);
+}
+
 TEST_F(StudioApi, AnOutOfRangeValueIsRefusedWithTheCompilersMessage) {
   const auto res = post("/api/set", {{"path", "camera.exposure.aperture"}, {"value", "f/0.8"}});
   ASSERT_TRUE(res);

@@ -12,7 +12,7 @@
 
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
-#include "backends/registry.h"
+#include "backends/preview/preview_backend.h"
 #include "compiler/diagnostics.h"
 #include "compiler/frontend.h"
 #include "compiler/presets.h"
@@ -20,6 +20,7 @@
 #include "io/atomic_file.h"
 #include "plan/plan_scene.h"
 #include "plan/scene_text.h"
+#include "raster/shadow_map_cache.h"
 #include "run/run_loop.h"
 #include "scene/motion_blur.h"
 #include "studio/frame_encoding.h"
@@ -65,6 +66,16 @@ bool scene_focus_auto(const std::string& text) {
   }
 }
 
+// The scene's lens preset (`camera.lens.preset`), or "" when it gives a focal length only.
+std::string scene_lens_preset(const std::string& text) {
+  try {
+    const YAML::Node preset = YAML::Load(text)["camera"]["lens"]["preset"];
+    return preset && preset.IsScalar() ? preset.Scalar() : std::string();
+  } catch (const YAML::Exception&) {
+    return {};
+  }
+}
+
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -93,7 +104,6 @@ std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* 
     *error = viewed.message;
     return nullptr;
   }
-  session->preview_ = backends::find_backend("preview")->make();
   if (run_folder.empty()) run_folder = fs::path("out") / session->scene_->name / "studio";
   session->reference_ = std::make_unique<ReferenceCheck>(run_folder);
   return session;
@@ -105,11 +115,7 @@ Outcome Session::start_reference(const ReferenceRequest& request) {
   if (!(request.width >= 64 && request.width <= 4096) || request.samples < 0) {
     return Outcome::fail("a reference is 64..4096 pixels wide, with samples >= 0");
   }
-  std::shared_ptr<const ir::Scene> view;
-  {
-    std::lock_guard lock(mutex_);
-    view = view_scene_;
-  }
+  const std::shared_ptr<const ir::Scene> view = view_scene();
   const double scale = std::min(1.0, static_cast<double>(request.width) / view->camera.width_px);
   std::string error;
   std::optional<Frame> preview = frame(scale, &error);
@@ -132,32 +138,36 @@ std::string Session::read_disk(std::string* error) const {
   return text.str();
 }
 
-// Compiles `text`; when it compiles it becomes the session's scene (the view is recompiled on
-// it), otherwise the last good scene stays and the diagnostics are the message. What `change`
-// cannot have touched is kept.
+// Compiles `text`; when it compiles it becomes the session's scene, otherwise the last good
+// scene stays and the diagnostics are the message. What `change` cannot have touched is kept.
+// Unless only shots changed, the view is compiled with it in one go: appended as the last shot
+// (the compiler places, focuses and refuses it there as in a scene of its own).
 Outcome Session::apply_text(std::string text, Change change) {
-  Compiled compiled = compile_text(text, file_);
-  if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
-  auto scene = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
-  auto studio =
-      change != Change::kAnything && studio_
-          ? studio_
-          : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
-  const std::string previous = text_;
-  auto previous_scene = scene_;
-  auto previous_studio = studio_;
+  std::optional<ir::Shot> view_shot;
+  std::optional<ir::Scene> compiled_scene;
+  if (view_shot_ && change != Change::kShots) {
+    std::string error;
+    std::string entry = view_pose_text(view_);
+    entry = entry.substr(1, entry.size() - 2);
+    const auto with_view = append_to_list(text, {"shots"}, entry, &error);
+    if (!with_view) return Outcome::fail(error);
+    Compiled compiled = compile_text(*with_view, file_);
+    if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+    view_shot = as_view_shot(compiled.scene->shots.back());
+    compiled.scene->shots.pop_back();
+    compiled_scene = std::move(compiled.scene);
+  } else {
+    Compiled compiled = compile_text(text, file_);
+    if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+    compiled_scene = std::move(compiled.scene);
+  }
+  auto scene = std::make_shared<const ir::Scene>(std::move(*compiled_scene));
+  studio_ = change != Change::kAnything && studio_
+                ? studio_
+                : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
   text_ = std::move(text);
   scene_ = scene;
-  studio_ = studio;
-  if (view_scene_ && change != Change::kShots) {
-    const Outcome viewed = compile_view(view_);
-    if (!viewed.ok) {
-      text_ = previous;
-      scene_ = previous_scene;
-      studio_ = previous_studio;
-      return viewed;
-    }
-  }
+  if (view_shot) view_shot_ = std::move(view_shot);
   if (change != Change::kShots) ++analysis_generation_;
   ++revision_;
   return {};
@@ -169,7 +179,7 @@ std::string Session::view_pose_text(const View& view) const {
                      view.turntable_rad * 180 / std::numbers::pi);
 }
 
-// The view is compiled as the scene's only shot, so the compiler places it, focuses it and
+// The view is compiled as the scene's only shot, so that the compiler places it, focuses it and
 // refuses it (below the floor, inside the table) with its own message.
 Outcome Session::compile_view(const View& view) {
   std::string error;
@@ -179,21 +189,46 @@ Outcome Session::compile_view(const View& view) {
   if (!text) return Outcome::fail(error);
   Compiled compiled = compile_text(*text, file_);
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
-  view_scene_ = std::make_shared<const ir::Scene>(std::move(*compiled.scene));
+  view_shot_ = as_view_shot(compiled.scene->shots.front());
   view_ = view;
   ++revision_;
   return {};
 }
 
-Outcome Session::set_value(const ScenePath& path, const std::string& value) {
+// The view's shot as a scene of its own would hold it: the first.
+ir::Shot Session::as_view_shot(ir::Shot shot) {
+  shot.index = 0;
+  shot.name = "shot_000";
+  return shot;
+}
+
+// The scene with the view as its only shot (for the reference check).
+std::shared_ptr<const ir::Scene> Session::view_scene() {
   std::lock_guard lock(mutex_);
-  if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
-    return Outcome::fail("only camera.* and studio.* values can be set");
+  auto view = std::make_shared<ir::Scene>(*scene_);
+  view->shots = {*view_shot_};
+  return view;
+}
+
+Outcome Session::set_value(const ScenePath& path, const std::string& value) {
+  return set_values({{path, value}});
+}
+
+Outcome Session::set_values(const std::vector<std::pair<ScenePath, std::string>>& values) {
+  std::lock_guard lock(mutex_);
+  std::string text = text_;
+  Change change = Change::kCamera;
+  for (const auto& [path, value] : values) {
+    if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
+      return Outcome::fail("only camera.* and studio.* values can be set");
+    }
+    std::string error;
+    const auto edited = studio::set_value(text, path, value, &error);
+    if (!edited) return Outcome::fail(error);
+    text = *edited;
+    if (path[0] != "camera") change = Change::kAnything;
   }
-  std::string error;
-  const auto text = studio::set_value(text_, path, value, &error);
-  if (!text) return Outcome::fail(error);
-  return push_text(*text, path[0] == "camera" ? Change::kCamera : Change::kAnything);
+  return push_text(text, change);
 }
 
 Outcome Session::add_light(const std::string& entry) {
@@ -353,10 +388,18 @@ nlohmann::json lights_json(const std::vector<ir::Light>& lights) {
 nlohmann::json Session::state() {
   std::lock_guard lock(mutex_);
   const ir::Scene& scene = *scene_;
-  const ir::Shot& view_shot = view_scene_->shots.front();
+  const ir::Shot& view_shot = *view_shot_;
   const auto focus = scene_focus_auto(text_);
   nlohmann::json bodies = nlohmann::json::array();
   for (const auto& preset : body_presets()) bodies.push_back(preset.name);
+  nlohmann::json lenses = nlohmann::json::array();
+  for (const auto& lens : lens_presets()) {
+    lenses.push_back({{"name", lens.name},
+                      {"model", lens.model},
+                      {"focal_mm", {lens.shortest_focal_m * 1000, lens.longest_focal_m * 1000}},
+                      {"f_numbers", {lens.widest_f_number, lens.narrowest_f_number}},
+                      {"min_focus_m", lens.min_focus_m}});
+  }
   const Eigen::Vector3d center =
       (ir::world_from_object(scene, view_.turntable_rad) *
        ((scene.object.bounds_min_object + scene.object.bounds_max_object) / 2).homogeneous())
@@ -383,7 +426,9 @@ nlohmann::json Session::state() {
             {"green_screen", scene.studio.backdrop.green_screen},
             {"ambient_lx", scene.studio.ambient_lx},
             {"lights", lights_json(scene.studio.lights)}}},
-          {"bodies", bodies}};
+          {"bodies", bodies},
+          {"lens", scene_lens_preset(text_)},
+          {"lenses", lenses}};
 }
 
 // The preview's linear frame of `shot`, or the one kept from an earlier frame that differs only
@@ -392,7 +437,7 @@ nlohmann::json Session::state() {
 bool Session::render_linear(const ir::Scene& scene,
                             const std::shared_ptr<const scene::StudioScene>& studio,
                             const ir::Shot& shot, const run::RenderSettings& settings,
-                            run::RenderedShot* rendered, bool* reused, std::string* error) {
+                            std::shared_ptr<const run::RenderedShot>* rendered, bool* reused) {
   RenderCache key;
   key.studio = studio;
   key.world_from_camera = shot.world_from_camera;
@@ -414,24 +459,36 @@ bool Session::render_linear(const ir::Scene& scene,
   *reused = hit != render_cache_.end();
   if (*reused) {
     *rendered = hit->rendered;
-    rendered->stage_ms.clear();
     return true;
   }
-  if (!preview_->render(scene, *studio, shot, settings, {}, rendered, error)) return false;
-  key.rendered = *rendered;
+  auto fresh = std::make_shared<run::RenderedShot>();
+  render_preview(scene, studio, shot, settings.scale, fresh.get());
+  key.rendered = *rendered = std::move(fresh);
   render_cache_.push_front(std::move(key));
   // The live view's two sizes (moving and at rest) of the current view.
   if (render_cache_.size() > 2) render_cache_.pop_back();
   return true;
 }
 
+// The preview's frame, with the shadow maps kept while the studio (and its lights) stays.
+void Session::render_preview(const ir::Scene& scene,
+                             const std::shared_ptr<const scene::StudioScene>& studio,
+                             const ir::Shot& shot, double scale, run::RenderedShot* rendered) {
+  if (shadow_studio_ != studio || !shadow_cache_) {
+    shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
+    shadow_studio_ = studio;
+  }
+  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get());
+}
+
 std::optional<Frame> Session::frame(double scale, std::string* error) {
-  std::shared_ptr<const ir::Scene> scene, view;
+  std::shared_ptr<const ir::Scene> scene;
   std::shared_ptr<const scene::StudioScene> studio;
+  ir::Shot shot;
   {
     std::lock_guard lock(mutex_);
     scene = scene_;
-    view = view_scene_;
+    shot = *view_shot_;
     studio = studio_;
   }
   ++frames_rendering_;
@@ -445,22 +502,21 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   } done{frames_rendering_, last_frame_end_};
   std::lock_guard render_lock(render_mutex_);
   const auto start = Clock::now();
-  const ir::Shot& shot = view->shots.front();
   run::RenderSettings settings;
   settings.scale = scale;
   if (!settings.check(error)) return std::nullopt;
-  run::RenderedShot rendered;
+  std::shared_ptr<const run::RenderedShot> rendered;
   Frame frame;
-  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render, error)) {
+  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render)) {
     return std::nullopt;
   }
   error->clear();
-  std::map<std::string, double> stages = rendered.stage_ms;
+  std::map<std::string, double> stages;
+  if (!frame.reused_render) stages = rendered->stage_ms;
+  bool reused_optics = false;
   dslr::DevelopResult developed =
-      run::develop_shot(*scene, shot, std::move(rendered), settings, false, error, &stages);
-  if (developed.encoded_bytes.empty()) {
-    developed.encoded_bytes.assign(developed.encoded.begin(), developed.encoded.end());
-  }
+      live_develop_.develop(scene->camera, std::move(rendered), shot, settings.seed, scale,
+                            &reused_optics, error, &stages);
   if (developed.encoded_bytes.empty()) {
     if (error->empty()) *error = "the DSLR model produced no image";
     return std::nullopt;
@@ -477,14 +533,16 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   return frame;
 }
 
-// The coverage of `scene`'s shots with `options`. The cached analysis serves when only shots
-// changed since it started (generation): the shots it has beyond those `scene` begins with are
-// taken back, and `scene`'s further shots added. Nullopt when a newer change started another
-// generation meanwhile (the analysis stops at its next shot).
-std::optional<analysis::CoverageResult> Session::analyse(
-    AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
-    const std::shared_ptr<const scene::StudioScene>& studio, int generation,
-    const analysis::CoverageOptions& options) {
+// The coverage of `scene`'s shots with `options`. A kept analysis of the same scene but for its
+// shots (`key`: the scene text without them) serves: the shots it has beyond those `scene`
+// begins with are taken back, and `scene`'s further shots added. Nullopt when a newer change
+// started another generation meanwhile (the analysis stops at its next shot, and is kept for
+// when its scene comes back), or when a capture waits for a background coverage. A background
+// analysis yields to the live view between shots.
+std::optional<analysis::CoverageResult> Session::analyse(std::deque<AnalysisCache>& caches,
+                                                         const Analysed& what,
+                                                         const analysis::CoverageOptions& options,
+                                                         bool background) {
   const auto same_shot = [](const ir::Shot& a, const ir::Shot& b) {
     return a.world_from_camera == b.world_from_camera &&
            a.object_from_camera == b.object_from_camera &&
@@ -492,57 +550,75 @@ std::optional<analysis::CoverageResult> Session::analyse(
            a.turntable_velocity_rad_s == b.turntable_velocity_rad_s &&
            a.focus_distance_m == b.focus_distance_m;
   };
-  if (cache.run && cache.generation == generation) {
+  const auto& shots = what.scene->shots;
+  auto hit = std::find_if(caches.begin(), caches.end(),
+                          [&](const AnalysisCache& c) { return c.key == what.key; });
+  if (hit == caches.end()) {
+    caches.push_front({what.key, nullptr});
+    if (caches.size() > kKeptAnalyses) caches.pop_back();
+    hit = caches.begin();
+  }
+  AnalysisCache& cache = *hit;
+  if (cache.run) {
     const auto& kept = cache.run->shots();
     size_t common = 0;
-    while (common < kept.size() && common < scene->shots.size() &&
-           same_shot(kept[common], scene->shots[common])) {
+    while (common < kept.size() && common < shots.size() &&
+           same_shot(kept[common], shots[common])) {
       ++common;
     }
     while (cache.run && static_cast<size_t>(cache.run->shot_count()) > common) {
       if (!cache.run->remove_last_shot()) cache.run.reset();
     }
-  } else {
-    cache.run.reset();
   }
   if (!cache.run) {
-    cache.run = std::make_unique<analysis::IncrementalCoverage>(scene, studio, options);
-    cache.generation = generation;
+    cache.run = std::make_unique<analysis::IncrementalCoverage>(what.scene, what.studio, options);
   }
-  for (size_t s = cache.run->shot_count(); s < scene->shots.size(); ++s) {
-    if (analysis_generation_ != generation) return std::nullopt;
-    // The live view first: while frames come (a slider or the camera moving), the next shot
-    // waits until they pause.
-    const auto live_view_busy = [&] {
-      const Clock::duration since_frame =
-          Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
-      return frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200);
-    };
-    while (live_view_busy() && analysis_generation_ == generation) {
+  // The live view first: while frames come (a slider or the camera moving), the next shot of a
+  // background analysis waits until they pause, unless a capture waits for the coverage.
+  const auto live_view_busy = [&] {
+    const Clock::duration since_frame =
+        Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
+    return urgent_requests_ == 0 &&
+           (frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200));
+  };
+  for (size_t s = cache.run->shot_count(); s < shots.size(); ++s) {
+    if (analysis_generation_ != what.generation) return std::nullopt;
+    // A background analysis hands the kept work to a waiting capture's (it goes on from here).
+    if (background && urgent_requests_ > 0 && &caches == &coverage_caches_) return std::nullopt;
+    while (background && live_view_busy() && analysis_generation_ == what.generation) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    cache.run->add_shot(scene->shots[s]);
+    cache.run->add_shot(shots[s]);
   }
   return cache.run->result();
 }
 
-// The coverage `rigc coverage` computes (its default options).
-std::optional<nlohmann::json> Session::coverage() {
-  std::shared_ptr<const ir::Scene> scene;
-  std::shared_ptr<const scene::StudioScene> studio;
-  int generation = 0;
-  {
-    std::lock_guard lock(mutex_);
-    scene = scene_;
-    studio = studio_;
-    generation = analysis_generation_;
-  }
-  std::lock_guard analysis_lock(analysis_mutex_);
+// What the analyses see now: the scene, its studio, the generation and the cache key.
+Session::Analysed Session::analysed() {
+  std::lock_guard lock(mutex_);
+  std::string error;
+  const auto without_shots = plan::replace_shots_section(text_, "shots:\n", &error);
+  return {scene_, studio_, analysis_generation_, without_shots ? *without_shots : text_};
+}
+
+// The coverage `rigc coverage` computes (its default options). A capture's (not `background`)
+// goes first: background analyses stop yielding to the live view while it waits.
+std::optional<nlohmann::json> Session::coverage(bool background) {
+  const Analysed what = analysed();
+  struct Urgent {
+    std::atomic<int>& count;
+    bool on;
+    ~Urgent() {
+      if (on) --count;
+    }
+  } urgent{urgent_requests_, !background};
+  if (!background) ++urgent_requests_;
+  std::lock_guard coverage_lock(coverage_mutex_);
   const auto start = Clock::now();
-  const auto result = analyse(coverage_cache_, scene, studio, generation, {});
+  const auto result = analyse(coverage_caches_, what, {}, background);
   if (!result) return std::nullopt;
   const double ms = ms_since(start);
-  nlohmann::json out = coverage_json(*scene, *result);
+  nlohmann::json out = coverage_json(*what.scene, *result);
   out["analysis_ms"] = ms;
   return out;
 }
@@ -565,15 +641,8 @@ nlohmann::json Session::coverage_json(const ir::Scene& scene,
 
 // The warnings `rigc check` prints, at the same reduced resolution.
 std::optional<nlohmann::json> Session::advice() {
-  std::shared_ptr<const ir::Scene> scene;
-  std::shared_ptr<const scene::StudioScene> studio;
-  int generation = 0;
-  {
-    std::lock_guard lock(mutex_);
-    scene = scene_;
-    studio = studio_;
-    generation = analysis_generation_;
-  }
+  const Analysed what = analysed();
+  std::shared_ptr<const ir::Scene> scene = what.scene;
   std::lock_guard analysis_lock(analysis_mutex_);
   DiagnosticEngine diag;
   diag.add_source(file_.string(), text_snapshot(scene));
@@ -587,9 +656,9 @@ std::optional<nlohmann::json> Session::advice() {
   });
   analysis::CoverageOptions options;
   options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-  const auto coverage = analyse(advice_cache_, scene, studio, generation, options);
+  const auto coverage = analyse(advice_caches_, what, options, true);
   if (!coverage) return std::nullopt;
-  analysis::report_capture_advice(*scene, *studio, *coverage, diag);
+  analysis::report_capture_advice(*scene, *what.studio, *coverage, diag);
   return out;
 }
 

@@ -18,9 +18,11 @@
 
 #include "analysis/coverage.h"
 #include "ir/ir.h"
+#include "raster/shadow_map_cache.h"
 #include "run/backend.h"
 #include "scene/studio_scene.h"
 #include "studio/frame_encoding.h"
+#include "studio/live_develop.h"
 #include "studio/reference_check.h"
 #include "studio/scene_edit.h"
 
@@ -75,6 +77,8 @@ class Session {
   nlohmann::json state();
   // Sets the value at `path` (camera.* or studio.* only) to scene-language text.
   Outcome set_value(const ScenePath& path, const std::string& value);
+  // Several values in one change (a lens preset with a focal length it takes), compiled once.
+  Outcome set_values(const std::vector<std::pair<ScenePath, std::string>>& values);
   Outcome add_light(const std::string& entry);
   Outcome remove_light(size_t index);
   Outcome set_view(const View& view);
@@ -91,7 +95,7 @@ class Session {
   std::optional<Frame> frame(double scale, std::string* error);
   // The coverage of the scene's shots; nullopt when the scene changed (other than in its shots)
   // while it was being analysed.
-  std::optional<nlohmann::json> coverage();
+  std::optional<nlohmann::json> coverage(bool background = true);
   std::optional<nlohmann::json> advice();
   nlohmann::json mesh();
   int sensor_width_px();
@@ -105,9 +109,18 @@ class Session {
   Session() = default;
   // A coverage analysis kept between requests: shots added or taken back reuse it.
   struct AnalysisCache {
+    std::string key;  // the scene text without its shots
     std::unique_ptr<analysis::IncrementalCoverage> run;
-    int generation = -1;
   };
+  // Analyses kept for the last scenes (a setting turned back and forth).
+  static constexpr size_t kKeptAnalyses = 3;
+  struct Analysed {
+    std::shared_ptr<const ir::Scene> scene;
+    std::shared_ptr<const scene::StudioScene> studio;
+    int generation = 0;
+    std::string key;
+  };
+  Analysed analysed();
   // A linear frame the preview rendered, and what it depends on besides the exposure, focus and
   // white balance (which the DSLR model applies after it).
   struct RenderCache {
@@ -116,30 +129,35 @@ class Session {
     double turntable_angle_rad = 0, turntable_velocity_rad_s = 0, shutter_s = 0;
     dslr::RenderGeometry canvas;
     int subframes = 1;
-    run::RenderedShot rendered;
+    std::shared_ptr<const run::RenderedShot> rendered;
   };
 
   Outcome apply_text(std::string text, Change change);
   Outcome push_text(const std::string& text, Change change);
   Outcome compile_view(const View& view);
+  static ir::Shot as_view_shot(ir::Shot shot);
+  std::shared_ptr<const ir::Scene> view_scene();
   std::string view_pose_text(const View& view) const;
   std::string read_disk(std::string* error) const;
   nlohmann::json coverage_json(const ir::Scene& scene,
                                const analysis::CoverageResult& coverage) const;
   std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
-  std::optional<analysis::CoverageResult> analyse(
-      AnalysisCache& cache, const std::shared_ptr<const ir::Scene>& scene,
-      const std::shared_ptr<const scene::StudioScene>& studio, int generation,
-      const analysis::CoverageOptions& options);
+  std::optional<analysis::CoverageResult> analyse(std::deque<AnalysisCache>& caches,
+                                                  const Analysed& what,
+                                                  const analysis::CoverageOptions& options,
+                                                  bool background);
   bool render_linear(const ir::Scene& scene,
                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                     const run::RenderSettings& settings, run::RenderedShot* rendered, bool* reused,
-                     std::string* error);
+                     const run::RenderSettings& settings,
+                     std::shared_ptr<const run::RenderedShot>* rendered, bool* reused);
+  void render_preview(const ir::Scene& scene,
+                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
+                      double scale, run::RenderedShot* rendered);
 
   std::mutex mutex_;
-  // One frame at a time, and one analysis at a time beside it, so that a capture's coverage (which
-  // takes seconds) does not hold up the live view.
-  std::mutex render_mutex_, analysis_mutex_;
+  // One frame at a time; beside it one coverage and one advice analysis (and plan), so that
+  // neither analysis holds up the live view or the other.
+  std::mutex render_mutex_, analysis_mutex_, coverage_mutex_;
   std::filesystem::path file_;
   std::string disk_text_;  // the file as last read or saved
   std::string text_;       // the scene as the user changed it
@@ -151,7 +169,7 @@ class Session {
   std::string file_error_;                  // the file on disk does not compile: its diagnostics
   std::shared_ptr<const ir::Scene> scene_;  // text_ compiled, with every shot
   std::shared_ptr<const scene::StudioScene> studio_;
-  std::shared_ptr<const ir::Scene> view_scene_;  // text_ with the view as its only shot
+  std::optional<ir::Shot> view_shot_;  // the view, compiled as the only shot of text_
   View view_;
   int captures_ = 0;
   int revision_ = 0;  // counts the changes, so the page knows when to refresh
@@ -160,9 +178,14 @@ class Session {
   std::atomic<int> analysis_generation_{0};
   std::atomic<int> frames_rendering_{0};  // the analysis yields to the live view between shots
   std::atomic<std::int64_t> last_frame_end_{0};  // steady clock ticks
-  AnalysisCache coverage_cache_, advice_cache_;  // under analysis_mutex_
+  std::atomic<int> urgent_requests_{0};          // captures waiting for their coverage
+  std::deque<AnalysisCache> coverage_caches_;    // under coverage_mutex_, newest first
+  std::deque<AnalysisCache> advice_caches_;      // under analysis_mutex_, newest first
   std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
-  std::unique_ptr<run::Backend> preview_;
+  LiveDevelop live_develop_;                     // under render_mutex_
+  // Shadow maps of shadow_studio_'s lights, kept while the camera moves (under render_mutex_).
+  std::shared_ptr<const scene::StudioScene> shadow_studio_;
+  std::unique_ptr<raster::ShadowMapCache> shadow_cache_;
   std::unique_ptr<ReferenceCheck> reference_;
 };
 

@@ -41,7 +41,8 @@ dslr::LinearFrame render_motion_blurred(const ir::Scene& scene, const scene::Stu
 }  // namespace
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
-                                const ir::Shot& shot, double scale) {
+                                const ir::Shot& shot, double scale,
+                                raster::ShadowMapCache* shadow_cache) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   raster::FrameRequest request;
   request.world_from_camera = shot.world_from_camera;
@@ -52,7 +53,7 @@ run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene
   raster::RasterTimings timings;
   if (out.subframes == 1) {
     request.turntable_angle_rad = shot.turntable_angle_rad;
-    out.frame = raster::render_frame(scene, studio, request, &timings);
+    out.frame = raster::render_frame(scene, studio, request, &timings, shadow_cache);
   } else {
     out.frame = render_motion_blurred(scene, studio, shot, out.subframes, request, &timings);
   }

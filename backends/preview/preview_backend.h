@@ -10,6 +10,10 @@
 #include "run/run_loop.h"
 #include "scene/studio_scene.h"
 
+namespace rigc::raster {
+class ShadowMapCache;
+}
+
 namespace rigc::preview {
 
 class PreviewBackend : public run::Backend {
@@ -20,9 +24,11 @@ class PreviewBackend : public run::Backend {
               run::RenderedShot* out, std::string* error) override;
 };
 
-// One shot in linear light, with the rasterizer's stages in stage_ms.
+// One shot in linear light, with the rasterizer's stages in stage_ms. A `shadow_cache` keeps the
+// shadow maps of a frame without motion blur for the next (raster/shadow_map_cache.h).
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
-                                const ir::Shot& shot, double scale);
+                                const ir::Shot& shot, double scale,
+                                raster::ShadowMapCache* shadow_cache = nullptr);
 
 // Renders and develops one shot (no files), for tests and benchmarks. Without `keep_linear` the
 // result's linear image is left empty (what a run that writes files does).

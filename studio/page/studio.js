@@ -9,7 +9,7 @@ const FULL_WIDTH = 1280;   // the live view at rest
 const MOVING_WIDTH = 480;  // while a slider or the camera moves
 
 // Timings for bench/studio_bench.py (Performance API), and the last frame's statistics.
-window.rigcBench = { slider: [], capture: [], dragFrames: [] };
+window.rigcBench = { slider: [], capture: [], captureParts: [], dragFrames: [] };
 window.rigcFrame = { mean: 0, clipped: 0, width: 0, count: 0 };
 
 const APERTURES = [1.2, 1.4, 1.6, 1.8, 2, 2.2, 2.5, 2.8, 3.2, 3.5, 4, 4.5, 5, 5.6, 6.3, 7.1, 8, 9,
@@ -149,6 +149,13 @@ function fillPanels() {
     [...state.bodies, 'custom'].forEach((name) => body.add(new Option(name, name)));
   }
   body.value = c.body;
+  const lens = $('lens');
+  if (lens.options.length !== state.lenses.length + 1) {
+    lens.innerHTML = '';
+    lens.add(new Option('focal length only', ''));
+    state.lenses.forEach((l) => lens.add(new Option(l.name, l.name)));
+  }
+  lens.value = state.lens;
   setSlider('aperture', APERTURES.length - 1, nearestIndex(APERTURES, c.aperture), `f/${c.aperture}`);
   setSlider('shutter', SHUTTERS.length - 1, nearestIndex(SHUTTERS, c.shutter_s), shutterText(c.shutter_s));
   setSlider('iso', ISOS.length - 1, nearestIndex(ISOS, c.iso), `${c.iso}`);
@@ -215,11 +222,25 @@ async function setScene(path, value, released) {
   const started = performance.now();
   if (!(await post('api/set', { path, value }))) { await refreshState(); return; }
   showStatus('');
-  await refreshState();
+  // The frame and the panels' state at once.
   requestFrame(released ? FULL_WIDTH : MOVING_WIDTH, () => {
     if (released) window.rigcBench.slider.push(performance.now() - started);
   });
+  await refreshState();
   if (released) scheduleAnalysis();
+}
+
+// A lens preset with a focal length it takes: a prime's own, the current one kept in a zoom's
+// range. ("focal length only" marks a scene without a preset; taking one out is an edit of the
+// file.)
+async function setLens(name) {
+  const lens = state.lenses.find((l) => l.name === name);
+  if (!lens) { await refreshState(); return; }
+  const [shortest, longest] = lens.focal_mm;
+  const focal = Math.round(Math.min(longest, Math.max(shortest, state.camera.focal_length_mm)));
+  const changes = [{ path: 'camera.lens.preset', value: name },
+    { path: 'camera.lens.focal_length', value: `${focal}mm` }];
+  if (await post('api/set', { changes })) changed(); else await refreshState();
 }
 
 function bindSlider(id, list, path, format) {
@@ -248,6 +269,7 @@ function bindPanels() {
   bindRange('wb', 'camera.white_balance', (v) => `${v}K`);
   bindRange('table', 'studio.turntable.diameter', (v) => `${Math.round(100 * v)}cm`);
   $('body').addEventListener('change', () => setScene('camera.body', $('body').value, true));
+  $('lens').addEventListener('change', () => setLens($('lens').value));
   $('focus-auto').addEventListener('change', () => setScene('camera.focus',
     $('focus-auto').checked ? 'auto' : `${state.view.focus_distance_m.toFixed(2)}m`, true));
   $('wb-auto').addEventListener('change', () => setScene('camera.white_balance',
@@ -363,9 +385,11 @@ function bindMovement() {
 async function capture() {
   const started = performance.now();
   if (!(await post('api/capture'))) return;
+  const posted = performance.now();
   showStatus(`captured shot ${state ? state.shots + 1 : ''}`);
-  await refreshCoverage();
+  const parts = await refreshCoverage(true);
   window.rigcBench.capture.push(performance.now() - started);
+  window.rigcBench.captureParts.push(Object.assign({ capture: posted - started }, parts));
   await refreshState();
   scheduleAnalysis();
 }
@@ -422,10 +446,12 @@ async function setUpCoverageView() {
 
 const PAPER = [[1, 1, 1], [0.85, 0.05, 0.05], [0.05, 0.7, 0.1]];
 
-async function refreshCoverage() {
-  const res = await api('api/coverage');
-  if (!res.ok) return;  // the scene changed meanwhile: the next change asks again
+async function refreshCoverage(afterCapture) {
+  const started = performance.now();
+  const res = await api(afterCapture ? 'api/coverage?capture=1' : 'api/coverage');
+  if (!res.ok) return {};  // the scene changed meanwhile: the next change asks again
   const coverage = await res.json();
+  const fetched = performance.now();
   $('coverage-summary').textContent = `${coverage.shots} shots: ` +
     `${(100 * coverage.reconstructable).toFixed(1)} % reconstructable, ` +
     `${(100 * coverage.seen_2).toFixed(1)} % seen twice; last shot new ${(100 * coverage.new).toFixed(1)} %, ` +
@@ -434,7 +460,7 @@ async function refreshCoverage() {
   table.textContent = coverage.table;
   table.scrollTop = table.scrollHeight;  // the latest shots
   window.rigcCoverage = coverage;
-  if (!coverageView.geometry) return;
+  if (!coverageView.geometry) return {};
   const colors = coverageView.geometry.attributes.color;
   coverage.views.forEach((views, f) => {
     const c = PAPER[Math.min(2, views)];
@@ -442,6 +468,8 @@ async function refreshCoverage() {
   });
   colors.needsUpdate = true;
   coverageView.render();
+  return { coverage: fetched - started, analysis: coverage.analysis_ms,
+    draw: performance.now() - fetched };
 }
 
 // ---- advice, a moment after the last change ----
