@@ -155,6 +155,7 @@ void FrameShader::albedo_batch(const int* tris, const int* px, const int* py, in
 }
 
 Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
+  if (request_.albedo_only) return {Vector3f::Ones(), Vector3f::Zero()};
   const scene::ShadedMaterial& material = studio_.materials[sp.material];
   const float metallic = material.metallic;
   // Ambient: a uniform white room of the given illuminance.
@@ -684,9 +685,8 @@ bool TileShader::known_albedos(const int* px, const int* py, const float* footpr
                                Vector3f* out) {
   if (!failed_block_.valid || !shader_.request().reuse_block_albedos) return false;
   const ir::SurfacePattern& pattern = *failed_block_.pattern;
-  if (!scene::pattern_fully_resolved(pattern, failed_block_.footprint_m)) return false;
   for (int i = 0; i < 4; ++i) {
-    if (!scene::pattern_fully_resolved(pattern, footprints[i])) return false;
+    if (!scene::pattern_same_for(pattern, failed_block_.footprint_m, footprints[i])) return false;
   }
   for (int i = 0; i < 4; ++i) {
     out[i] = failed_block_.albedo[(py[i] - failed_block_.by) * kBlock + px[i] - failed_block_.bx];

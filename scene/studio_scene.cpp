@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "dslr/simd.h"
+#include "scene/speckle.h"
 
 namespace rigc::scene {
 namespace {
@@ -239,21 +240,19 @@ float pattern_resolve(float scale_m, float footprint_m) {
 
 // The pattern's darkness (clamped to [0, 1] by the caller) at lanes points, in units of its
 // scale, and its mean over the surface (what a pattern too fine to resolve fades to).
+// `footprint` is each lane's pixel size in the same units (the speckle's dots blur by it).
 simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx, simd::F32x8 qy,
-                              simd::F32x8 qz, int lanes, float& mean_darkness) {
+                              simd::F32x8 qz, simd::F32x8 footprint, int lanes,
+                              float& mean_darkness) {
   using simd::F32x8;
   F32x8 darkness{};
   switch (pattern.kind) {
     case ir::PatternKind::kSpeckle: {
-      // Dark blotches at two scales, with soft edges (the darkness ramps over 1/12 of n).
-      const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
-                      0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
-                                           pattern.seed + 1);
-      darkness = (n - 0.47f) * 12.0f;
-      // The clamped darkness averages 0.47 over the surface (see the test
-      // Preview.ResolvedPatternsAverageToTheirFadedValue): fading to it keeps the brightness
-      // when zooming out.
-      mean_darkness = 0.47f;
+      // The dots blurred as a pixel-wide box filter would.
+      F32x8 edge;
+      for (int k = 0; k < 8; ++k) edge[k] = speckle::filtered_edge(footprint[k]);
+      darkness = speckle::darkness8(qx, qy, qz, speckle::seed_offset(pattern.seed), edge);
+      mean_darkness = speckle::kMeanDarkness;
       break;
     }
     case ir::PatternKind::kNoise: {
@@ -304,8 +303,10 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
       qy[k] = y[first + k] / scale;
       qz[k] = z[first + k] / scale;
     }
+    F32x8 footprint{};
+    for (int k = 0; k < lanes; ++k) footprint[k] = footprint_of(first + k) / scale;
     float mean_darkness = 0;
-    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes, mean_darkness);
+    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, footprint, lanes, mean_darkness);
     for (int k = 0; k < lanes; ++k) {
       const float resolve = pattern_resolve(scale, footprint_of(first + k));
       const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
@@ -318,6 +319,17 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
 
 bool has_pattern(const ir::SurfacePattern& pattern) {
   return pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
+}
+
+bool pattern_same_for(const ir::SurfacePattern& pattern, float footprint_a_m, float footprint_b_m) {
+  if (!pattern_fully_resolved(pattern, footprint_a_m) ||
+      !pattern_fully_resolved(pattern, footprint_b_m)) {
+    return false;
+  }
+  if (!has_pattern(pattern) || pattern.kind != ir::PatternKind::kSpeckle) return true;
+  const float scale = static_cast<float>(pattern.scale_m);
+  return speckle::filtered_edge(footprint_a_m / scale) ==
+         speckle::filtered_edge(footprint_b_m / scale);
 }
 
 bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m) {

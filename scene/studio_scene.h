@@ -87,6 +87,9 @@ bool has_pattern(const ir::SurfacePattern& pattern);
 // Whether `footprint_m` leaves the pattern fully resolved (no fade to its mean), so that the
 // factor at a point is the same for any such footprint. True without a pattern.
 bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m);
+// Whether the pattern's factor at any point is the same at footprints a and b: both fully
+// resolved and, for the speckle, its dots blurred alike.
+bool pattern_same_for(const ir::SurfacePattern& pattern, float footprint_a_m, float footprint_b_m);
 
 // pattern_factor at `count` points (object-frame x[i], y[i], z[i]) sharing one footprint,
 // written to out[i], eight points per step (pattern_factor is this for one point).
