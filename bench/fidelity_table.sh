@@ -6,10 +6,9 @@
 #
 # Usage: bench/fidelity_table.sh [OUT_DIR] [SCALE] [CYCLES_SAMPLES] [RUNS] [SCENES]
 #   defaults: out/fidelity-table, 0.25, 0 (Cycles' default, 64), 2, "paper spot".
-#   SCENES: paper (scenes/paper-turntable.yaml) and/or spot (Keenan Crane's Spot with its
-#   photographic-style texture map, from SPOT_DIR, default /work/shared/assets/spot, given an .mtl
-#   here since its OBJ names none). The Cycles renders of the paper scene take about 20 minutes
-#   at 0.25 with 64 samples on 2 quiet cores.
+#   SCENES: paper (scenes/paper-turntable.yaml) and/or spot (scenes/spot-turntable.yaml: Spot
+#   with a photographed texture). The Cycles renders of the paper scene take about 20 minutes at
+#   0.25 with 64 samples on 2 quiet cores.
 # Prints one row per scene, backend and evaluation: registered images, points, signed distance
 # mean ± std (mm), F-score at 1 mm, and per scene the preview/Cycles ratios of std and points.
 set -euo pipefail
@@ -20,27 +19,12 @@ scale=${2:-0.25}
 samples=${3:-0}
 runs=${4:-2}
 scenes=${5:-paper spot}
-spot_dir=${SPOT_DIR:-/work/shared/assets/spot}
 mkdir -p "$out"
-
-# Spot as a scene: the OBJ with a material that maps the texture, turned on the paper's turntable.
-write_spot_scene() {
-  local dir=$out/spot-assets
-  mkdir -p "$dir"
-  cp "$spot_dir/spot_texture.png" "$dir/spot_texture.png"
-  { echo "mtllib spot.mtl"; echo "usemtl spot"; cat "$spot_dir/spot_triangulated.obj"; } >"$dir/spot.obj"
-  printf 'newmtl spot\nKd 1 1 1\nmap_Kd spot_texture.png\n' >"$dir/spot.mtl"
-  sed -e "s|primitive: {shape: statue, detail: 6, seed: 7}|mesh: $(realpath "$dir")/spot.obj|" \
-      -e "s|name: paper-turntable|name: spot-turntable|" \
-      -e "s|fit: {height: 30cm}|fit: {height: 25cm}|" \
-      -e "s|surface: {pattern: speckle, scale: 2mm, contrast: 0.7, color: \[0.55, 0.52, 0.48\], roughness: 0.8}|surface: {roughness: 0.8}|" \
-      scenes/paper-turntable.yaml >"$out/spot-turntable.yaml"
-}
 
 scene_file() {
   case $1 in
     paper) echo scenes/paper-turntable.yaml ;;
-    spot) write_spot_scene; echo "$out/spot-turntable.yaml" ;;
+    spot) echo scenes/spot-turntable.yaml ;;
     *) echo "fidelity_table.sh: unknown scene $1" >&2; exit 1 ;;
   esac
 }
