@@ -261,9 +261,11 @@ void expect_same_albedo(ir::Scene scene, int shot_index, double scale) {
   pov.albedo_only = true;
   cycles::CyclesBackend cyc;
   cyc.albedo_only = true;
-  // Both supersample each pixel with a box filter (POV-Ray 4 x 4 rays, Cycles 64 samples).
-  auto pov_frame = render_with(pov, scene, shot, scale, 16, dir.path() / "povray");
-  auto cyc_frame = render_with(cyc, scene, shot, scale, 64, dir.path() / "cycles");
+  // Both supersample each pixel with a box filter, here densely enough that their own sampling
+  // noise stays well under the 2 % (POV-Ray 6 x 6 rays; Cycles 256 samples, cheap without
+  // lights; at 4 x 4 and 64 they differ from each other by 2.4 % on the paper scene).
+  auto pov_frame = render_with(pov, scene, shot, scale, 36, dir.path() / "povray");
+  auto cyc_frame = render_with(cyc, scene, shot, scale, 256, dir.path() / "cycles");
   ASSERT_TRUE(pov_frame && cyc_frame);
   all.push_back(std::move(*pov_frame));
   all.push_back(std::move(*cyc_frame));
@@ -280,10 +282,9 @@ void expect_same_albedo(ir::Scene scene, int shot_index, double scale) {
       const double difference = relative_difference(all[i].frame, all[j].frame, common);
       std::printf("albedo %s vs %s: mean absolute difference %.2f %% over %.0f px\n",
                   all[i].backend.c_str(), all[j].backend.c_str(), 100 * difference, pixels);
-      // The ray tracers agree within 2 %; the preview (one filtered sample a pixel against their
-      // supersampled box) differs at the dots' edges: 2.3-2.5 % measured, issue #34 wants 2 %.
-      const double limit = i == 0 ? 0.03 : 0.02;
-      EXPECT_LT(difference, limit) << all[i].backend << " vs " << all[j].backend;
+      // All three filter the albedo by a box over the pixel; what differs is sampling noise
+      // (Cycles) and the grids' density.
+      EXPECT_LT(difference, 0.02) << all[i].backend << " vs " << all[j].backend;
     }
   }
 }
@@ -291,16 +292,15 @@ void expect_same_albedo(ir::Scene scene, int shot_index, double scale) {
 TEST(ReferenceAgreement, PaperSceneAlbedo) {
   ir::Scene scene = compile_file("scenes/paper-turntable.yaml");
   // The speckle at about 4 px a cell, as the paper scene at --scale 0.25 draws it, in an image
-  // an eighth of the sensor's width.
-  for (auto& material : scene.materials) material.pattern.scale_m *= 5;
+  // an eighth of the sensor's width (4 mm cells at 0.95 mm a pixel).
+  for (auto& material : scene.materials) material.pattern.scale_m *= 2;
   expect_same_albedo(scene, 2, 0.125);
 }
 
+// A photographed texture over a mesh's UV atlas, at about a texel a pixel.
 TEST(ReferenceAgreement, TexturedSceneAlbedo) {
-  RIGC_REQUIRE_TOOL(fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf"),
-                    "assimp-testmodels");
-  const ir::Scene scene = compile_file("scenes/orbit-textured.yaml");
-  expect_same_albedo(scene, 3, 384.0 / scene.camera.width_px);
+  const ir::Scene scene = compile_file("scenes/spot-turntable.yaml");
+  expect_same_albedo(scene, 2, 0.125);
 }
 
 // 10 %-90 % width in pixels of the left silhouette edge of a bright box on black, averaged over

@@ -32,7 +32,7 @@ inline constexpr int kDotsPerCell = 2;
 inline constexpr std::array<float, kDotsPerCell> kDotStarts = {1, 145};
 inline constexpr float kRadiusMin = 0.28f;
 inline constexpr float kRadiusSpan = 0.14f;
-// Half-width of a dot's soft edge when drawn sharp (the renderers' own pixel filter on top).
+// Half-width of a dot's soft edge (each renderer's pixel filter on top).
 inline constexpr float kEdge = 0.06f;
 // Mean darkness over the surface, what the pattern fades to when too fine to resolve
 // (Studio.ResolvedPatternsAverageToTheirFadedValue measures it).
@@ -43,16 +43,8 @@ inline float seed_offset(std::uint32_t seed) {
   return static_cast<float>(seed % 289u);
 }
 
-// The edge half-width (cells) that blurs the dots as a box filter one pixel of `footprint` cells
-// wide would (0.66 maps the box's 10-90 % width onto the smoothstep's), in steps of 1/200 so
-// that neighbouring pixels share it exactly.
-inline float filtered_edge(float footprint) {
-  const float edge = std::sqrt(kEdge * kEdge + 0.66f * footprint * 0.66f * footprint);
-  return std::round(edge * 200) / 200;
-}
-
 // The darkness in [0, 1] at eight points q (cells), each lane with its own edge half-width
-// (>= kEdge; a dot's edge is narrowed where it would reach past half a cell).
+// (kEdge for the pattern itself; a dot's edge is narrowed where it would reach past half a cell).
 simd::F32x8 darkness8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, float seed_offset,
                       simd::F32x8 edge);
 

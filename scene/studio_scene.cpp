@@ -238,23 +238,32 @@ float pattern_resolve(float scale_m, float footprint_m) {
   return std::clamp(2.0f - 2.0f * footprint_m / scale_m, 0.0f, 1.0f);
 }
 
+// The pattern's mean darkness over the surface: what it fades to when too fine to resolve
+// (Studio.ResolvedPatternsAverageToTheirFadedValue measures it).
+float mean_darkness(const ir::SurfacePattern& pattern) {
+  switch (pattern.kind) {
+    case ir::PatternKind::kSpeckle:
+      return speckle::kMeanDarkness;
+    case ir::PatternKind::kNoise:
+    case ir::PatternKind::kChecker:
+      return 0.5f;
+    case ir::PatternKind::kNone:
+      break;
+  }
+  return 0;
+}
+
 // The pattern's darkness (clamped to [0, 1] by the caller) at lanes points, in units of its
-// scale, and its mean over the surface (what a pattern too fine to resolve fades to).
-// `footprint` is each lane's pixel size in the same units (the speckle's dots blur by it).
+// scale.
 simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx, simd::F32x8 qy,
-                              simd::F32x8 qz, simd::F32x8 footprint, int lanes,
-                              float& mean_darkness) {
+                              simd::F32x8 qz, int lanes) {
   using simd::F32x8;
   F32x8 darkness{};
   switch (pattern.kind) {
-    case ir::PatternKind::kSpeckle: {
-      // The dots blurred as a pixel-wide box filter would.
-      F32x8 edge;
-      for (int k = 0; k < 8; ++k) edge[k] = speckle::filtered_edge(footprint[k]);
-      darkness = speckle::darkness8(qx, qy, qz, speckle::seed_offset(pattern.seed), edge);
-      mean_darkness = speckle::kMeanDarkness;
+    case ir::PatternKind::kSpeckle:
+      darkness = speckle::darkness8(qx, qy, qz, speckle::seed_offset(pattern.seed),
+                                    F32x8{} + speckle::kEdge);
       break;
-    }
     case ir::PatternKind::kNoise: {
       F32x8 n{};
       float amplitude = 0.5f, frequency = 1;
@@ -265,7 +274,6 @@ simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx,
         frequency *= 2.1f;
       }
       darkness = n / 0.875f;
-      mean_darkness = 0.5f;
       break;
     }
     case ir::PatternKind::kChecker: {
@@ -275,7 +283,6 @@ simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx,
                                           static_cast<int>(std::floor(qz[k]))) &
                                          1);
       }
-      mean_darkness = 0.5f;
       break;
     }
     case ir::PatternKind::kNone:
@@ -295,6 +302,7 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
   }
   const float scale = static_cast<float>(pattern.scale_m);
   const float contrast = static_cast<float>(pattern.contrast);
+  const float mean = mean_darkness(pattern);
   for (int first = 0; first < count; first += 8) {
     const int lanes = std::min(8, count - first);
     F32x8 qx{}, qy{}, qz{};
@@ -303,17 +311,51 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
       qy[k] = y[first + k] / scale;
       qz[k] = z[first + k] / scale;
     }
-    F32x8 footprint{};
-    for (int k = 0; k < lanes; ++k) footprint[k] = footprint_of(first + k) / scale;
-    float mean_darkness = 0;
-    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, footprint, lanes, mean_darkness);
+    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes);
     for (int k = 0; k < lanes; ++k) {
       const float resolve = pattern_resolve(scale, footprint_of(first + k));
-      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
+      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean;
       out[first + k] = 1.0f - contrast * d;
     }
   }
 }
+
+// Samples of the box filter per pixel side: one per kFilterSpacing of the pattern's scale that
+// the side spans, at most kMaxFilterSide (64 samples a pixel, where the pattern starts fading).
+constexpr float kFilterSpacing = 0.05f;
+constexpr int kMaxFilterSide = 8;
+
+int filter_side(const Vector3f& side_cells) {
+  const float n = std::ceil(side_cells.norm() / kFilterSpacing);
+  return std::clamp(static_cast<int>(n), 1, kMaxFilterSide);
+}
+
+// Point samples of a pattern collected eight at a time; each lane's clamped darkness is added to
+// its pixel's sum.
+class SampleStream {
+ public:
+  SampleStream(const ir::SurfacePattern& pattern, float* sums) : pattern_(pattern), sums_(sums) {}
+  void add(const Vector3f& q, int pixel) {
+    qx_[lanes_] = q.x();
+    qy_[lanes_] = q.y();
+    qz_[lanes_] = q.z();
+    owner_[lanes_] = pixel;
+    if (++lanes_ == 8) flush();
+  }
+  void flush() {
+    if (lanes_ == 0) return;
+    const simd::F32x8 darkness = pattern_darkness8(pattern_, qx_, qy_, qz_, lanes_);
+    for (int k = 0; k < lanes_; ++k) sums_[owner_[k]] += std::clamp(darkness[k], 0.0f, 1.0f);
+    lanes_ = 0;
+  }
+
+ private:
+  const ir::SurfacePattern& pattern_;
+  float* sums_;
+  simd::F32x8 qx_{}, qy_{}, qz_{};
+  std::array<int, 8> owner_{};
+  int lanes_ = 0;
+};
 
 }  // namespace
 
@@ -321,20 +363,37 @@ bool has_pattern(const ir::SurfacePattern& pattern) {
   return pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
 }
 
-bool pattern_same_for(const ir::SurfacePattern& pattern, float footprint_a_m, float footprint_b_m) {
-  if (!pattern_fully_resolved(pattern, footprint_a_m) ||
-      !pattern_fully_resolved(pattern, footprint_b_m)) {
-    return false;
+void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
+                         float* out) {
+  if (!has_pattern(pattern)) {
+    std::fill_n(out, count, 1.0f);
+    return;
   }
-  if (!has_pattern(pattern) || pattern.kind != ir::PatternKind::kSpeckle) return true;
   const float scale = static_cast<float>(pattern.scale_m);
-  return speckle::filtered_edge(footprint_a_m / scale) ==
-         speckle::filtered_edge(footprint_b_m / scale);
-}
-
-bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m) {
-  return !has_pattern(pattern) ||
-         pattern_resolve(static_cast<float>(pattern.scale_m), footprint_m) == 1.0f;
+  const float contrast = static_cast<float>(pattern.contrast);
+  const float mean = mean_darkness(pattern);
+  // out[i] first sums pixel i's sample darknesses, in units of the pattern's scale.
+  std::fill_n(out, count, 0.0f);
+  SampleStream stream(pattern, out);
+  for (int i = 0; i < count; ++i) {
+    const PixelOnSurface& pixel = pixels[i];
+    const float footprint = std::max(pixel.dx.norm(), pixel.dy.norm());
+    if (pattern_resolve(scale, footprint) == 0) continue;
+    const Vector3f at = pixel.at / scale, dx = pixel.dx / scale, dy = pixel.dy / scale;
+    const int nx = filter_side(dx), ny = filter_side(dy);
+    for (int j = 0; j < ny; ++j) {
+      const float t = (j + 0.5f) / ny - 0.5f;
+      for (int k = 0; k < nx; ++k) stream.add(at + ((k + 0.5f) / nx - 0.5f) * dx + t * dy, i);
+    }
+  }
+  stream.flush();
+  for (int i = 0; i < count; ++i) {
+    const PixelOnSurface& pixel = pixels[i];
+    const float resolve = pattern_resolve(scale, std::max(pixel.dx.norm(), pixel.dy.norm()));
+    const int samples = filter_side(pixel.dx / scale) * filter_side(pixel.dy / scale);
+    const float filtered = resolve > 0 ? out[i] / samples : mean;
+    out[i] = 1.0f - contrast * (resolve * filtered + (1 - resolve) * mean);
+  }
 }
 
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
