@@ -297,6 +297,18 @@ TEST(ReferenceAgreement, PaperSceneAlbedo) {
   expect_same_albedo(scene, 2, 0.125);
 }
 
+// The noise pattern, at the paper scene's speckle size: one function in all three renderers.
+TEST(ReferenceAgreement, NoisePatternAlbedo) {
+  ir::Scene scene = compile_file("scenes/paper-turntable.yaml");
+  for (auto& material : scene.materials) {
+    if (material.pattern.kind == ir::PatternKind::kSpeckle) {
+      material.pattern.kind = ir::PatternKind::kNoise;
+      material.pattern.scale_m *= 2;
+    }
+  }
+  expect_same_albedo(scene, 2, 0.125);
+}
+
 // A photographed texture over a mesh's UV atlas, at about a texel a pixel.
 TEST(ReferenceAgreement, TexturedSceneAlbedo) {
   const ir::Scene scene = compile_file("scenes/spot-turntable.yaml");

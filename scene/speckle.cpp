@@ -4,7 +4,6 @@
 #include <cmath>
 
 namespace rigc::scene::speckle {
-namespace {
 
 using simd::F32x8;
 
@@ -21,6 +20,8 @@ F32x8 mod289(F32x8 x) {
 F32x8 perm(F32x8 v) {
   return mod289((34 * v + 1) * v);
 }
+
+namespace {
 
 F32x8 smoothstep01(F32x8 t) {
   t = t < 0 ? F32x8{} : t;
@@ -95,3 +96,69 @@ double darkness_reference(double qx, double qy, double qz, double seed_offset, d
 }
 
 }  // namespace rigc::scene::speckle
+
+namespace rigc::scene::noise {
+namespace {
+
+using simd::F32x8;
+
+// value(q, s) of speckle.h: the cell's corner hashes blended trilinearly.
+F32x8 value8(F32x8 qx, F32x8 qy, F32x8 qz, float seed_offset) {
+  using speckle::mod289;
+  using speckle::perm;
+  const F32x8 fx = simd::floor(qx), fy = simd::floor(qy), fz = simd::floor(qz);
+  auto fade = [](F32x8 t) { return t * t * (3 - 2 * t); };
+  const F32x8 tx = fade(qx - fx), ty = fade(qy - fy), tz = fade(qz - fz);
+  const F32x8 wx = mod289(fx), wy = mod289(fy), wz = mod289(fz);
+  std::array<F32x8, 8> corner;
+  for (int c = 0; c < 8; ++c) {
+    const F32x8 hx = perm(mod289(wx + static_cast<float>(c & 1)) + seed_offset);
+    const F32x8 hy = perm(hx + mod289(wy + static_cast<float>((c >> 1) & 1)));
+    corner[c] =
+        perm(hy + mod289(wz + static_cast<float>((c >> 2) & 1))) * (1 / (speckle::kPrime - 1));
+  }
+  auto mix = [](F32x8 a, F32x8 b, F32x8 t) { return a + (b - a) * t; };
+  const F32x8 y0 = mix(mix(corner[0], corner[1], tx), mix(corner[2], corner[3], tx), ty);
+  const F32x8 y1 = mix(mix(corner[4], corner[5], tx), mix(corner[6], corner[7], tx), ty);
+  return mix(y0, y1, tz);
+}
+
+}  // namespace
+
+F32x8 darkness8(F32x8 qx, F32x8 qy, F32x8 qz, std::uint32_t seed) {
+  F32x8 n{};
+  for (int k = 0; k < kOctaves; ++k) {
+    const float f = kFrequencies[k];
+    n += kAmplitudes[k] * value8(qx * f, qy * f, qz * f, speckle::seed_offset(seed + k));
+  }
+  return n * (1 / kAmplitudeSum);
+}
+
+double darkness_reference(double qx, double qy, double qz, std::uint32_t seed) {
+  const double p = speckle::kPrime;
+  auto perm = [&](double v) { return std::fmod((34 * v + 1) * v, p); };
+  auto wrap = [&](double c) { return std::fmod(std::fmod(c, p) + p, p); };
+  auto fade = [](double t) { return t * t * (3 - 2 * t); };
+  double n = 0;
+  for (int k = 0; k < kOctaves; ++k) {
+    const double s = speckle::seed_offset(seed + k);
+    const double x = qx * static_cast<double>(kFrequencies[k]),
+                 y = qy * static_cast<double>(kFrequencies[k]),
+                 z = qz * static_cast<double>(kFrequencies[k]);
+    const double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
+    double value = 0;
+    for (int c = 0; c < 8; ++c) {
+      const int ix = c & 1, iy = (c >> 1) & 1, iz = (c >> 2) & 1;
+      const double lattice =
+          perm(perm(perm(wrap(fx + ix) + s) + wrap(fy + iy)) + wrap(fz + iz)) / (p - 1);
+      const double w = (ix ? fade(x - fx) : 1 - fade(x - fx)) *
+                       (iy ? fade(y - fy) : 1 - fade(y - fy)) *
+                       (iz ? fade(z - fz) : 1 - fade(z - fz));
+      value += w * lattice;
+    }
+    n += kAmplitudes[k] * value;
+  }
+  return n / kAmplitudeSum;
+}
+
+}  // namespace rigc::scene::noise

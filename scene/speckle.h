@@ -43,6 +43,11 @@ inline float seed_offset(std::uint32_t seed) {
   return static_cast<float>(seed % 289u);
 }
 
+// The hash's steps on eight lanes, exact in float: x mod 289 (x an integer, |x| < 2^24) and
+// perm(v) (v an integer in [0, 578)).
+simd::F32x8 mod289(simd::F32x8 x);
+simd::F32x8 perm(simd::F32x8 v);
+
 // The darkness in [0, 1] at eight points q (cells), each lane with its own edge half-width
 // (kEdge for the pattern itself; a dot's edge is narrowed where it would reach past half a cell).
 simd::F32x8 darkness8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, float seed_offset,
@@ -53,3 +58,29 @@ simd::F32x8 darkness8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, float seed
 double darkness_reference(double qx, double qy, double qz, double seed_offset, double edge);
 
 }  // namespace rigc::scene::speckle
+
+// The `noise` pattern on the speckle's hash: three octaves of value noise, one function of the
+// object-frame point that every renderer evaluates alike (backends/ write it from these
+// constants).
+//
+//   lattice(c, s) = hash(c) / 288, with the speckle's hash at seed offset s
+//   value(q, s)   = lattice at the 8 corners of q's unit cell, blended trilinearly with weights
+//                   smoothstep(q - floor(q))
+//   darkness      = sum over octaves k of kAmplitudes[k] · value(kFrequencies[k] · q, s_k) / 0.875,
+//                   s_k = seed_offset(seed + k)
+namespace rigc::scene::noise {
+
+inline constexpr int kOctaves = 3;
+inline constexpr std::array<float, kOctaves> kFrequencies = {1.0f, 2.1f, 4.41f};
+inline constexpr std::array<float, kOctaves> kAmplitudes = {0.5f, 0.25f, 0.125f};
+inline constexpr float kAmplitudeSum = 0.875f;
+// The lattice values are uniform over {0, 1/288, ..., 1}: the pattern averages a half.
+inline constexpr float kMeanDarkness = 0.5f;
+
+// The darkness in [0, 1] at eight points q (cells) for the pattern's seed.
+simd::F32x8 darkness8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, std::uint32_t seed);
+
+// The same at one point in double precision, the definition read literally (for tests).
+double darkness_reference(double qx, double qy, double qz, std::uint32_t seed);
+
+}  // namespace rigc::scene::noise

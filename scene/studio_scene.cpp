@@ -79,46 +79,6 @@ Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
          (at(x0, y0 + 1) * (1 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
 }
 
-// Smooth value noise in [0, 1] on a unit lattice, at eight points at once (one per lane): a
-// 32-bit integer hash of each corner's lattice coordinates and the seed, interpolated with a
-// smoothstep fade.
-simd::F32x8 value_noise8(simd::F32x8 px, simd::F32x8 py, simd::F32x8 pz, std::uint32_t seed) {
-  using simd::F32x8;
-  using simd::I32x8;
-  using simd::U32x8;
-  const F32x8 fx = simd::floor(px), fy = simd::floor(py), fz = simd::floor(pz);
-  const auto ix = reinterpret_cast<U32x8>(__builtin_convertvector(fx, I32x8));
-  const auto iy = reinterpret_cast<U32x8>(__builtin_convertvector(fy, I32x8));
-  const auto iz = reinterpret_cast<U32x8>(__builtin_convertvector(fz, I32x8));
-  auto fade = [](F32x8 t) { return t * t * (3 - 2 * t); };
-  const F32x8 tx = fade(px - fx), ty = fade(py - fy), tz = fade(pz - fz);
-  // The hash up to the z step is shared by the corners (dx, dy, 0) and (dx, dy, 1).
-  auto corner_pair = [&](std::uint32_t dx, std::uint32_t dy, F32x8& near, F32x8& far) {
-    U32x8 h = U32x8{} + seed * 0x9E3779B9u;
-    h ^= (ix + dx) * 0x85EBCA6Bu;
-    h = (h ^ (h >> 13)) * 0xC2B2AE35u;
-    h ^= (iy + dy) * 0x27D4EB2Fu;
-    h = (h ^ (h >> 15)) * 0x165667B1u;
-    auto finish = [&](U32x8 z) {
-      U32x8 g = h ^ (z * 0x9E3779B1u);
-      g = (g ^ (g >> 16)) * 0x85EBCA77u;
-      g ^= g >> 13;
-      const I32x8 low = reinterpret_cast<I32x8>(g & 0xFFFFFFu);
-      return __builtin_convertvector(low, F32x8) / float(0xFFFFFF);
-    };
-    near = finish(iz);
-    far = finish(iz + 1u);
-  };
-  F32x8 v000, v001, v100, v101, v010, v011, v110, v111;
-  corner_pair(0, 0, v000, v001);
-  corner_pair(1, 0, v100, v101);
-  corner_pair(0, 1, v010, v011);
-  corner_pair(1, 1, v110, v111);
-  auto lerp = [](F32x8 a, F32x8 b, F32x8 t) { return a + (b - a) * t; };
-  return lerp(lerp(lerp(v000, v100, tx), lerp(v010, v110, tx), ty),
-              lerp(lerp(v001, v101, tx), lerp(v011, v111, tx), ty), tz);
-}
-
 // The triangles from `first` on are one convex planar face.
 void mark_convex_face(Geometry& g, std::size_t first) {
   g.convex_face.resize(first, -1);
@@ -245,6 +205,7 @@ float mean_darkness(const ir::SurfacePattern& pattern) {
     case ir::PatternKind::kSpeckle:
       return speckle::kMeanDarkness;
     case ir::PatternKind::kNoise:
+      return noise::kMeanDarkness;
     case ir::PatternKind::kChecker:
       return 0.5f;
     case ir::PatternKind::kNone:
@@ -264,18 +225,9 @@ simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx,
       darkness = speckle::darkness8(qx, qy, qz, speckle::seed_offset(pattern.seed),
                                     F32x8{} + speckle::kEdge);
       break;
-    case ir::PatternKind::kNoise: {
-      F32x8 n{};
-      float amplitude = 0.5f, frequency = 1;
-      for (int octave = 0; octave < 3; ++octave) {
-        n += amplitude *
-             value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
-        amplitude *= 0.5f;
-        frequency *= 2.1f;
-      }
-      darkness = n / 0.875f;
+    case ir::PatternKind::kNoise:
+      darkness = noise::darkness8(qx, qy, qz, pattern.seed);
       break;
-    }
     case ir::PatternKind::kChecker: {
       for (int k = 0; k < lanes; ++k) {
         darkness[k] = static_cast<float>((static_cast<int>(std::floor(qx[k])) +

@@ -108,6 +108,13 @@ json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material
                        {"scale", pattern.scale_m},
                        {"contrast", pattern.contrast},
                        {"seed", scene::speckle::seed_offset(pattern.seed)}};
+    if (pattern.kind == ir::PatternKind::kNoise) {
+      json seeds = json::array();
+      for (int k = 0; k < scene::noise::kOctaves; ++k) {
+        seeds.push_back(scene::speckle::seed_offset(pattern.seed + k));
+      }
+      spec["pattern"]["octave_seeds"] = seeds;
+    }
   }
   return spec;
 }
@@ -209,6 +216,10 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                      {"radius_min", sp::kRadiusMin},
                      {"radius_span", sp::kRadiusSpan},
                      {"edge", sp::kEdge}};
+  namespace nz = scene::noise;
+  data["noise"] = {{"frequencies", nz::kFrequencies},
+                   {"amplitudes", nz::kAmplitudes},
+                   {"amplitude_sum", nz::kAmplitudeSum}};
   data["albedo_only"] = albedo_only;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     if (!external::write_texture_png(dir / texture_file_name(static_cast<int>(t)),

@@ -103,9 +103,17 @@ std::string pigment_text(const scene::ShadedMaterial& material, int index, bool 
           "function {{ min(rigc_speckle(x, y, z, {0}), 0.99999) }}\n"
           "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
           number_text(scene::speckle::seed_offset(pattern.seed)), vec(base), vec(dark), scale);
-    case ir::PatternKind::kNoise:
-      return fmt::format("bozo color_map {{ [0 rgb {}] [1 rgb {}] }} scale {}", vec(base),
-                         vec(dark), scale);
+    case ir::PatternKind::kNoise: {
+      // scene/speckle.h's noise, one seed offset per octave.
+      std::string seeds;
+      for (int k = 0; k < scene::noise::kOctaves; ++k) {
+        seeds += ", " + number_text(scene::speckle::seed_offset(pattern.seed + k));
+      }
+      return fmt::format(
+          "function {{ min(rigc_noise(x, y, z{0}), 0.99999) }}\n"
+          "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
+          seeds, vec(base), vec(dark), scale);
+    }
     case ir::PatternKind::kChecker:
       return fmt::format("checker rgb {}, rgb {} scale {}", vec(base), vec(dark), scale);
     case ir::PatternKind::kNone:
@@ -158,6 +166,43 @@ std::string speckle_functions_text() {
       "#declare rigc_speckle = function(qx, qy, qz, ps) {{\n"
       "  rigc_speckle_in(qx, qy, qz, floor(qx - 0.5), floor(qy - 0.5), floor(qz - 0.5), ps) }}\n\n",
       corners);
+  return text;
+}
+
+// scene/speckle.h's noise as POV-Ray functions (on the speckle's rigc_hash and rigc_smooth).
+std::string noise_functions_text() {
+  namespace nz = scene::noise;
+  std::string text = fmt::format(
+      "#declare rigc_lattice = function(cx, cy, cz, ps) {{ rigc_hash(cx, cy, cz, ps) / {} }}\n"
+      "#declare rigc_mix = function(pa, pb, pt) {{ pa + (pb - pa) * pt }}\n",
+      number_text(scene::speckle::kPrime - 1));
+  // value(q, s) from the cell corner f and the smoothed fractions t.
+  auto lattice = [](int c) {
+    return fmt::format("rigc_lattice(fx + {}, fy + {}, fz + {}, ps)", c & 1, (c >> 1) & 1,
+                       (c >> 2) & 1);
+  };
+  auto along_x = [&](int c) {
+    return fmt::format("rigc_mix({}, {}, tx)", lattice(c), lattice(c + 1));
+  };
+  auto along_y = [&](int c) {
+    return fmt::format("rigc_mix({},\n    {}, ty)", along_x(c), along_x(c + 2));
+  };
+  text += fmt::format(
+      "#declare rigc_value_in = function(fx, fy, fz, tx, ty, tz, ps) {{\n"
+      "  rigc_mix({},\n  {}, tz) }}\n"
+      "#declare rigc_value = function(qx, qy, qz, ps) {{\n"
+      "  rigc_value_in(floor(qx), floor(qy), floor(qz), rigc_smooth(qx - floor(qx)),\n"
+      "                rigc_smooth(qy - floor(qy)), rigc_smooth(qz - floor(qz)), ps) }}\n",
+      along_y(0), along_y(4));
+  std::string octaves, seeds;
+  for (int k = 0; k < nz::kOctaves; ++k) {
+    const std::string f = number_text(nz::kFrequencies[k]);
+    octaves += fmt::format("{}{} * rigc_value({} * qx, {} * qy, {} * qz, ps{})",
+                           k ? " +\n    " : "", number_text(nz::kAmplitudes[k]), f, f, f, k);
+    seeds += fmt::format(", ps{}", k);
+  }
+  text += fmt::format("#declare rigc_noise = function(qx, qy, qz{}) {{\n  ({}) / {} }}\n\n", seeds,
+                      octaves, number_text(nz::kAmplitudeSum));
   return text;
 }
 
@@ -393,12 +438,12 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                  "ambient_light rgb {}\n"
                  "  #end\n}}\n\n",
                  number_text(ambient));
+  bool procedural = false;
   for (int m = 0; m < object_materials; ++m) {
-    if (studio.materials[m].pattern.kind == ir::PatternKind::kSpeckle) {
-      fmt::format_to(out, "{}", speckle_functions_text());
-      break;
-    }
+    const ir::PatternKind kind = studio.materials[m].pattern.kind;
+    procedural = procedural || kind == ir::PatternKind::kSpeckle || kind == ir::PatternKind::kNoise;
   }
+  if (procedural) fmt::format_to(out, "{}{}", speckle_functions_text(), noise_functions_text());
   for (int m = 0; m < total_materials; ++m) {
     const scene::ShadedMaterial& material = studio.materials[m];
     const bool is_object = m < object_materials;
