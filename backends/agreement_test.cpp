@@ -261,9 +261,8 @@ void expect_same_albedo(ir::Scene scene, int shot_index, double scale) {
   pov.albedo_only = true;
   cycles::CyclesBackend cyc;
   cyc.albedo_only = true;
-  // Both supersample each pixel with a box filter, here densely enough that their own sampling
-  // noise stays well under the 2 % (POV-Ray 6 x 6 rays; Cycles 256 samples, cheap without
-  // lights; at 4 x 4 and 64 they differ from each other by 2.4 % on the paper scene).
+  // Both supersample each pixel with a box filter, densely enough that their sampling noise is
+  // not what the test measures (POV-Ray 6 x 6 rays; Cycles 256 samples, cheap without lights).
   auto pov_frame = render_with(pov, scene, shot, scale, 36, dir.path() / "povray");
   auto cyc_frame = render_with(cyc, scene, shot, scale, 256, dir.path() / "cycles");
   ASSERT_TRUE(pov_frame && cyc_frame);
