@@ -108,7 +108,7 @@ name: eval-e2e
 object:
   primitive: {shape: statue, detail: 5, seed: 3}
   fit: {height: 25cm}
-  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
+  surface: {pattern: speckle, scale: 5mm, contrast: 0.8}
 studio:
   backdrop: {green_screen: true}
   lights:

@@ -26,7 +26,7 @@ name: recon-colmap
 object:
   primitive: {shape: statue, detail: 4, seed: 3}
   fit: {height: 25cm}
-  surface: {pattern: speckle, scale: 2mm, contrast: 0.8}
+  surface: {pattern: speckle, scale: 5mm, contrast: 0.8}
 studio:
   backdrop: {green_screen: true}
   lights:

@@ -31,6 +31,31 @@ Vector3f unit(const Vector3f& x) {
   return x * (1 / std::sqrt(x.squaredNorm()));
 }
 
+// A texture averaged over a pixel's parallelogram uv + s du + t dv (s, t in [-1/2, 1/2]), a
+// one-pixel box filter as the reference renderers apply: a grid of up to 4 x 4 samples about
+// half a texel apart, each from the mip level that their spacing leaves (the finest while they
+// are that close).
+Vector3f texture_box(const scene::MipTexture& texture, const Vector2f& uv, const Vector2f& du,
+                     const Vector2f& dv) {
+  if (texture.levels.empty()) return Vector3f::Ones();
+  const float size =
+      static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
+  const float texels_u = du.norm() * size, texels_v = dv.norm() * size;
+  auto side = [](float texels) {
+    return std::clamp(static_cast<int>(std::ceil(2 * texels)), 1, 4);
+  };
+  const int nu = side(texels_u), nv = side(texels_v);
+  const float spacing = std::max(texels_u / nu, texels_v / nv);
+  Vector3f sum = Vector3f::Zero();
+  for (int j = 0; j < nv; ++j) {
+    const float t = (j + 0.5f) / nv - 0.5f;
+    for (int k = 0; k < nu; ++k) {
+      sum += texture.sample(uv + ((k + 0.5f) / nu - 0.5f) * du + t * dv, spacing);
+    }
+  }
+  return sum / static_cast<float>(nu * nv);
+}
+
 }  // namespace
 
 FrameShader::FrameShader(const ir::Scene& scene, const scene::StudioScene& studio,
@@ -77,8 +102,6 @@ SurfacePoint FrameShader::surface_at(const ScreenTriangle& s, float px, float py
   if (sp.geometric.dot(sp.v) < 0) sp.geometric = -sp.geometric;
   if (sp.n.dot(sp.v) < 0) sp.n = -sp.n;
   sp.material = source.material();
-  const float depth = (cam_rot_ * sp.p + cam_t_).z();
-  sp.footprint_m = depth / fx_ / std::max(std::abs(sp.n.dot(sp.v)), 0.2f);
   return sp;
 }
 
@@ -113,48 +136,62 @@ AlbedoSample FrameShader::albedo_sample_at(const ScreenTriangle& s, float px, fl
     const Vector2f uv = source.at(source.g.uvs, b);
     const Vector2f du = uv_at(px + 1, py) - uv_at(px, py);
     const Vector2f dv = uv_at(px, py + 1) - uv_at(px, py);
-    const float texels =
-        std::max(du.norm(), dv.norm()) *
-        static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
-    out.color = out.color.cwiseProduct(texture.sample(uv, texels));
+    out.color = out.color.cwiseProduct(texture_box(texture, uv, du, dv));
   }
-  if (out.patterned) out.pattern_at = source.at(source.g.positions, b);
+  if (out.patterned) {
+    // The pixel's extent on the triangle's plane, for the pattern's box filter: a step of one
+    // pixel across the view, slid along the view ray onto the plane (first order in the pixel,
+    // and free of the screen triangle's shape, which is ill-conditioned for slivers).
+    // The plane's point under the pixel's centre, which may lie just outside the triangle
+    // (a pixel shaded by its first sample's triangle).
+    const Vector3f at =
+        source.at(source.g.positions, setup_.source_bary(s, screen_bary(s, px, py)));
+    const Vector3f p = object_rot_ * at + object_t_;
+    const Vector3f n = object_rot_ * source.g.face_normals[source.local];
+    const Vector3f v = unit(eye_ - p);
+    const float n_dot_v = n.dot(v);
+    const float slant = std::copysign(std::max(std::abs(n_dot_v), 0.2f), n_dot_v);
+    const float pixel_m = (cam_rot_ * p + cam_t_).z() / fx_;
+    auto step = [&](const Vector3f& across) {
+      return Vector3f(object_rot_.transpose() * (pixel_m * (across - v * (n.dot(across) / slant))));
+    };
+    out.pattern_at = {at, step(cam_rot_.row(0).transpose()), step(cam_rot_.row(1).transpose())};
+  }
   return out;
 }
 
-Vector3f FrameShader::albedo_at(const ScreenTriangle& s, float px, float py,
-                                float footprint_m) const {
+Vector3f FrameShader::albedo_at(const ScreenTriangle& s, float px, float py) const {
   AlbedoSample sample = albedo_sample_at(s, px, py);
   if (sample.patterned) {
     const scene::ShadedMaterial& material = studio_.materials[source_of(s).material()];
-    sample.color *= scene::pattern_factor(material.pattern, sample.pattern_at, footprint_m);
+    float factor = 1;
+    scene::pattern_factors_box(material.pattern, &sample.pattern_at, 1, &factor);
+    sample.color *= factor;
   }
   return sample.color;
 }
 
-template <typename Footprint>
 void FrameShader::albedo_batch(const int* tris, const int* px, const int* py, int count,
-                               Footprint footprint_m, Vector3f* out) const {
-  std::array<float, kMaxBatch> x, y, z, factor;
+                               Vector3f* out) const {
+  std::array<scene::PixelOnSurface, kMaxBatch> pixels;
+  std::array<float, kMaxBatch> factor;
   int patterned = 0;
   for (int i = 0; i < count; ++i) {
     const AlbedoSample sample = albedo_sample_at(screen_tris_[tris[i]], px[i] + 0.5f, py[i] + 0.5f);
     out[i] = sample.color;
     patterned += sample.patterned;
-    x[i] = sample.pattern_at.x();
-    y[i] = sample.pattern_at.y();
-    z[i] = sample.pattern_at.z();
+    pixels[i] = sample.pattern_at;
   }
   if (patterned == 0) return;
   // One material: either every pixel has the pattern or none does.
   const scene::ShadedMaterial& material =
       studio_.materials[source_of(screen_tris_[tris[0]]).material()];
-  scene::pattern_factors(material.pattern, x.data(), y.data(), z.data(), count, footprint_m,
-                         factor.data());
+  scene::pattern_factors_box(material.pattern, pixels.data(), count, factor.data());
   for (int i = 0; i < count; ++i) out[i] *= factor[i];
 }
 
 Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
+  if (request_.albedo_only) return {Vector3f::Ones(), Vector3f::Zero()};
   const scene::ShadedMaterial& material = studio_.materials[sp.material];
   const float metallic = material.metallic;
   // Ambient: a uniform white room of the given illuminance.
@@ -188,19 +225,15 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
 template <typename KnownAlbedos>
 void FrameShader::shade_four(const int* tris, const int* px, const int* py,
                              const KnownAlbedos& known, Vector3f* out) const {
-  std::array<float, 4> footprint;
   std::array<Vector3f, 4> scale, offset;
   for (int i = 0; i < 4; ++i) {
     const SurfacePoint sp = surface_at(screen_tris_[tris[i]], px[i] + 0.5f, py[i] + 0.5f);
     const auto lighting = lighting_at(sp);
     scale[i] = lighting.scale;
     offset[i] = lighting.offset;
-    footprint[i] = sp.footprint_m;
   }
   std::array<Vector3f, 4> albedo;
-  if (!known(px, py, footprint.data(), albedo.data())) {
-    albedo_batch(tris, px, py, 4, footprint.data(), albedo.data());
-  }
+  if (!known(px, py, albedo.data())) albedo_batch(tris, px, py, 4, albedo.data());
   for (int i = 0; i < 4; ++i) out[i] = albedo[i].cwiseProduct(scale[i]) + offset[i];
 }
 
@@ -219,7 +252,7 @@ Vector3f FrameShader::shade_on_plane(const ScreenTriangle& s, float px, float py
 Vector3f FrameShader::shade(const ScreenTriangle& s, float px, float py) const {
   const SurfacePoint sp = surface_at(s, px, py);
   const Lighting lighting = lighting_at(sp);
-  return albedo_at(s, px, py, sp.footprint_m).cwiseProduct(lighting.scale) + lighting.offset;
+  return albedo_at(s, px, py).cwiseProduct(lighting.scale) + lighting.offset;
 }
 
 PixelSurfaces FrameShader::single_surface(const float* inv_z, std::int32_t id, int object_samples) {
@@ -328,19 +361,15 @@ class TileShader {
   struct ObjectCorner {
     Lighting lighting;
     Vector3f n;
-    float footprint_m;
     bool known = false;
   };
 
   // A bumpy block that failed its light check (shade_object_block) leaves its sixteen albedos
-  // here for its quads: the same pixels, triangles and sample points. Of an albedo only the
-  // pattern's fade depends on the footprint, and where the block's and the quad's footprints
-  // both leave the pattern fully resolved, the albedos are the quad's.
+  // here for its quads: the same pixels and triangles, so the same albedos (each a function of
+  // its pixel and triangle alone).
   struct BlockAlbedos {
     bool valid = false;
     int bx = 0, by = 0;
-    float footprint_m = 0;
-    const ir::SurfacePattern* pattern = nullptr;  // the block's material's
     std::array<Vector3f, kBlock * kBlock> albedo;
   };
 
@@ -367,7 +396,7 @@ class TileShader {
   void resolve_quad(int qx, int qy);
   bool uniform_quad(int qx, int qy, bool whole, std::array<PixelSurfaces, 4>& quad) const;
   void shade_uniform_quad(int qx, int qy, const std::array<PixelSurfaces, 4>& quad);
-  bool known_albedos(const int* px, const int* py, const float* footprints, Vector3f* out);
+  bool known_albedos(const int* px, const int* py, Vector3f* out);
 
   const FrameShader& shader_;
   const StudioPlanes& planes_;
@@ -485,14 +514,11 @@ bool TileShader::shade_object_block(int bx, int by, std::int32_t single_id) {
     pxs[i] = bx + i % kBlock;
     pys[i] = by + i / kBlock;
   }
-  shader_.albedo_batch(tris.data(), pxs.data(), pys.data(), kBlock * kBlock, corner[0]->footprint_m,
-                       albedo.data());
+  shader_.albedo_batch(tris.data(), pxs.data(), pys.data(), kBlock * kBlock, albedo.data());
   if (!smooth && !light_is_linear(bx, by, block, corner, albedo)) {
     failed_block_.valid = true;
     failed_block_.bx = bx;
     failed_block_.by = by;
-    failed_block_.footprint_m = corner[0]->footprint_m;
-    failed_block_.pattern = &shader_.material(material).pattern;
     failed_block_.albedo = albedo;
     return false;
   }
@@ -551,7 +577,6 @@ std::array<const TileShader::ObjectCorner*, 4> TileShader::object_corners(int bx
                                                  static_cast<float>(by + kBlock * (k >> 1)), true);
       c.lighting = shader_.lighting_at(sp);
       c.n = sp.n;
-      c.footprint_m = sp.footprint_m;
       c.known = true;
     }
     corner[k] = &c;
@@ -658,11 +683,8 @@ void TileShader::shade_uniform_quad(int qx, int qy, const std::array<PixelSurfac
   if (smooth) {
     const Lighting lighting = shader_.lighting_at(centre);
     std::array<Vector3f, 4> albedo;
-    const std::array<float, 4> footprints = {centre.footprint_m, centre.footprint_m,
-                                             centre.footprint_m, centre.footprint_m};
-    if (!known_albedos(pxs.data(), pys.data(), footprints.data(), albedo.data())) {
-      shader_.albedo_batch(tris.data(), pxs.data(), pys.data(), 4, centre.footprint_m,
-                           albedo.data());
+    if (!known_albedos(pxs.data(), pys.data(), albedo.data())) {
+      shader_.albedo_batch(tris.data(), pxs.data(), pys.data(), 4, albedo.data());
     }
     for (int i = 0; i < 4; ++i) {
       shader_.write_pixel(pxs[i], pys[i], quad[i],
@@ -672,22 +694,16 @@ void TileShader::shade_uniform_quad(int qx, int qy, const std::array<PixelSurfac
   }
   // A bumpy patch: each pixel lit on its own; the albedos (the pattern) in one batch.
   std::array<Vector3f, 4> colors;
-  auto known = [this](const int* px, const int* py, const float* footprints, Vector3f* out) {
-    return known_albedos(px, py, footprints, out);
+  auto known = [this](const int* px, const int* py, Vector3f* out) {
+    return known_albedos(px, py, out);
   };
   shader_.shade_four(tris.data(), pxs.data(), pys.data(), known, colors.data());
   for (int i = 0; i < 4; ++i) shader_.write_pixel(pxs[i], pys[i], quad[i], colors[i]);
 }
 
 // The failed block's albedos for four of its pixels, when they serve (see BlockAlbedos).
-bool TileShader::known_albedos(const int* px, const int* py, const float* footprints,
-                               Vector3f* out) {
+bool TileShader::known_albedos(const int* px, const int* py, Vector3f* out) {
   if (!failed_block_.valid || !shader_.request().reuse_block_albedos) return false;
-  const ir::SurfacePattern& pattern = *failed_block_.pattern;
-  if (!scene::pattern_fully_resolved(pattern, failed_block_.footprint_m)) return false;
-  for (int i = 0; i < 4; ++i) {
-    if (!scene::pattern_fully_resolved(pattern, footprints[i])) return false;
-  }
   for (int i = 0; i < 4; ++i) {
     out[i] = failed_block_.albedo[(py[i] - failed_block_.by) * kBlock + px[i] - failed_block_.bx];
   }

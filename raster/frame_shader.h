@@ -1,5 +1,5 @@
 // Internal to the rasterizer: what a frame's surfaces look like. FrameShader works out, for a
-// point of a screen triangle, its surface (position, normals, footprint), its albedo (base
+// point of a screen triangle, its surface (position, normals), its albedo (base
 // colour, texture, pattern) and the light it sends to the camera, and writes shaded pixels;
 // shade_tiles drives the tile raster and shades every tile (frame_shader.cpp), the plain studio
 // planes through StudioPlanes (studio_planes.h).
@@ -45,15 +45,14 @@ struct SurfacePoint {
   Vector3f n;          // unit shading normal, turned towards the viewer
   Vector3f geometric;  // unit face normal, turned towards the viewer (shadow bias)
   Vector3f v;          // unit, towards the eye
-  float footprint_m;   // surface size of a pixel, for texture and pattern filtering
   int material;
 };
 
-// Base colour x texture at a point, and where on the object (in its own frame) the surface
-// pattern is to be read, when it has one.
+// Base colour x texture at a pixel, and where the pixel sees the object (in its own frame) to
+// read the surface pattern, when it has one.
 struct AlbedoSample {
   Vector3f color;
-  Vector3f pattern_at;
+  scene::PixelOnSurface pattern_at;
   bool patterned = false;
 };
 
@@ -108,19 +107,16 @@ class FrameShader {
   bool normal_agrees(const ScreenTriangle& s, float px, float py, const SurfacePoint& centre) const;
   AlbedoSample albedo_sample_at(const ScreenTriangle& s, float px, float py) const;
   // Base colour x texture x surface pattern at (px, py) on the screen triangle.
-  Vector3f albedo_at(const ScreenTriangle& s, float px, float py, float footprint_m) const;
-  // albedo_at for up to kMaxBatch pixels of one material at once (the pattern is evaluated eight
-  // pixels at a time): pixel i at (px[i], py[i]) on screen triangle tris[i], with the footprint
-  // `footprint_m` (a float: all alike; a pointer: one per pixel).
+  Vector3f albedo_at(const ScreenTriangle& s, float px, float py) const;
+  // albedo_at for up to kMaxBatch pixels of one material at once (the pattern's samples are
+  // evaluated eight at a time): pixel i at (px[i], py[i]) on screen triangle tris[i].
   static constexpr int kMaxBatch = 16;
-  template <typename Footprint>
-  void albedo_batch(const int* tris, const int* px, const int* py, int count, Footprint footprint_m,
-                    Vector3f* out) const;
+  void albedo_batch(const int* tris, const int* px, const int* py, int count, Vector3f* out) const;
   // The lights (shadows included) and the ambient term at a surface point.
   Lighting lighting_at(const SurfacePoint& sp) const;
-  // Four pixels of one surface and material, each shaded as shade() does (its own normal, light
-  // and footprint), with their albedos batched: pixel i at (px[i], py[i]) on screen triangle
-  // tris[i]. known(px, py, footprints, albedo) may supply the albedos (true) instead.
+  // Four pixels of one surface and material, each shaded as shade() does (its own normal and
+  // light), with their albedos batched: pixel i at (px[i], py[i]) on screen triangle tris[i].
+  // known(px, py, albedo) may supply the albedos (true) instead.
   template <typename KnownAlbedos>
   void shade_four(const int* tris, const int* px, const int* py, const KnownAlbedos& known,
                   Vector3f* out) const;

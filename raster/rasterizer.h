@@ -24,6 +24,9 @@ struct FrameRequest {
   // then shade its pixels (where the pattern is fully resolved, they are the quads' own); false
   // makes the quads evaluate every albedo (tests compare the two).
   bool reuse_block_albedos = true;
+  // Every surface sends its albedo (base colour x texture x pattern) as its radiance, unlit:
+  // the albedo agreement test compares this with the ray tracers' emission-only renders.
+  bool albedo_only = false;
 };
 
 struct RasterTimings {

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "dslr/simd.h"
+#include "scene/speckle.h"
 
 namespace rigc::scene {
 namespace {
@@ -76,46 +77,6 @@ Vector3f bilinear(const MipTexture::Level& level, Vector2f uv) {
   };
   return (at(x0, y0) * (1 - tx) + at(x0 + 1, y0) * tx) * (1 - ty) +
          (at(x0, y0 + 1) * (1 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
-}
-
-// Smooth value noise in [0, 1] on a unit lattice, at eight points at once (one per lane): a
-// 32-bit integer hash of each corner's lattice coordinates and the seed, interpolated with a
-// smoothstep fade.
-simd::F32x8 value_noise8(simd::F32x8 px, simd::F32x8 py, simd::F32x8 pz, std::uint32_t seed) {
-  using simd::F32x8;
-  using simd::I32x8;
-  using simd::U32x8;
-  const F32x8 fx = simd::floor(px), fy = simd::floor(py), fz = simd::floor(pz);
-  const auto ix = reinterpret_cast<U32x8>(__builtin_convertvector(fx, I32x8));
-  const auto iy = reinterpret_cast<U32x8>(__builtin_convertvector(fy, I32x8));
-  const auto iz = reinterpret_cast<U32x8>(__builtin_convertvector(fz, I32x8));
-  auto fade = [](F32x8 t) { return t * t * (3 - 2 * t); };
-  const F32x8 tx = fade(px - fx), ty = fade(py - fy), tz = fade(pz - fz);
-  // The hash up to the z step is shared by the corners (dx, dy, 0) and (dx, dy, 1).
-  auto corner_pair = [&](std::uint32_t dx, std::uint32_t dy, F32x8& near, F32x8& far) {
-    U32x8 h = U32x8{} + seed * 0x9E3779B9u;
-    h ^= (ix + dx) * 0x85EBCA6Bu;
-    h = (h ^ (h >> 13)) * 0xC2B2AE35u;
-    h ^= (iy + dy) * 0x27D4EB2Fu;
-    h = (h ^ (h >> 15)) * 0x165667B1u;
-    auto finish = [&](U32x8 z) {
-      U32x8 g = h ^ (z * 0x9E3779B1u);
-      g = (g ^ (g >> 16)) * 0x85EBCA77u;
-      g ^= g >> 13;
-      const I32x8 low = reinterpret_cast<I32x8>(g & 0xFFFFFFu);
-      return __builtin_convertvector(low, F32x8) / float(0xFFFFFF);
-    };
-    near = finish(iz);
-    far = finish(iz + 1u);
-  };
-  F32x8 v000, v001, v100, v101, v010, v011, v110, v111;
-  corner_pair(0, 0, v000, v001);
-  corner_pair(1, 0, v100, v101);
-  corner_pair(0, 1, v010, v011);
-  corner_pair(1, 1, v110, v111);
-  auto lerp = [](F32x8 a, F32x8 b, F32x8 t) { return a + (b - a) * t; };
-  return lerp(lerp(lerp(v000, v100, tx), lerp(v010, v110, tx), ty),
-              lerp(lerp(v001, v101, tx), lerp(v011, v111, tx), ty), tz);
 }
 
 // The triangles from `first` on are one convex planar face.
@@ -237,38 +198,36 @@ float pattern_resolve(float scale_m, float footprint_m) {
   return std::clamp(2.0f - 2.0f * footprint_m / scale_m, 0.0f, 1.0f);
 }
 
+// The pattern's mean darkness over the surface: what it fades to when too fine to resolve
+// (Studio.ResolvedPatternsAverageToTheirFadedValue measures it).
+float mean_darkness(const ir::SurfacePattern& pattern) {
+  switch (pattern.kind) {
+    case ir::PatternKind::kSpeckle:
+      return speckle::kMeanDarkness;
+    case ir::PatternKind::kNoise:
+      return noise::kMeanDarkness;
+    case ir::PatternKind::kChecker:
+      return 0.5f;
+    case ir::PatternKind::kNone:
+      break;
+  }
+  return 0;
+}
+
 // The pattern's darkness (clamped to [0, 1] by the caller) at lanes points, in units of its
-// scale, and its mean over the surface (what a pattern too fine to resolve fades to).
+// scale.
 simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx, simd::F32x8 qy,
-                              simd::F32x8 qz, int lanes, float& mean_darkness) {
+                              simd::F32x8 qz, int lanes) {
   using simd::F32x8;
   F32x8 darkness{};
   switch (pattern.kind) {
-    case ir::PatternKind::kSpeckle: {
-      // Dark blotches at two scales, with soft edges (the darkness ramps over 1/12 of n).
-      const F32x8 n = 0.65f * value_noise8(qx, qy, qz, pattern.seed) +
-                      0.35f * value_noise8(qx * 2.7f + 17.1f, qy * 2.7f + 3.3f, qz * 2.7f + 9.7f,
-                                           pattern.seed + 1);
-      darkness = (n - 0.47f) * 12.0f;
-      // The clamped darkness averages 0.47 over the surface (see the test
-      // Preview.ResolvedPatternsAverageToTheirFadedValue): fading to it keeps the brightness
-      // when zooming out.
-      mean_darkness = 0.47f;
+    case ir::PatternKind::kSpeckle:
+      darkness = speckle::darkness8(qx, qy, qz, speckle::seed_offset(pattern.seed),
+                                    F32x8{} + speckle::kEdge);
       break;
-    }
-    case ir::PatternKind::kNoise: {
-      F32x8 n{};
-      float amplitude = 0.5f, frequency = 1;
-      for (int octave = 0; octave < 3; ++octave) {
-        n += amplitude *
-             value_noise8(qx * frequency, qy * frequency, qz * frequency, pattern.seed + octave);
-        amplitude *= 0.5f;
-        frequency *= 2.1f;
-      }
-      darkness = n / 0.875f;
-      mean_darkness = 0.5f;
+    case ir::PatternKind::kNoise:
+      darkness = noise::darkness8(qx, qy, qz, pattern.seed);
       break;
-    }
     case ir::PatternKind::kChecker: {
       for (int k = 0; k < lanes; ++k) {
         darkness[k] = static_cast<float>((static_cast<int>(std::floor(qx[k])) +
@@ -276,7 +235,6 @@ simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx,
                                           static_cast<int>(std::floor(qz[k]))) &
                                          1);
       }
-      mean_darkness = 0.5f;
       break;
     }
     case ir::PatternKind::kNone:
@@ -296,6 +254,7 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
   }
   const float scale = static_cast<float>(pattern.scale_m);
   const float contrast = static_cast<float>(pattern.contrast);
+  const float mean = mean_darkness(pattern);
   for (int first = 0; first < count; first += 8) {
     const int lanes = std::min(8, count - first);
     F32x8 qx{}, qy{}, qz{};
@@ -304,15 +263,51 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
       qy[k] = y[first + k] / scale;
       qz[k] = z[first + k] / scale;
     }
-    float mean_darkness = 0;
-    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes, mean_darkness);
+    const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes);
     for (int k = 0; k < lanes; ++k) {
       const float resolve = pattern_resolve(scale, footprint_of(first + k));
-      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean_darkness;
+      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean;
       out[first + k] = 1.0f - contrast * d;
     }
   }
 }
+
+// Samples of the box filter per pixel side: one per kFilterSpacing of the pattern's scale that
+// the side spans, at most kMaxFilterSide (64 samples a pixel, where the pattern starts fading).
+constexpr float kFilterSpacing = 0.05f;
+constexpr int kMaxFilterSide = 8;
+
+int filter_side(const Vector3f& side_cells) {
+  const float n = std::ceil(side_cells.norm() / kFilterSpacing);
+  return std::clamp(static_cast<int>(n), 1, kMaxFilterSide);
+}
+
+// Point samples of a pattern collected eight at a time; each lane's clamped darkness is added to
+// its pixel's sum.
+class SampleStream {
+ public:
+  SampleStream(const ir::SurfacePattern& pattern, float* sums) : pattern_(pattern), sums_(sums) {}
+  void add(const Vector3f& q, int pixel) {
+    qx_[lanes_] = q.x();
+    qy_[lanes_] = q.y();
+    qz_[lanes_] = q.z();
+    owner_[lanes_] = pixel;
+    if (++lanes_ == 8) flush();
+  }
+  void flush() {
+    if (lanes_ == 0) return;
+    const simd::F32x8 darkness = pattern_darkness8(pattern_, qx_, qy_, qz_, lanes_);
+    for (int k = 0; k < lanes_; ++k) sums_[owner_[k]] += std::clamp(darkness[k], 0.0f, 1.0f);
+    lanes_ = 0;
+  }
+
+ private:
+  const ir::SurfacePattern& pattern_;
+  float* sums_;
+  simd::F32x8 qx_{}, qy_{}, qz_{};
+  std::array<int, 8> owner_{};
+  int lanes_ = 0;
+};
 
 }  // namespace
 
@@ -320,9 +315,37 @@ bool has_pattern(const ir::SurfacePattern& pattern) {
   return pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0;
 }
 
-bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m) {
-  return !has_pattern(pattern) ||
-         pattern_resolve(static_cast<float>(pattern.scale_m), footprint_m) == 1.0f;
+void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
+                         float* out) {
+  if (!has_pattern(pattern)) {
+    std::fill_n(out, count, 1.0f);
+    return;
+  }
+  const float scale = static_cast<float>(pattern.scale_m);
+  const float contrast = static_cast<float>(pattern.contrast);
+  const float mean = mean_darkness(pattern);
+  // out[i] first sums pixel i's sample darknesses, in units of the pattern's scale.
+  std::fill_n(out, count, 0.0f);
+  SampleStream stream(pattern, out);
+  for (int i = 0; i < count; ++i) {
+    const PixelOnSurface& pixel = pixels[i];
+    const float footprint = std::max(pixel.dx.norm(), pixel.dy.norm());
+    if (pattern_resolve(scale, footprint) == 0) continue;
+    const Vector3f at = pixel.at / scale, dx = pixel.dx / scale, dy = pixel.dy / scale;
+    const int nx = filter_side(dx), ny = filter_side(dy);
+    for (int j = 0; j < ny; ++j) {
+      const float t = (j + 0.5f) / ny - 0.5f;
+      for (int k = 0; k < nx; ++k) stream.add(at + ((k + 0.5f) / nx - 0.5f) * dx + t * dy, i);
+    }
+  }
+  stream.flush();
+  for (int i = 0; i < count; ++i) {
+    const PixelOnSurface& pixel = pixels[i];
+    const float resolve = pattern_resolve(scale, std::max(pixel.dx.norm(), pixel.dy.norm()));
+    const int samples = filter_side(pixel.dx / scale) * filter_side(pixel.dy / scale);
+    const float filtered = resolve > 0 ? out[i] / samples : mean;
+    out[i] = 1.0f - contrast * (resolve * filtered + (1 - resolve) * mean);
+  }
 }
 
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,

@@ -84,9 +84,6 @@ float pattern_factor(const ir::SurfacePattern& pattern, const Eigen::Vector3f& p
 
 // Whether `pattern` changes an albedo at all (a kind, and some contrast).
 bool has_pattern(const ir::SurfacePattern& pattern);
-// Whether `footprint_m` leaves the pattern fully resolved (no fade to its mean), so that the
-// factor at a point is the same for any such footprint. True without a pattern.
-bool pattern_fully_resolved(const ir::SurfacePattern& pattern, float footprint_m);
 
 // pattern_factor at `count` points (object-frame x[i], y[i], z[i]) sharing one footprint,
 // written to out[i], eight points per step (pattern_factor is this for one point).
@@ -95,5 +92,17 @@ void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const fl
 // The same with a footprint per point, footprints_m[i].
 void pattern_factors(const ir::SurfacePattern& pattern, const float* x, const float* y,
                      const float* z, int count, const float* footprints_m, float* out);
+
+// Where a pixel sees the surface: the object-frame point under its centre, and the point's change
+// across one pixel in x and in y (so the pixel covers at + s dx + t dy, s and t in [-1/2, 1/2]).
+struct PixelOnSurface {
+  Eigen::Vector3f at, dx, dy;
+};
+// The pattern's factor averaged over each pixel's area on the surface, a one-pixel box filter as
+// the reference renderers apply (their pixel filter): a grid of point samples about a twentieth
+// of the pattern's scale apart (at most 8 x 8), the pattern still fading to its mean where a
+// pixel spans more than half its scale. out[i] for pixels[i], count of them.
+void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
+                         float* out);
 
 }  // namespace rigc::scene

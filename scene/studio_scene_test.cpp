@@ -121,6 +121,52 @@ TEST(Studio, ResolvedPatternsAverageToTheirFadedValue) {
   }
 }
 
+// The preview filters a pattern as the reference renderers do, a box over the pixel: its factor
+// for a pixel is the pattern's mean over the pixel's parallelogram on the surface (measured
+// here on a 100 x 100 grid), tilted and stretched pixels alike, and a pixel of no extent is
+// the point itself.
+TEST(Studio, PatternBoxFilterAveragesThePixelArea) {
+  for (const auto kind : {ir::PatternKind::kSpeckle, ir::PatternKind::kChecker}) {
+    ir::SurfacePattern pattern;
+    pattern.kind = kind;
+    pattern.scale_m = 0.002;
+    pattern.contrast = 0.7;
+    pattern.seed = 3;
+    std::mt19937 random(21);
+    std::uniform_real_distribution<float> coordinate(-0.05f, 0.05f), side(-0.0008f, 0.0008f);
+    double worst = 0, mean_difference = 0;
+    constexpr int kPixels = 60, kGrid = 100;
+    for (int i = 0; i < kPixels; ++i) {
+      const scene::PixelOnSurface pixel{
+          {coordinate(random), coordinate(random), coordinate(random)},
+          {side(random), side(random), side(random)},
+          {side(random), side(random), side(random)}};
+      float box = 0;
+      scene::pattern_factors_box(pattern, &pixel, 1, &box);
+      if (std::max(pixel.dx.norm(), pixel.dy.norm()) > 0.5 * pattern.scale_m) continue;  // fades
+      double want = 0;
+      for (int j = 0; j < kGrid; ++j) {
+        for (int k = 0; k < kGrid; ++k) {
+          const Eigen::Vector3f at = pixel.at + ((k + 0.5f) / kGrid - 0.5f) * pixel.dx +
+                                     ((j + 0.5f) / kGrid - 0.5f) * pixel.dy;
+          want += scene::pattern_factor(pattern, at, 0.0f);
+        }
+      }
+      want /= kGrid * kGrid;
+      worst = std::max(worst, std::abs(box - want));
+      mean_difference += std::abs(box - want) / kPixels;
+    }
+    // The checker's hard edges leave a grid's steps; the speckle's soft ones hardly any.
+    EXPECT_LT(worst, kind == ir::PatternKind::kChecker ? 0.06 : 0.03)
+        << "kind " << static_cast<int>(kind);
+    EXPECT_LT(mean_difference, 0.005) << "kind " << static_cast<int>(kind);
+    const scene::PixelOnSurface point{{0.01f, -0.02f, 0.003f}, {0, 0, 0}, {0, 0, 0}};
+    float factor = 0;
+    scene::pattern_factors_box(pattern, &point, 1, &factor);
+    EXPECT_EQ(factor, scene::pattern_factor(pattern, point.at, 0.0f));
+  }
+}
+
 // The rasterizer lets the triangles of one convex face cover a tile together (a tile with a
 // corner in none of them, or an edge crossing it, is rasterized per sample): each face must be
 // flat, and its triangles must tile a convex polygon, their areas summing to its hull's.

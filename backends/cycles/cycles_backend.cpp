@@ -12,6 +12,7 @@
 #include "backends/external/script_text.h"
 #include "dslr/lens.h"
 #include "io/files.h"
+#include "scene/speckle.h"
 #include "scene/studio_scene.h"
 
 namespace rigc::cycles {
@@ -100,13 +101,20 @@ json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material
                {"pattern", nullptr}};
   const ir::SurfacePattern& pattern = material.pattern;
   if (is_object && pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0) {
-    // Blender's noise is centred on 0.5 like the preview's value noise: speckle darkens where it
-    // is above a step a little over the middle (about 40 % of the surface).
-    json from = pattern.kind == ir::PatternKind::kSpeckle ? json{0.52, 0.57} : json{0.0, 1.0};
-    spec["pattern"] = {{"kind", pattern.kind == ir::PatternKind::kChecker ? "checker" : "noise"},
+    const char* kind = pattern.kind == ir::PatternKind::kChecker   ? "checker"
+                       : pattern.kind == ir::PatternKind::kSpeckle ? "speckle"
+                                                                   : "noise";
+    spec["pattern"] = {{"kind", kind},
                        {"scale", pattern.scale_m},
                        {"contrast", pattern.contrast},
-                       {"from", from}};
+                       {"seed", scene::speckle::seed_offset(pattern.seed)}};
+    if (pattern.kind == ir::PatternKind::kNoise) {
+      json seeds = json::array();
+      for (int k = 0; k < scene::noise::kOctaves; ++k) {
+        seeds.push_back(scene::speckle::seed_offset(pattern.seed + k));
+      }
+      spec["pattern"]["octave_seeds"] = seeds;
+    }
   }
   return spec;
 }
@@ -201,6 +209,18 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
     materials.push_back(material_json(scene, studio.materials[m], m, m < object_materials));
   }
   data["materials"] = materials;
+  // scene/speckle.h's constants, for the script's speckle node group.
+  namespace sp = scene::speckle;
+  data["speckle"] = {{"prime", sp::kPrime},
+                     {"dot_starts", sp::kDotStarts},
+                     {"radius_min", sp::kRadiusMin},
+                     {"radius_span", sp::kRadiusSpan},
+                     {"edge", sp::kEdge}};
+  namespace nz = scene::noise;
+  data["noise"] = {{"frequencies", nz::kFrequencies},
+                   {"amplitudes", nz::kAmplitudes},
+                   {"amplitude_sum", nz::kAmplitudeSum}};
+  data["albedo_only"] = albedo_only;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     if (!external::write_texture_png(dir / texture_file_name(static_cast<int>(t)),
                                      scene.textures[t], error)) {

@@ -23,6 +23,10 @@ class CyclesBackend : public external::ExternalBackend {
   std::string name() const override { return "cycles"; }
   std::string executable() const override { return "blender"; }
   std::string package() const override { return "blender"; }
+  // Emits a script that renders the unlit albedo (every surface an emitter of its base colour x
+  // texture x pattern, no lights or world) instead of the lit image: for the albedo agreement
+  // test.
+  bool albedo_only = false;
   // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
   // the script's default Cycles sample count (0: 64).
   bool emit(const ir::Scene& scene, const scene::StudioScene& studio,

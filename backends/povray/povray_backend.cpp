@@ -17,6 +17,7 @@
 #include "dslr/lens.h"
 #include "io/files.h"
 #include "scene/motion_blur.h"
+#include "scene/speckle.h"
 #include "scene/studio_scene.h"
 
 namespace rigc::povray {
@@ -97,20 +98,112 @@ std::string pigment_text(const scene::ShadedMaterial& material, int index, bool 
   const std::string scale = number_text(pattern.scale_m);
   switch (pattern.kind) {
     case ir::PatternKind::kSpeckle:
-      // Dark blotches on about 40 % of the surface, as the preview's speckle: POV's noise is
-      // centred on 0.5, so the step sits a little above it.
+      // scene/speckle.h's darkness, kept below 1 (a function pattern wraps 1 round to 0).
       return fmt::format(
-          "bozo color_map {{ [0 rgb {0}] [0.52 rgb {0}] [0.57 rgb {1}] [1 rgb {1}] }} scale {2}",
-          vec(base), vec(dark), scale);
-    case ir::PatternKind::kNoise:
-      return fmt::format("bozo color_map {{ [0 rgb {}] [1 rgb {}] }} scale {}", vec(base),
-                         vec(dark), scale);
+          "function {{ min(rigc_speckle(x, y, z, {0}), 0.99999) }}\n"
+          "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
+          number_text(scene::speckle::seed_offset(pattern.seed)), vec(base), vec(dark), scale);
+    case ir::PatternKind::kNoise: {
+      // scene/speckle.h's noise, one seed offset per octave.
+      std::string seeds;
+      for (int k = 0; k < scene::noise::kOctaves; ++k) {
+        seeds += ", " + number_text(scene::speckle::seed_offset(pattern.seed + k));
+      }
+      return fmt::format(
+          "function {{ min(rigc_noise(x, y, z{0}), 0.99999) }}\n"
+          "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
+          seeds, vec(base), vec(dark), scale);
+    }
     case ir::PatternKind::kChecker:
       return fmt::format("checker rgb {}, rgb {} scale {}", vec(base), vec(dark), scale);
     case ir::PatternKind::kNone:
       break;
   }
   return "rgb " + vec(base);
+}
+
+// scene/speckle.h's pattern as POV-Ray functions: a function has no local variables, so each
+// value used twice is a parameter of the next one.
+std::string speckle_functions_text() {
+  namespace sp = scene::speckle;
+  const std::string p = number_text(sp::kPrime);
+  std::string text = fmt::format(
+      "#declare rigc_perm = function(pv) {{ mod((34 * pv + 1) * pv, {0}) }}\n"
+      "#declare rigc_wrap = function(pv) {{ mod(mod(pv, {0}) + {0}, {0}) }}\n"
+      "#declare rigc_smooth = function(pt) {{ pt * pt * (3 - 2 * pt) }}\n"
+      "#declare rigc_edge = function(pd, pr, pw) {{\n"
+      "  rigc_smooth(min(max((pr + pw - pd) / (2 * pw), 0), 1)) }}\n"
+      "#declare rigc_dot_r = function(pd, pr) {{ rigc_edge(pd, pr, min({1}, 0.5 - pr)) }}\n"
+      "#declare rigc_dot3 = function(ex, ey, dz, g3) {{\n"
+      "  rigc_dot_r(sqrt(ex * ex + ey * ey + pow(dz - g3 / {0}, 2)),\n"
+      "             {2} + {3} * rigc_perm(g3 + 1)) }}\n"
+      "#declare rigc_dot2 = function(ex, dy, dz, g2) {{\n"
+      "  rigc_dot3(ex, dy - g2 / {0}, dz, rigc_perm(g2 + 1)) }}\n"
+      "#declare rigc_dot1 = function(dx, dy, dz, g1) {{\n"
+      "  rigc_dot2(dx - g1 / {0}, dy, dz, rigc_perm(g1 + 1)) }}\n",
+      p, number_text(sp::kEdge), number_text(sp::kRadiusMin),
+      number_text(static_cast<double>(sp::kRadiusSpan) / (sp::kPrime - 1)));
+  std::string dots;
+  for (const float start : sp::kDotStarts) {
+    const std::string dot =
+        fmt::format("rigc_dot1(dx, dy, dz, rigc_perm(ph + {}))", number_text(start));
+    dots = dots.empty() ? dot : fmt::format("max({}, {})", dots, dot);
+  }
+  text += fmt::format("#declare rigc_cell = function(dx, dy, dz, ph) {{ {} }}\n", dots);
+  text +=
+      "#declare rigc_hash = function(cx, cy, cz, ps) {\n"
+      "  rigc_perm(rigc_perm(rigc_perm(rigc_wrap(cx) + ps) + rigc_wrap(cy)) + rigc_wrap(cz)) }\n"
+      "#declare rigc_corner = function(qx, qy, qz, cx, cy, cz, ps) {\n"
+      "  rigc_cell(qx - cx, qy - cy, qz - cz, rigc_hash(cx, cy, cz, ps)) }\n";
+  std::string corners;
+  for (int c = 0; c < 8; ++c) {
+    const std::string corner = fmt::format("rigc_corner(qx, qy, qz, bx + {}, by + {}, bz + {}, ps)",
+                                           c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    corners = corners.empty() ? corner : fmt::format("max({},\n    {})", corners, corner);
+  }
+  text += fmt::format(
+      "#declare rigc_speckle_in = function(qx, qy, qz, bx, by, bz, ps) {{\n  {} }}\n"
+      "#declare rigc_speckle = function(qx, qy, qz, ps) {{\n"
+      "  rigc_speckle_in(qx, qy, qz, floor(qx - 0.5), floor(qy - 0.5), floor(qz - 0.5), ps) }}\n\n",
+      corners);
+  return text;
+}
+
+// scene/speckle.h's noise as POV-Ray functions (on the speckle's rigc_hash and rigc_smooth).
+std::string noise_functions_text() {
+  namespace nz = scene::noise;
+  std::string text = fmt::format(
+      "#declare rigc_lattice = function(cx, cy, cz, ps) {{ rigc_hash(cx, cy, cz, ps) / {} }}\n"
+      "#declare rigc_mix = function(pa, pb, pt) {{ pa + (pb - pa) * pt }}\n",
+      number_text(scene::speckle::kPrime - 1));
+  // value(q, s) from the cell corner f and the smoothed fractions t.
+  auto lattice = [](int c) {
+    return fmt::format("rigc_lattice(fx + {}, fy + {}, fz + {}, ps)", c & 1, (c >> 1) & 1,
+                       (c >> 2) & 1);
+  };
+  auto along_x = [&](int c) {
+    return fmt::format("rigc_mix({}, {}, tx)", lattice(c), lattice(c + 1));
+  };
+  auto along_y = [&](int c) {
+    return fmt::format("rigc_mix({},\n    {}, ty)", along_x(c), along_x(c + 2));
+  };
+  text += fmt::format(
+      "#declare rigc_value_in = function(fx, fy, fz, tx, ty, tz, ps) {{\n"
+      "  rigc_mix({},\n  {}, tz) }}\n"
+      "#declare rigc_value = function(qx, qy, qz, ps) {{\n"
+      "  rigc_value_in(floor(qx), floor(qy), floor(qz), rigc_smooth(qx - floor(qx)),\n"
+      "                rigc_smooth(qy - floor(qy)), rigc_smooth(qz - floor(qz)), ps) }}\n",
+      along_y(0), along_y(4));
+  std::string octaves, seeds;
+  for (int k = 0; k < nz::kOctaves; ++k) {
+    const std::string f = number_text(nz::kFrequencies[k]);
+    octaves += fmt::format("{}{} * rigc_value({} * qx, {} * qy, {} * qz, ps{})",
+                           k ? " +\n    " : "", number_text(nz::kAmplitudes[k]), f, f, f, k);
+    seeds += fmt::format(", ps{}", k);
+  }
+  text += fmt::format("#declare rigc_noise = function(qx, qy, qz{}) {{\n  ({}) / {} }}\n\n", seeds,
+                      octaves, number_text(nz::kAmplitudeSum));
+  return text;
 }
 
 // The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) scaled by
@@ -264,12 +357,13 @@ std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::I
 }
 
 std::string shot_ini(const ir::Shot& shot, const dslr::Intrinsics& canvas, int subframes,
-                     int samples, bool mask, bool focal_blur) {
+                     int samples, bool mask, bool focal_blur, bool albedo) {
   const std::string stem = shot.name;
   std::string text = fmt::format(
       "; RigC: the {} of {}. Run: povray {}{}.ini\n"
       "Input_File_Name={}.pov\n",
       mask ? "object mask" : "image", stem, stem, mask ? "_mask" : "", stem);
+  if (albedo && !mask) text += "Declare=RIGC_ALBEDO=1\n";
   if (mask) {
     text += fmt::format("Declare=RIGC_MASK=1\nOutput_File_Name={}_mask.exr\n", stem);
   } else if (subframes > 1) {
@@ -333,15 +427,23 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                  "// RigC POV-Ray scene '{}' (from {}; object {}).\n"
                  "// World frame: +Z up, floor at z = 0, metres. Colours are linear; light is in "
                  "Blender's units (1 = 683 cd/m2).\n"
-                 "#version 3.7;\n#ifndef (RIGC_MASK)\n  #declare RIGC_MASK = 0;\n#end\n\n",
+                 "#version 3.7;\n#ifndef (RIGC_MASK)\n  #declare RIGC_MASK = 0;\n#end\n"
+                 "#ifndef (RIGC_ALBEDO)\n  #declare RIGC_ALBEDO = 0;\n#end\n\n",
                  external::comment_text(scene.name), external::comment_text(scene.source_file),
                  external::comment_text(scene.object.source));
   const double ambient = scene.studio.ambient_lx / external::kCandelaPerBlenderUnit / kPi;
   fmt::format_to(out,
                  "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 5\n"
-                 "  #if (RIGC_MASK)\n    ambient_light rgb 1\n  #else\n    ambient_light rgb {}\n"
+                 "  #if (RIGC_MASK | RIGC_ALBEDO)\n    ambient_light rgb 1\n  #else\n    "
+                 "ambient_light rgb {}\n"
                  "  #end\n}}\n\n",
                  number_text(ambient));
+  bool procedural = false;
+  for (int m = 0; m < object_materials; ++m) {
+    const ir::PatternKind kind = studio.materials[m].pattern.kind;
+    procedural = procedural || kind == ir::PatternKind::kSpeckle || kind == ir::PatternKind::kNoise;
+  }
+  if (procedural) fmt::format_to(out, "{}{}", speckle_functions_text(), noise_functions_text());
   for (int m = 0; m < total_materials; ++m) {
     const scene::ShadedMaterial& material = studio.materials[m];
     const bool is_object = m < object_materials;
@@ -354,9 +456,11 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
       }
     }
     fmt::format_to(out,
-                   "#declare {} =\n#if (RIGC_MASK)\n"
-                   "  texture {{ pigment {{ rgb {} }} finish {{ ambient 1 diffuse 0 }} }}\n"
-                   "#else\n  texture {{\n    pigment {{ {} }}\n    {}\n  }}\n#end\n",
+                   "#declare {0} =\n#if (RIGC_MASK)\n"
+                   "  texture {{ pigment {{ rgb {1} }} finish {{ ambient 1 diffuse 0 }} }}\n"
+                   "#elseif (RIGC_ALBEDO)\n"
+                   "  texture {{ pigment {{ {2} }} finish {{ ambient 1 diffuse 0 }} }}\n"
+                   "#else\n  texture {{\n    pigment {{ {2} }}\n    {3}\n  }}\n#end\n",
                    material_identifier(m), is_object ? 1 : 0, pigment_text(material, m, is_object),
                    finish_text(material));
   }
@@ -368,7 +472,7 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
   for (size_t t = 0; t < studio_triangles.size(); ++t) studio_triangles[t] = static_cast<int>(t);
   append_mesh2(inc, "RigcStudio", studio.studio, studio_triangles, object_materials,
                total_materials - object_materials);
-  fmt::format_to(out, "\n#if (!RIGC_MASK)\n");
+  fmt::format_to(out, "\n#if (!RIGC_MASK & !RIGC_ALBEDO)\n");
   for (const auto& light : scene.studio.lights) fmt::format_to(out, "{}", light_text(light));
   fmt::format_to(out, "#end\n");
   if (!write_text_file(dir / "scene.inc", fmt::to_string(inc), error)) return false;
@@ -383,9 +487,11 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
     if (!write_text_file(dir / (shot.name + ".pov"), shot_pov(scene, shot, canvas, count, samples),
                          error) ||
         !write_text_file(dir / (shot.name + ".ini"),
-                         shot_ini(shot, canvas, count, samples, false, focal_blur), error) ||
+                         shot_ini(shot, canvas, count, samples, false, focal_blur, albedo_only),
+                         error) ||
         !write_text_file(dir / (shot.name + "_mask.ini"),
-                         shot_ini(shot, canvas, count, samples, true, focal_blur), error)) {
+                         shot_ini(shot, canvas, count, samples, true, focal_blur, albedo_only),
+                         error)) {
       return false;
     }
   }

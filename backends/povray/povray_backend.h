@@ -29,6 +29,9 @@ class PovrayBackend : public external::ExternalBackend {
   std::string name() const override { return "povray"; }
   std::string executable() const override { return "povray"; }
   std::string package() const override { return "povray"; }
+  // Emits shots that render the unlit albedo (every surface its own pigment at ambient 1, no
+  // lights) instead of the lit image: for the albedo agreement test.
+  bool albedo_only = false;
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
   // samples (0: defaults).

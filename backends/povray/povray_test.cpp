@@ -69,7 +69,7 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   EXPECT_NE(inc.find("#declare RigcObject = mesh2 {"), std::string::npos);
   EXPECT_NE(inc.find("uv_vectors"), std::string::npos);
   EXPECT_NE(inc.find("area_light"), std::string::npos);
-  EXPECT_NE(inc.find("bozo"), std::string::npos);  // the speckle pattern
+  EXPECT_NE(inc.find("rigc_speckle(x, y, z"), std::string::npos);  // the speckle pattern
   for (const auto& shot : scene.shots) {
     EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + ".pov")));
     EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + "_mask.ini")));

@@ -63,6 +63,16 @@ run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene
   return out;
 }
 
+dslr::LinearFrame render_albedo(const ir::Scene& scene, const scene::StudioScene& studio,
+                                const ir::Shot& shot, double scale) {
+  raster::FrameRequest request;
+  request.world_from_camera = shot.world_from_camera;
+  request.canvas = dslr::render_geometry_for(scene.camera, scale);
+  request.turntable_angle_rad = shot.turntable_angle_rad;
+  request.albedo_only = true;
+  return raster::render_frame(scene, studio, request);
+}
+
 bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& studio,
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,

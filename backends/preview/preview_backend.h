@@ -30,6 +30,11 @@ run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache = nullptr);
 
+// The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
+// lights, shadows or motion blur.
+dslr::LinearFrame render_albedo(const ir::Scene& scene, const scene::StudioScene& studio,
+                                const ir::Shot& shot, double scale);
+
 // Renders and develops one shot (no files), for tests and benchmarks. Without `keep_linear` the
 // result's linear image is left empty (what a run that writes files does).
 dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene& studio,

@@ -1,0 +1,94 @@
+#include "scene/speckle.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace rigc::scene::speckle {
+namespace {
+
+// darkness8 (float, SIMD) is the definition read in double: the hash is exact in both, so the
+// dots are the same and only rounding separates them.
+TEST(Speckle, SimdMatchesTheReferenceDefinition) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> coordinate(-300.0f, 300.0f);
+  double worst = 0;
+  int dark = 0;
+  for (int batch = 0; batch < 2000; ++batch) {
+    simd::F32x8 qx, qy, qz;
+    for (int k = 0; k < 8; ++k) {
+      qx[k] = coordinate(random);
+      qy[k] = coordinate(random);
+      qz[k] = coordinate(random);
+    }
+    const simd::F32x8 edge = simd::F32x8{} + kEdge;
+    const simd::F32x8 d = darkness8(qx, qy, qz, seed_offset(7), edge);
+    for (int k = 0; k < 8; ++k) {
+      const double want = darkness_reference(qx[k], qy[k], qz[k], seed_offset(7), kEdge);
+      worst = std::max(worst, std::abs(d[k] - want));
+      dark += want > 0.5;
+    }
+  }
+  EXPECT_LT(worst, 1e-3);
+  // About a third of the surface is dark.
+  EXPECT_GT(dark, 0.2 * 16000);
+  EXPECT_LT(dark, 0.5 * 16000);
+}
+
+// No square cells: the pattern changes as much along a cell's edge as along its diagonal.
+TEST(Speckle, IsotropicAcrossCells) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-40.0, 40.0);
+  const double step = 0.3, diagonal = step / std::sqrt(3.0);
+  double along_axis = 0, along_diagonal = 0, mean = 0;
+  constexpr int kPoints = 40000;
+  for (int i = 0; i < kPoints; ++i) {
+    const double x = coordinate(random), y = coordinate(random), z = coordinate(random);
+    const double here = darkness_reference(x, y, z, 5, kEdge);
+    mean += here;
+    along_axis += std::abs(darkness_reference(x + step, y, z, 5, kEdge) - here);
+    along_diagonal +=
+        std::abs(darkness_reference(x + diagonal, y + diagonal, z + diagonal, 5, kEdge) - here);
+  }
+  EXPECT_NEAR(along_diagonal / along_axis, 1.0, 0.05);
+  EXPECT_NEAR(mean / kPoints, kMeanDarkness, 0.02);
+}
+
+}  // namespace
+}  // namespace rigc::scene::speckle
+
+namespace rigc::scene::noise {
+namespace {
+
+// The noise pattern's SIMD form is its definition read in double (speckle.h), with smooth
+// values over [0, 1] averaging a half.
+TEST(Speckle, NoiseSimdMatchesTheReferenceDefinition) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-200.0f, 200.0f);
+  double worst = 0, mean = 0, lowest = 1, highest = 0;
+  constexpr int kBatches = 2000;
+  for (int batch = 0; batch < kBatches; ++batch) {
+    simd::F32x8 qx, qy, qz;
+    for (int k = 0; k < 8; ++k) {
+      qx[k] = coordinate(random);
+      qy[k] = coordinate(random);
+      qz[k] = coordinate(random);
+    }
+    const simd::F32x8 d = darkness8(qx, qy, qz, 11);
+    for (int k = 0; k < 8; ++k) {
+      const double want = darkness_reference(qx[k], qy[k], qz[k], 11);
+      worst = std::max(worst, std::abs(d[k] - want));
+      mean += want / (8 * kBatches);
+      lowest = std::min(lowest, want);
+      highest = std::max(highest, want);
+    }
+  }
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_NEAR(mean, kMeanDarkness, 0.02);
+  EXPECT_GE(lowest, 0);
+  EXPECT_LE(highest, 1);
+  EXPECT_GT(highest - lowest, 0.6);
+}
+
+}  // namespace
+}  // namespace rigc::scene::noise
