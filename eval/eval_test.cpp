@@ -428,6 +428,7 @@ TEST(EvalCommand, TwoViewPointsAreLeftOutOfTheMeasurement) {
 
   EvalOptions o;
   o.run_dir = run->dir.string();
+  o.scene = run->scene_file.string();
   o.output_dir = (dir.path() / "eval").string();
   o.reuse_colmap = true;
   o.quiet = true;
