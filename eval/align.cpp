@@ -263,8 +263,9 @@ class Aligner {
           "global registration found no alignment of the reconstruction to the mesh (RANSAC "
           "fitness 0: no feature correspondence agreed)");
     }
-    Similarity g = Similarity::from_matrix(*global) * pre;
-    for (auto& p : moved) p = Similarity::from_matrix(*global).apply(p);
+    const Similarity global_step = Similarity::from_matrix(*global);
+    const Similarity g = global_step * pre;
+    apply_in_place(global_step, moved);
     const IcpResult scaled = icp_similarity(moved, samples, diag_ / 50, 60);
     a_.transform = Similarity::from_matrix(scaled.transform) * g;
     a_.report = {{"method", "scale from cloud spread, FPFH + RANSAC (Open3D), ICP with scale"},
