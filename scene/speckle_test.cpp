@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace rigc::scene::speckle {
@@ -33,6 +34,37 @@ TEST(Speckle, SimdMatchesTheReferenceDefinition) {
   // About a third of the surface is dark.
   EXPECT_GT(dark, 0.2 * 16000);
   EXPECT_LT(dark, 0.5 * 16000);
+}
+
+// Eight points sharing their 2 x 2 x 2 cells (a pixel's filter samples) take a path that hashes
+// the cells once: it gives the general path's darkness, to rounding.
+TEST(Speckle, PointsInOneBlockMatchTheGeneralPath) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> corner(-300.0f, 300.0f), offset(0.5f, 1.5f);
+  const simd::F32x8 edge = simd::F32x8{} + kEdge;
+  int compared = 0;
+  for (int batch = 0; batch < 500; ++batch) {
+    const float bx = std::floor(corner(random)), by = std::floor(corner(random)),
+                bz = std::floor(corner(random));
+    simd::F32x8 qx, qy, qz;
+    for (int k = 0; k < 8; ++k) {
+      qx[k] = bx + offset(random);
+      qy[k] = by + offset(random);
+      qz[k] = bz + offset(random);
+    }
+    const simd::F32x8 one_block = darkness8(qx, qy, qz, seed_offset(7), edge);
+    // Lane 7 moved three cells away: the general path for the other seven.
+    simd::F32x8 mixed_x = qx;
+    mixed_x[7] += 3;
+    const simd::F32x8 general = darkness8(mixed_x, qy, qz, seed_offset(7), edge);
+    for (int k = 0; k < 7; ++k) {
+      ASSERT_NEAR(one_block[k], general[k], 1e-5) << "batch " << batch << " lane " << k;
+      ++compared;
+    }
+    const double want = darkness_reference(qx[7], qy[7], qz[7], seed_offset(7), kEdge);
+    EXPECT_NEAR(one_block[7], want, 1e-3);
+  }
+  EXPECT_EQ(compared, 3500);
 }
 
 // No square cells: the pattern changes as much along a cell's edge as along its diagonal.
