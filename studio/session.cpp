@@ -342,6 +342,7 @@ void Session::reload_if_changed() {
   const Outcome outcome = apply_text(text, Change::kAnything);
   file_error_ = outcome.ok ? "" : outcome.message;
   ++revision_;
+  ++reloads_;
   if (outcome.ok && before != text) undo_.push_back({before, Change::kAnything});
 }
 
@@ -410,6 +411,7 @@ nlohmann::json Session::state() {
           {"file_error", file_error_},
           {"captures", captures_},
           {"revision", revision_},
+          {"reloads", reloads_},
           {"can_undo", !undo_.empty()},
           {"shots", scene.shots.size()},
           {"camera", camera_json(scene.camera)},

@@ -173,6 +173,7 @@ class Session {
   View view_;
   int captures_ = 0;
   int revision_ = 0;  // counts the changes, so the page knows when to refresh
+  int reloads_ = 0;   // counts the file's changes on disk, which the page did not make
   // Counts the changes that make the coverage analysis start again (all but shot changes); an
   // analysis of an older generation stops at its next shot.
   std::atomic<int> analysis_generation_{0};

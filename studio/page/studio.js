@@ -584,9 +584,12 @@ async function start() {
   try { await setUpCoverageView(); } catch (e) { showStatus(`coverage view: ${e}`, true); }
   await refreshCoverage();
   scheduleAnalysis();
-  // The file may change in an editor: the server reloads it when asked for the state.
+  // The file may change in an editor: the server reloads it when asked for the state. (The
+  // page's own changes already asked for their frame and analyses.)
   setInterval(async () => {
-    if (await refreshState()) { requestFrame(FULL_WIDTH); scheduleAnalysis(); }
+    const reloads = state && state.reloads;
+    await refreshState();
+    if (state && state.reloads !== reloads) { requestFrame(FULL_WIDTH); scheduleAnalysis(); }
   }, 1000);
 }
 
