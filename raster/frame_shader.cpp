@@ -32,17 +32,17 @@ Vector3f unit(const Vector3f& x) {
 }
 
 // A texture averaged over a pixel's parallelogram uv + s du + t dv (s, t in [-1/2, 1/2]), a
-// one-pixel box filter as the reference renderers apply: a grid of up to 4 x 4 samples about
-// half a texel apart, each from the mip level that their spacing leaves (the finest while they
-// are that close).
+// one-pixel box filter as the reference renderers apply: a grid of up to 4 x 4 (max_side) samples
+// about half a texel apart, each from the mip level that their spacing leaves (the finest while
+// they are that close).
 Vector3f texture_box(const scene::MipTexture& texture, const Vector2f& uv, const Vector2f& du,
-                     const Vector2f& dv) {
+                     const Vector2f& dv, int max_side) {
   if (texture.levels.empty()) return Vector3f::Ones();
   const float size =
       static_cast<float>(std::max(texture.levels[0].width, texture.levels[0].height));
   const float texels_u = du.norm() * size, texels_v = dv.norm() * size;
-  auto side = [](float texels) {
-    return std::clamp(static_cast<int>(std::ceil(2 * texels)), 1, 4);
+  auto side = [max_side](float texels) {
+    return std::clamp(static_cast<int>(std::ceil(2 * texels)), 1, max_side);
   };
   const int nu = side(texels_u), nv = side(texels_v);
   const float spacing = std::max(texels_u / nu, texels_v / nv);
@@ -136,7 +136,7 @@ AlbedoSample FrameShader::albedo_sample_at(const ScreenTriangle& s, float px, fl
     const Vector2f uv = source.at(source.g.uvs, b);
     const Vector2f du = uv_at(px + 1, py) - uv_at(px, py);
     const Vector2f dv = uv_at(px, py + 1) - uv_at(px, py);
-    out.color = out.color.cwiseProduct(texture_box(texture, uv, du, dv));
+    out.color = out.color.cwiseProduct(texture_box(texture, uv, du, dv, texture_filter_side()));
   }
   if (out.patterned) {
     // The pixel's extent on the triangle's plane, for the pattern's box filter: a step of one
@@ -165,7 +165,8 @@ Vector3f FrameShader::albedo_at(const ScreenTriangle& s, float px, float py) con
   if (sample.patterned) {
     const scene::ShadedMaterial& material = studio_.materials[source_of(s).material()];
     float factor = 1;
-    scene::pattern_factors_box(material.pattern, &sample.pattern_at, 1, &factor);
+    scene::pattern_factors_box(material.pattern, &sample.pattern_at, 1, &factor,
+                               pattern_filter_side());
     sample.color *= factor;
   }
   return sample.color;
@@ -186,7 +187,8 @@ void FrameShader::albedo_batch(const int* tris, const int* px, const int* py, in
   // One material: either every pixel has the pattern or none does.
   const scene::ShadedMaterial& material =
       studio_.materials[source_of(screen_tris_[tris[0]]).material()];
-  scene::pattern_factors_box(material.pattern, pixels.data(), count, factor.data());
+  scene::pattern_factors_box(material.pattern, pixels.data(), count, factor.data(),
+                             pattern_filter_side());
   for (int i = 0; i < count; ++i) out[i] *= factor[i];
 }
 

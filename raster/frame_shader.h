@@ -106,6 +106,11 @@ class FrameShader {
   // Whether the shading normal at (px, py) agrees with that of `centre` (kQuadNormalCos).
   bool normal_agrees(const ScreenTriangle& s, float px, float py, const SurfacePoint& centre) const;
   AlbedoSample albedo_sample_at(const ScreenTriangle& s, float px, float py) const;
+  // The box filters' samples per pixel side: one in a draft (see FrameRequest::draft_surface).
+  int pattern_filter_side() const {
+    return request_.draft_surface ? 1 : scene::kMaxPatternFilterSide;
+  }
+  int texture_filter_side() const { return request_.draft_surface ? 1 : 4; }
   // Base colour x texture x surface pattern at (px, py) on the screen triangle.
   Vector3f albedo_at(const ScreenTriangle& s, float px, float py) const;
   // albedo_at for up to kMaxBatch pixels of one material at once (the pattern's samples are

@@ -27,6 +27,10 @@ struct FrameRequest {
   // Every surface sends its albedo (base colour x texture x pattern) as its radiance, unlit:
   // the albedo agreement test compares this with the ray tracers' emission-only renders.
   bool albedo_only = false;
+  // Textures and patterns point-sampled at each pixel's centre (trilinear mip levels; a pattern
+  // still fades to its mean where too fine) instead of box-filtered over the pixel: the
+  // studio's frames while the camera moves.
+  bool draft_surface = false;
 };
 
 struct RasterTimings {

@@ -273,13 +273,12 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
 }
 
 // Samples of the box filter per pixel side: one per kFilterSpacing of the pattern's scale that
-// the side spans, at most kMaxFilterSide (64 samples a pixel, where the pattern starts fading).
+// the side spans, at most max_side.
 constexpr float kFilterSpacing = 0.05f;
-constexpr int kMaxFilterSide = 8;
 
-int filter_side(const Vector3f& side_cells) {
+int filter_side(const Vector3f& side_cells, int max_side) {
   const float n = std::ceil(side_cells.norm() / kFilterSpacing);
-  return std::clamp(static_cast<int>(n), 1, kMaxFilterSide);
+  return std::clamp(static_cast<int>(n), 1, max_side);
 }
 
 // Point samples of a pattern collected eight at a time; each lane's clamped darkness is added to
@@ -316,7 +315,7 @@ bool has_pattern(const ir::SurfacePattern& pattern) {
 }
 
 void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
-                         float* out) {
+                         float* out, int max_side) {
   if (!has_pattern(pattern)) {
     std::fill_n(out, count, 1.0f);
     return;
@@ -332,7 +331,7 @@ void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface
     const float footprint = std::max(pixel.dx.norm(), pixel.dy.norm());
     if (pattern_resolve(scale, footprint) == 0) continue;
     const Vector3f at = pixel.at / scale, dx = pixel.dx / scale, dy = pixel.dy / scale;
-    const int nx = filter_side(dx), ny = filter_side(dy);
+    const int nx = filter_side(dx, max_side), ny = filter_side(dy, max_side);
     for (int j = 0; j < ny; ++j) {
       const float t = (j + 0.5f) / ny - 0.5f;
       for (int k = 0; k < nx; ++k) stream.add(at + ((k + 0.5f) / nx - 0.5f) * dx + t * dy, i);
@@ -342,7 +341,8 @@ void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface
   for (int i = 0; i < count; ++i) {
     const PixelOnSurface& pixel = pixels[i];
     const float resolve = pattern_resolve(scale, std::max(pixel.dx.norm(), pixel.dy.norm()));
-    const int samples = filter_side(pixel.dx / scale) * filter_side(pixel.dy / scale);
+    const int samples =
+        filter_side(pixel.dx / scale, max_side) * filter_side(pixel.dy / scale, max_side);
     const float filtered = resolve > 0 ? out[i] / samples : mean;
     out[i] = 1.0f - contrast * (resolve * filtered + (1 - resolve) * mean);
   }

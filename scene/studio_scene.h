@@ -100,9 +100,10 @@ struct PixelOnSurface {
 };
 // The pattern's factor averaged over each pixel's area on the surface, a one-pixel box filter as
 // the reference renderers apply (their pixel filter): a grid of point samples about a twentieth
-// of the pattern's scale apart (at most 8 x 8), the pattern still fading to its mean where a
-// pixel spans more than half its scale. out[i] for pixels[i], count of them.
+// of the pattern's scale apart (at most max_side x max_side), the pattern still fading to its
+// mean where a pixel spans more than half its scale. out[i] for pixels[i], count of them.
+inline constexpr int kMaxPatternFilterSide = 8;
 void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
-                         float* out);
+                         float* out, int max_side = kMaxPatternFilterSide);
 
 }  // namespace rigc::scene

@@ -167,6 +167,30 @@ TEST(Studio, PatternBoxFilterAveragesThePixelArea) {
   }
 }
 
+// A draft's box filter of one sample per side is the pattern at the pixel's centre, fading to its
+// mean as the point-sampled pattern does where the pixel spans more than half its scale.
+TEST(Studio, PatternBoxFilterOfOneSampleIsThePointFaded) {
+  ir::SurfacePattern pattern;
+  pattern.kind = ir::PatternKind::kSpeckle;
+  pattern.scale_m = 0.002;
+  pattern.contrast = 0.7;
+  std::mt19937 random(8);
+  std::uniform_real_distribution<float> coordinate(-0.05f, 0.05f), side(-0.002f, 0.002f);
+  int filtered_differs = 0;
+  for (int i = 0; i < 200; ++i) {
+    const scene::PixelOnSurface pixel{{coordinate(random), coordinate(random), coordinate(random)},
+                                      {side(random), side(random), side(random)},
+                                      {side(random), side(random), side(random)}};
+    float draft = 0, filtered = 0;
+    scene::pattern_factors_box(pattern, &pixel, 1, &draft, 1);
+    scene::pattern_factors_box(pattern, &pixel, 1, &filtered);
+    const float footprint = std::max(pixel.dx.norm(), pixel.dy.norm());
+    EXPECT_NEAR(draft, scene::pattern_factor(pattern, pixel.at, footprint), 1e-6) << i;
+    filtered_differs += std::abs(draft - filtered) > 1e-3;
+  }
+  EXPECT_GT(filtered_differs, 20);
+}
+
 // The rasterizer lets the triangles of one convex face cover a tile together (a tile with a
 // corner in none of them, or an edge crossing it, is rasterized per sample): each face must be
 // flat, and its triangles must tile a convex polygon, their areas summing to its hull's.

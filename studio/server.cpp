@@ -246,8 +246,10 @@ void StudioServer::add_page_routes() {
         return send_error(res, 400, "width must be 64..4096 pixels");
       }
     }
+    const std::string draft = req.has_param("draft") ? req.get_param_value("draft") : "0";
+    if (draft != "0" && draft != "1") return send_error(res, 400, "draft must be 0 or 1");
     std::string error;
-    const auto frame = session_.frame(std::min(1.0, width / full_width), &error);
+    const auto frame = session_.frame(std::min(1.0, width / full_width), draft == "1", &error);
     if (!frame) return send_error(res, 500, error);
     std::string bins;
     for (const int count : frame->histogram.bins)

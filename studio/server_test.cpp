@@ -42,6 +42,20 @@ class StudioApi : public StudioServerTest {
   }
 };
 
+// A draft (the frames while something moves) point-samples the surface: the same view, about
+// the same brightness, not the same pixels.
+TEST_F(StudioApi, DraftFrameIsTheViewPointSampled) {
+  const auto full = client_->Get("/api/frame?width=480");
+  const auto draft = client_->Get("/api/frame?width=480&draft=1");
+  ASSERT_TRUE(full && draft);
+  ASSERT_EQ(full->status, 200) << full->body;
+  ASSERT_EQ(draft->status, 200) << draft->body;
+  EXPECT_EQ(draft->get_header_value("X-Rigc-Reused-Render"), "0");
+  EXPECT_NE(full->body, draft->body);
+  const double full_mean = std::stod(full->get_header_value("X-Rigc-Mean"));
+  EXPECT_NEAR(std::stod(draft->get_header_value("X-Rigc-Mean")), full_mean, 0.05 * full_mean);
+}
+
 TEST_F(StudioApi, FrameIsAJpegOfTheRequestedWidthWithItsHistogram) {
   const auto res = client_->Get("/api/frame?width=320");
   ASSERT_TRUE(res);
@@ -268,6 +282,7 @@ TEST_F(StudioApi, BadRequestsGetA4xxAndTheServerStaysUp) {
   EXPECT_EQ(post("/api/lights/remove", {{"index", 99}})->status, 422);
   EXPECT_EQ(post("/api/lights/add", {{"type", "point"}, {"position: [1", "2]"}})->status, 400);
   EXPECT_EQ(client_->Get("/api/frame?width=5")->status, 400);
+  EXPECT_EQ(client_->Get("/api/frame?width=200&draft=yes")->status, 400);
   EXPECT_EQ(client_->Get("/api/nothing")->status, 404);
   EXPECT_EQ(client_->Get("/api/state")->status, 200);
 }

@@ -118,7 +118,7 @@ Outcome Session::start_reference(const ReferenceRequest& request) {
   const std::shared_ptr<const ir::Scene> view = view_scene();
   const double scale = std::min(1.0, static_cast<double>(request.width) / view->camera.width_px);
   std::string error;
-  std::optional<Frame> preview = frame(scale, &error);
+  std::optional<Frame> preview = frame(scale, false, &error);
   if (!preview) return Outcome::fail(error);
   if (!reference_->start(view, scale, std::move(preview->jpeg), request, &error)) {
     return Outcome::fail(error);
@@ -438,9 +438,10 @@ nlohmann::json Session::state() {
 // same object as long as the object, the materials, the studio and its lights do.
 bool Session::render_linear(const ir::Scene& scene,
                             const std::shared_ptr<const scene::StudioScene>& studio,
-                            const ir::Shot& shot, const run::RenderSettings& settings,
+                            const ir::Shot& shot, const run::RenderSettings& settings, bool draft,
                             std::shared_ptr<const run::RenderedShot>* rendered, bool* reused) {
   RenderCache key;
+  key.draft = draft;
   key.studio = studio;
   key.world_from_camera = shot.world_from_camera;
   key.turntable_angle_rad = shot.turntable_angle_rad;
@@ -452,7 +453,7 @@ bool Session::render_linear(const ir::Scene& scene,
     return c.studio == key.studio && c.world_from_camera == key.world_from_camera &&
            c.turntable_angle_rad == key.turntable_angle_rad &&
            c.turntable_velocity_rad_s == key.turntable_velocity_rad_s &&
-           c.shutter_s == key.shutter_s && c.subframes == key.subframes &&
+           c.shutter_s == key.shutter_s && c.subframes == key.subframes && c.draft == key.draft &&
            c.canvas.width == key.canvas.width && c.canvas.height == key.canvas.height &&
            c.canvas.fx == key.canvas.fx && c.canvas.fy == key.canvas.fy &&
            c.canvas.cx == key.canvas.cx && c.canvas.cy == key.canvas.cy;
@@ -464,7 +465,7 @@ bool Session::render_linear(const ir::Scene& scene,
     return true;
   }
   auto fresh = std::make_shared<run::RenderedShot>();
-  render_preview(scene, studio, shot, settings.scale, fresh.get());
+  render_preview(scene, studio, shot, settings.scale, draft, fresh.get());
   key.rendered = *rendered = std::move(fresh);
   render_cache_.push_front(std::move(key));
   // The live view's two sizes (moving and at rest) of the current view.
@@ -475,15 +476,16 @@ bool Session::render_linear(const ir::Scene& scene,
 // The preview's frame, with the shadow maps kept while the studio (and its lights) stays.
 void Session::render_preview(const ir::Scene& scene,
                              const std::shared_ptr<const scene::StudioScene>& studio,
-                             const ir::Shot& shot, double scale, run::RenderedShot* rendered) {
+                             const ir::Shot& shot, double scale, bool draft,
+                             run::RenderedShot* rendered) {
   if (shadow_studio_ != studio || !shadow_cache_) {
     shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
     shadow_studio_ = studio;
   }
-  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get());
+  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get(), draft);
 }
 
-std::optional<Frame> Session::frame(double scale, std::string* error) {
+std::optional<Frame> Session::frame(double scale, bool draft, std::string* error) {
   std::shared_ptr<const ir::Scene> scene;
   std::shared_ptr<const scene::StudioScene> studio;
   ir::Shot shot;
@@ -509,7 +511,7 @@ std::optional<Frame> Session::frame(double scale, std::string* error) {
   if (!settings.check(error)) return std::nullopt;
   std::shared_ptr<const run::RenderedShot> rendered;
   Frame frame;
-  if (!render_linear(*scene, studio, shot, settings, &rendered, &frame.reused_render)) {
+  if (!render_linear(*scene, studio, shot, settings, draft, &rendered, &frame.reused_render)) {
     return std::nullopt;
   }
   error->clear();

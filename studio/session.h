@@ -91,8 +91,9 @@ class Session {
   // changes); a broken one is kept as `file_error` and the last good scene stays.
   void reload_if_changed();
 
-  // The current view through the preview backend and the DSLR model; `scale` of the sensor.
-  std::optional<Frame> frame(double scale, std::string* error);
+  // The current view through the preview backend and the DSLR model; `scale` of the sensor. A
+  // `draft` point-samples the surface (the frames while the camera or a slider moves).
+  std::optional<Frame> frame(double scale, bool draft, std::string* error);
   // The coverage of the scene's shots; nullopt when the scene changed (other than in its shots)
   // while it was being analysed.
   std::optional<nlohmann::json> coverage(bool background = true);
@@ -129,6 +130,7 @@ class Session {
     double turntable_angle_rad = 0, turntable_velocity_rad_s = 0, shutter_s = 0;
     dslr::RenderGeometry canvas;
     int subframes = 1;
+    bool draft = false;
     std::shared_ptr<const run::RenderedShot> rendered;
   };
 
@@ -148,11 +150,11 @@ class Session {
                                                   bool background);
   bool render_linear(const ir::Scene& scene,
                      const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                     const run::RenderSettings& settings,
+                     const run::RenderSettings& settings, bool draft,
                      std::shared_ptr<const run::RenderedShot>* rendered, bool* reused);
   void render_preview(const ir::Scene& scene,
                       const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                      double scale, run::RenderedShot* rendered);
+                      double scale, bool draft, run::RenderedShot* rendered);
 
   std::mutex mutex_;
   // One frame at a time; beside it one coverage and one advice analysis (and plan), so that

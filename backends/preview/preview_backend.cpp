@@ -42,9 +42,10 @@ dslr::LinearFrame render_motion_blurred(const ir::Scene& scene, const scene::Stu
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
-                                raster::ShadowMapCache* shadow_cache) {
+                                raster::ShadowMapCache* shadow_cache, bool draft_surface) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   raster::FrameRequest request;
+  request.draft_surface = draft_surface;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
   request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);

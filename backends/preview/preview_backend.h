@@ -25,10 +25,12 @@ class PreviewBackend : public run::Backend {
 };
 
 // One shot in linear light, with the rasterizer's stages in stage_ms. A `shadow_cache` keeps the
-// shadow maps of a frame without motion blur for the next (raster/shadow_map_cache.h).
+// shadow maps of a frame without motion blur for the next (raster/shadow_map_cache.h); a
+// `draft_surface` point-samples textures and patterns (raster::FrameRequest::draft_surface).
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
-                                raster::ShadowMapCache* shadow_cache = nullptr);
+                                raster::ShadowMapCache* shadow_cache = nullptr,
+                                bool draft_surface = false);
 
 // The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
 // lights, shadows or motion blur.

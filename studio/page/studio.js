@@ -76,7 +76,8 @@ async function pumpFrames() {
 }
 
 async function showFrame(width) {
-  const res = await api(`api/frame?width=${width}`);
+  // The frames while something moves are drafts (the surface point-sampled).
+  const res = await api(`api/frame?width=${width}&draft=${width === MOVING_WIDTH ? 1 : 0}`);
   if (!res.ok) { showStatus((await res.json()).error, true); return; }
   const bins = res.headers.get('X-Rigc-Histogram').split(',').map(Number);
   const clipped = Number(res.headers.get('X-Rigc-Clipped'));
