@@ -56,6 +56,20 @@ TEST_F(StudioApi, DraftFrameIsTheViewPointSampled) {
   EXPECT_NEAR(std::stod(draft->get_header_value("X-Rigc-Mean")), full_mean, 0.05 * full_mean);
 }
 
+// The answers go uncompressed whatever the browser accepts: a coverage's megabyte of JSON took a
+// second to compress with Brotli, for a loopback that gains nothing from it.
+TEST_F(StudioApi, AnswersAreNotCompressed) {
+  const httplib::Headers browser = {{"Accept-Encoding", "gzip, deflate, br"}};
+  for (const char* path : {"/api/mesh", "/api/coverage", "/studio.js"}) {
+    const auto res = client_->Get(path, browser);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << path << ": " << res->body;
+    EXPECT_EQ(res->get_header_value("Content-Encoding"), "") << path;
+    EXPECT_GT(res->body.size(), 1000u) << path;
+  }
+  EXPECT_TRUE(nlohmann::json::accept(client_->Get("/api/mesh", browser)->body));
+}
+
 TEST_F(StudioApi, FrameIsAJpegOfTheRequestedWidthWithItsHistogram) {
   const auto res = client_->Get("/api/frame?width=320");
   ASSERT_TRUE(res);
