@@ -112,7 +112,7 @@ def main():
         captures, parts = bench_capture(driver, args.captures)
         print(f'capture -> coverage view updated: median {statistics.median(captures):.0f} ms, '
               f'max {max(captures):.0f} ms ({len(captures)} captures)')
-        for key in ('capture', 'coverage', 'analysis', 'draw'):
+        for key in ('capture', 'coverage', 'wait', 'analysis', 'json', 'draw'):
             values = [p[key] for p in parts if key in p]
             if values:
                 print(f'  of it {key}: median {statistics.median(values):.0f} ms')

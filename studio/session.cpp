@@ -617,13 +617,16 @@ std::optional<nlohmann::json> Session::coverage(bool background) {
     }
   } urgent{urgent_requests_, !background};
   if (!background) ++urgent_requests_;
+  const auto asked = Clock::now();
   std::lock_guard coverage_lock(coverage_mutex_);
   const auto start = Clock::now();
   const auto result = analyse(coverage_caches_, what, {}, background);
   if (!result) return std::nullopt;
   const double ms = ms_since(start);
   nlohmann::json out = coverage_json(*what.scene, *result);
+  out["wait_ms"] = std::chrono::duration<double, std::milli>(start - asked).count();
   out["analysis_ms"] = ms;
+  out["json_ms"] = ms_since(start) - ms;
   return out;
 }
 

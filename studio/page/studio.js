@@ -469,7 +469,8 @@ async function refreshCoverage(afterCapture) {
   });
   colors.needsUpdate = true;
   coverageView.render();
-  return { coverage: fetched - started, analysis: coverage.analysis_ms,
+  return { coverage: fetched - started, wait: coverage.wait_ms, analysis: coverage.analysis_ms,
+    json: coverage.json_ms,
     draw: performance.now() - fetched };
 }
 
