@@ -300,7 +300,7 @@ class Checker {
   void read_exif_text(const YAML::Node& node, ir::Camera& camera);
   void read_lens(const YAML::Node& lens, ir::Camera& camera);
   void read_lens_preset(const YAML::Node& lens, ir::Camera& camera);
-  void check_lens_limits(const YAML::Node& node, const spec::SceneSpec& scene);
+  void check_lens_limits(const YAML::Node& node, spec::SceneSpec& scene);
   void read_distortion(const YAML::Node& distortion, ir::Camera& camera);
   void read_exposure(const YAML::Node& exposure, ir::Camera& camera);
   void read_focus(const YAML::Node& focus, spec::SceneSpec& scene);
@@ -895,9 +895,11 @@ void Checker::read_lens_preset(const YAML::Node& lens, ir::Camera& camera) {
 }
 
 // The aperture and a fixed focus distance within what the preset lens can do.
-void Checker::check_lens_limits(const YAML::Node& node, const spec::SceneSpec& scene) {
+void Checker::check_lens_limits(const YAML::Node& node, spec::SceneSpec& scene) {
   if (!lens_preset_) return;
   const LensPreset& lens = *lens_preset_;
+  scene.lens_preset = lens.name;
+  scene.lens_min_focus_m = lens.min_focus_m;
   const ir::Camera& camera = scene.camera;
   const YAML::Node aperture = node["exposure"] ? node["exposure"]["aperture"] : YAML::Node();
   constexpr double kStopRounding = 0.02;  // f-numbers are written rounded (f/1.8 for f/1.78)

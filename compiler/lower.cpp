@@ -365,6 +365,11 @@ void Lowering::add_shot(ir::ShotKind kind, const Mat4& world_from_camera, double
     error(spec_.focus_auto ? loc : scene_.camera.focus_loc,
           fmt::format("{}: focus distance {:.3f} m is not beyond the focal length {:.0f} mm",
                       shot.name, shot.focus_distance_m, f * 1000));
+  } else if (spec_.focus_auto && shot.focus_distance_m < spec_.lens_min_focus_m) {
+    error(loc,
+          fmt::format("{}: the subject is {:.2f} m away, closer than the lens {} focuses "
+                      "({:g} m at the closest); step back",
+                      shot.name, shot.focus_distance_m, spec_.lens_preset, spec_.lens_min_focus_m));
   }
   const Vec3 half = (scene_.object.bounds_max_object - scene_.object.bounds_min_object) / 2;
   const Vec3 eye_in_object = shot.object_from_camera.block<3, 1>(0, 3) - object_center_;

@@ -16,9 +16,10 @@ struct Compiled {
   std::string diagnostics;
 };
 
-// A small scene with `lens`, `exposure` and `focus` lines 8, 9 and 10.
+// A small scene with `lens`, `exposure` and `focus` lines 8, 9 and 10, its shots on line 12 at
+// `distance` from the object.
 Compiled compile_with(const std::string& lens, const std::string& aperture = "f/8",
-                      const std::string& focus = "auto") {
+                      const std::string& focus = "auto", const std::string& distance = "100cm") {
   const std::string text =
       "rigc: 1\n"
       "object:\n"
@@ -37,8 +38,8 @@ Compiled compile_with(const std::string& lens, const std::string& aperture = "f/
       focus +
       "\n"
       "shots:\n"
-      "  - turntable: {steps: 4, step: 90deg, camera: {distance: 80cm, "
-      "height: 20cm}}\n";
+      "  - turntable: {steps: 4, step: 90deg, camera: {distance: " +
+      distance + ", height: 20cm}}\n";
   DiagnosticEngine diag;
   Compiled out;
   diag.set_handler([&](const Diagnostic&, const std::string& text) { out.diagnostics += text; });
@@ -126,6 +127,18 @@ TEST(LensPresets, FocusCloserThanTheLensCanIsAnErrorAtItsLine) {
             std::string::npos)
       << close.diagnostics;
   EXPECT_TRUE(compile_with("{preset: canon-ef-85mm-f1.8-usm}", "f/8", "90cm").scene);
+}
+
+// Autofocus cannot focus closer either: a shot whose subject is nearer is an error at its line.
+TEST(LensPresets, AutofocusCloserThanTheLensCanIsAnErrorAtTheShot) {
+  const Compiled close = compile_with("{preset: canon-ef-85mm-f1.8-usm}", "f/8", "auto", "80cm");
+  EXPECT_FALSE(close.scene);
+  EXPECT_NE(close.diagnostics.find("lens.yaml:12:5: error: shot_000: the subject is 0.81 m away, "
+                                   "closer than the lens canon-ef-85mm-f1.8-usm focuses (0.85 m "
+                                   "at the closest); step back"),
+            std::string::npos)
+      << close.diagnostics;
+  EXPECT_TRUE(compile_with("{preset: canon-ef-50mm-f1.8-stm}", "f/8", "auto", "80cm").scene);
 }
 
 TEST(LensPresets, UnknownPresetSaysWhichAreKnown) {

@@ -103,6 +103,9 @@ struct SceneSpec {
   ir::Camera camera;  // intrinsics not yet computed
   bool focus_auto = true;
   double focus_distance_m = 1;
+  // The lens preset's closest focus, which `focus: auto` cannot go under; 0 without a preset.
+  std::string lens_preset;
+  double lens_min_focus_m = 0;
   std::vector<ShotGroupSpec> shots;
   ir::CoverageSettings coverage;
 };
