@@ -6,6 +6,7 @@
 #include <iostream>
 #include <thread>
 
+#include "assets/model_cache.h"
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
@@ -44,6 +45,8 @@ int run_studio_command(std::vector<std::string> args) {
   // Before any thread starts (the compiler's and the renderer's workers inherit the mask).
   const sigset_t signals = block_stop_signals();
 
+  // Each camera move and setting is a compile of the scene: its mesh is loaded once.
+  keep_loaded_models(true);
   std::string error;
   const auto session = studio::Session::open(scene_path, &error, run_folder);
   if (!session) {

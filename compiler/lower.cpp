@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "assets/mesh_io.h"
+#include "assets/model_cache.h"
 #include "assets/primitives.h"
 #include "compiler/check.h"
 #include "compiler/frontend.h"
@@ -144,13 +145,13 @@ bool Lowering::load_mesh(Eigen::Matrix3d* up) {
   if (!object.mesh_path) {
     auto kind = primitive_from_name(object.primitive->value);
     out.source = "primitive:" + object.primitive->value;
-    out.mesh = make_primitive(*kind, object.primitive_detail, object.primitive_seed);
+    out.mesh = make_primitive_cached(*kind, object.primitive_detail, object.primitive_seed);
     scene_.materials.push_back(ir::Material{});
     scene_.materials.back().name = object.primitive->value;
     return true;
   }
   std::string why;
-  auto model = load_model(object.mesh_path_resolved, &why);
+  auto model = load_model_cached(object.mesh_path_resolved, &why);
   if (!model) {
     error(object.mesh_path->loc, fmt::format("cannot load mesh: {}", why));
     return false;
