@@ -120,6 +120,7 @@ StudioServer::StudioServer(Session& session, ServerOptions options)
     : session_(session), options_(std::move(options)), server_(new httplib::Server()) {
   if (options_.token.empty()) options_.token = random_token();
   server_->set_payload_max_length(1 << 20);
+  server_->set_tcp_nodelay(true);
   add_routes();
 }
 
