@@ -361,5 +361,30 @@ TEST_F(StudioApi, AdviceComesAtTheScenesLines) {
   EXPECT_TRUE(exposure_line) << advice.dump(1);
 }
 
+// Advice given for a scene is given again when the scene comes back, and only then: a setting
+// turned away and back brings its warnings and takes them away again.
+TEST_F(StudioApi, AdviceFollowsASettingTurnedBackAndForth) {
+  const auto advice_text = [&] {
+    std::string messages;
+    for (const auto& d : nlohmann::json::parse(client_->Get("/api/advice")->body)) {
+      messages += d["message"].get<std::string>() + "\n";
+    }
+    return messages;
+  };
+  const std::string shutter = state()["camera"]["shutter_s"].dump() + "s";
+  const std::string before = advice_text();
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.shutter"}, {"value", "2s"}})->status, 200);
+  const std::string slow = advice_text();
+  EXPECT_NE(slow, before);
+  for (int round = 0; round < 2; ++round) {
+    ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.shutter"}, {"value", shutter}})->status,
+              200);
+    EXPECT_EQ(advice_text(), before) << "round " << round;
+    ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.shutter"}, {"value", "2s"}})->status,
+              200);
+    EXPECT_EQ(advice_text(), slow) << "round " << round;
+  }
+}
+
 }  // namespace
 }  // namespace rigc::studio

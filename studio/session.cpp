@@ -651,8 +651,12 @@ std::optional<nlohmann::json> Session::advice() {
   const Analysed what = analysed();
   std::shared_ptr<const ir::Scene> scene = what.scene;
   std::lock_guard analysis_lock(analysis_mutex_);
+  const std::string text = text_snapshot(scene);
+  for (const auto& [given_for, given] : advice_given_) {
+    if (!text.empty() && given_for == text) return given;
+  }
   DiagnosticEngine diag;
-  diag.add_source(file_.string(), text_snapshot(scene));
+  diag.add_source(file_.string(), text);
   nlohmann::json out = nlohmann::json::array();
   diag.set_handler([&](const Diagnostic& d, const std::string& rendered) {
     out.push_back({{"line", d.loc.line},
@@ -666,6 +670,10 @@ std::optional<nlohmann::json> Session::advice() {
   const auto coverage = analyse(advice_caches_, what, options, true);
   if (!coverage) return std::nullopt;
   analysis::report_capture_advice(*scene, *what.studio, *coverage, diag);
+  if (!text.empty()) {
+    advice_given_.emplace_front(text, out);
+    if (advice_given_.size() > kKeptAnalyses) advice_given_.pop_back();
+  }
   return out;
 }
 

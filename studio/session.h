@@ -184,8 +184,10 @@ class Session {
   std::atomic<int> urgent_requests_{0};          // captures waiting for their coverage
   std::deque<AnalysisCache> coverage_caches_;    // under coverage_mutex_, newest first
   std::deque<AnalysisCache> advice_caches_;      // under analysis_mutex_, newest first
-  std::deque<RenderCache> render_cache_;         // under render_mutex_, newest first
-  LiveDevelop live_develop_;                     // under render_mutex_
+  // The advice given for the last scene texts (a setting turned back and forth), newest first.
+  std::deque<std::pair<std::string, nlohmann::json>> advice_given_;  // under analysis_mutex_
+  std::deque<RenderCache> render_cache_;  // under render_mutex_, newest first
+  LiveDevelop live_develop_;              // under render_mutex_
   // Shadow maps of shadow_studio_'s lights, kept while the camera moves (under render_mutex_).
   std::shared_ptr<const scene::StudioScene> shadow_studio_;
   std::unique_ptr<raster::ShadowMapCache> shadow_cache_;
