@@ -462,13 +462,21 @@ async function refreshCoverage(afterCapture) {
   table.scrollTop = table.scrollHeight;  // the latest shots
   window.rigcCoverage = coverage;
   if (!coverageView.geometry) return {};
-  const colors = coverageView.geometry.attributes.color;
-  coverage.views.forEach((views, f) => {
-    const c = PAPER[Math.min(2, views)];
-    for (let k = 0; k < 3; ++k) colors.setXYZ(3 * f + k, c[0], c[1], c[2]);
-  });
-  colors.needsUpdate = true;
-  coverageView.render();
+  // The 3D view is drawn again only when a face changed colour (a software WebGL takes a core
+  // for a while to draw it).
+  const drawn = coverageView.views;
+  const same = drawn && drawn.length === coverage.views.length &&
+    coverage.views.every((views, f) => Math.min(2, views) === Math.min(2, drawn[f]));
+  if (!same) {
+    const colors = coverageView.geometry.attributes.color;
+    coverage.views.forEach((views, f) => {
+      const c = PAPER[Math.min(2, views)];
+      for (let k = 0; k < 3; ++k) colors.setXYZ(3 * f + k, c[0], c[1], c[2]);
+    });
+    colors.needsUpdate = true;
+    coverageView.views = coverage.views;
+    coverageView.render();
+  }
   return { coverage: fetched - started, wait: coverage.wait_ms, analysis: coverage.analysis_ms,
     json: coverage.json_ms,
     draw: performance.now() - fetched };
