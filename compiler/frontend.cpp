@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <tuple>
 
 #include "compiler/check.h"
 #include "compiler/limits.h"
+#include "io/file_status.h"
 
 namespace rigc {
 
@@ -36,31 +36,9 @@ std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::
   return lower_scene(*checked, diag);
 }
 
-namespace {
-
-// Why the scene file at `path` cannot be read: missing, a folder, a symlink loop, not a regular
-// file, or the system's reason (permission).
-std::string why_unreadable(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec == std::errc::too_many_symbolic_link_levels) return "it is a loop of symbolic links";
-  if (ec && ec != std::errc::no_such_file_or_directory) return ec.message();
-  if (!fs::exists(status)) {
-    return fs::is_symlink(fs::symlink_status(path, ec)) ? "it is a symbolic link to nothing"
-                                                        : "it does not exist";
-  }
-  if (fs::is_directory(status)) return "it is a folder";
-  if (!fs::is_regular_file(status)) return "it is not a regular file";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::generic_category().message(errno);
-  return "";
-}
-
-}  // namespace
-
 std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag) {
-  if (const std::string why = why_unreadable(path); !why.empty()) {
-    diag.error({path, 0, 0}, fmt::format("cannot read the scene file: {}", why));
+  if (const std::string why = why_not_readable(path); !why.empty()) {
+    diag.error({path, 0, 0}, fmt::format("cannot read the scene file: it {}", why));
     return std::nullopt;
   }
   std::ifstream in(path, std::ios::binary);
