@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 namespace rigc::scene::speckle {
 
@@ -30,84 +31,110 @@ F32x8 smoothstep01(F32x8 t) {
   return t * t * (3 - 2 * t);
 }
 
-// The darkest of the cell's dots at offset (dx, dy, dz) from its corner.
-F32x8 cell_darkness(F32x8 dx, F32x8 dy, F32x8 dz, F32x8 hash, F32x8 edge) {
+// Cells with integer coordinates, eight a group (a cell a lane); the last group's spare lanes
+// repeat its last cell.
+struct Cells {
+  static constexpr int kMostGroups = 4;  // 27 cells: three an axis
+  std::array<F32x8, kMostGroups> x{}, y{}, z{};
+  int groups = 0;
+};
+
+// The n[0] x n[1] x n[2] cells from `first` on, n at most 3 an axis.
+Cells cells_from(const std::array<float, 3>& first, const std::array<int, 3>& n) {
+  Cells cells;
+  int lane = 0;
+  for (int k = 0; k < n[2]; ++k) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int i = 0; i < n[0]; ++i) {
+        if (lane == 0) ++cells.groups;
+        const int g = cells.groups - 1;
+        cells.x[g][lane] = first[0] + static_cast<float>(i);
+        cells.y[g][lane] = first[1] + static_cast<float>(j);
+        cells.z[g][lane] = first[2] + static_cast<float>(k);
+        lane = (lane + 1) % 8;
+      }
+    }
+  }
+  for (const int g = cells.groups - 1; lane != 0 && lane < 8; ++lane) {
+    cells.x[g][lane] = cells.x[g][lane - 1];
+    cells.y[g][lane] = cells.y[g][lane - 1];
+    cells.z[g][lane] = cells.z[g][lane - 1];
+  }
+  return cells;
+}
+
+// The darkest of the dots of `cells` at eight points (a point a lane), for one edge half-width.
+// Each dot's darkness at a point comes from the same operations whichever other cells and points
+// the call holds, and a dot of a cell outside a point's own 2 x 2 x 2 lies more than half a cell
+// away, beyond its reach (radius + edge <= 0.48): a lane's result is its point's alone.
+F32x8 darkness_among(F32x8 qx, F32x8 qy, F32x8 qz, const Cells& cells, float seed_offset,
+                     float edge) {
   F32x8 darkness{};
-  for (const float start : kDotStarts) {
-    const F32x8 g1 = perm(hash + start);
-    const F32x8 g2 = perm(g1 + 1);
-    const F32x8 g3 = perm(g2 + 1);
-    const F32x8 g4 = perm(g3 + 1);
-    const F32x8 ex = dx - g1 * (1 / kPrime), ey = dy - g2 * (1 / kPrime),
-                ez = dz - g3 * (1 / kPrime);
-    const F32x8 dist = simd::sqrt(ex * ex + ey * ey + ez * ez);
-    const F32x8 radius = kRadiusMin + g4 * (kRadiusSpan / (kPrime - 1));
-    // A dot ends within half a cell of its centre (see speckle.h).
-    const F32x8 room = 0.5f - radius;
-    const F32x8 w = edge < room ? edge : room;
-    const F32x8 dot = smoothstep01((radius + w - dist) / (2 * w));
-    darkness = dot > darkness ? dot : darkness;
+  for (int g = 0; g < cells.groups; ++g) {
+    const F32x8 hx = perm(mod289(cells.x[g]) + seed_offset);
+    const F32x8 hy = perm(hx + mod289(cells.y[g]));
+    const F32x8 hash = perm(hy + mod289(cells.z[g]));
+    std::array<F32x8, kDotsPerCell> gx, gy, gz, radius;
+    for (int dot = 0; dot < kDotsPerCell; ++dot) {
+      const F32x8 g1 = perm(hash + kDotStarts[dot]);
+      const F32x8 g2 = perm(g1 + 1);
+      const F32x8 g3 = perm(g2 + 1);
+      const F32x8 g4 = perm(g3 + 1);
+      gx[dot] = g1 * (1 / kPrime);
+      gy[dot] = g2 * (1 / kPrime);
+      gz[dot] = g3 * (1 / kPrime);
+      radius[dot] = kRadiusMin + g4 * (kRadiusSpan / (kPrime - 1));
+    }
+    for (int c = 0; c < 8; ++c) {
+      const F32x8 dx = qx - cells.x[g][c], dy = qy - cells.y[g][c], dz = qz - cells.z[g][c];
+      for (int dot = 0; dot < kDotsPerCell; ++dot) {
+        const F32x8 ex = dx - gx[dot][c], ey = dy - gy[dot][c], ez = dz - gz[dot][c];
+        const F32x8 squared = ex * ex + ey * ey + ez * ez;
+        const float r = radius[dot][c];
+        const float w = std::min(edge, 0.5f - r);
+        // Most dots reach none of the points: their darkness there is 0.
+        if (!simd::any(squared < (r + w) * (r + w))) continue;
+        const F32x8 value = smoothstep01((r + w - simd::sqrt(squared)) * (0.5f / w));
+        darkness = value > darkness ? value : darkness;
+      }
+    }
   }
   return darkness;
 }
 
-// darkness8 where every lane's point has the same 2 x 2 x 2 cells and edge (a pixel's filter
-// samples, as a rule): the cells' hashes and dots are computed once, a cell a lane, then each
-// dot's darkness at the eight points where it reaches one.
-F32x8 darkness8_one_block(F32x8 qx, F32x8 qy, F32x8 qz, float bx, float by, float bz,
-                          float seed_offset, float edge) {
-  const F32x8 cell_i = {0, 1, 0, 1, 0, 1, 0, 1}, cell_j = {0, 0, 1, 1, 0, 0, 1, 1},
-              cell_k = {0, 0, 0, 0, 1, 1, 1, 1};
-  const F32x8 hx = perm(mod289(mod289(F32x8{} + bx) + cell_i) + seed_offset);
-  const F32x8 hy = perm(hx + mod289(mod289(F32x8{} + by) + cell_j));
-  const F32x8 hash = perm(hy + mod289(mod289(F32x8{} + bz) + cell_k));
-  std::array<F32x8, kDotsPerCell> gx, gy, gz, radius;
-  for (int dot = 0; dot < kDotsPerCell; ++dot) {
-    const F32x8 g1 = perm(hash + kDotStarts[dot]);
-    const F32x8 g2 = perm(g1 + 1);
-    const F32x8 g3 = perm(g2 + 1);
-    const F32x8 g4 = perm(g3 + 1);
-    gx[dot] = g1 * (1 / kPrime);
-    gy[dot] = g2 * (1 / kPrime);
-    gz[dot] = g3 * (1 / kPrime);
-    radius[dot] = kRadiusMin + g4 * (kRadiusSpan / (kPrime - 1));
+// The lowest value of `v`'s lanes and how many cells from it its 2 x 2 x 2 blocks span.
+std::pair<float, int> block_span(F32x8 v) {
+  float low = v[0], high = v[0];
+  for (int k = 1; k < 8; ++k) {
+    low = std::min(low, v[k]);
+    high = std::max(high, v[k]);
   }
-  F32x8 darkness{};
-  for (int c = 0; c < 8; ++c) {
-    const F32x8 dx = qx - (bx + cell_i[c]), dy = qy - (by + cell_j[c]), dz = qz - (bz + cell_k[c]);
-    for (int dot = 0; dot < kDotsPerCell; ++dot) {
-      const F32x8 ex = dx - gx[dot][c], ey = dy - gy[dot][c], ez = dz - gz[dot][c];
-      const F32x8 squared = ex * ex + ey * ey + ez * ez;
-      const float r = radius[dot][c];
-      const float w = std::min(edge, 0.5f - r);
-      // Most dots reach none of the points: their darkness there is 0.
-      if (!simd::any(squared < (r + w) * (r + w))) continue;
-      const F32x8 value = smoothstep01((r + w - simd::sqrt(squared)) * (0.5f / w));
-      darkness = value > darkness ? value : darkness;
-    }
-  }
-  return darkness;
+  return {low, static_cast<int>(high - low) + 2};
 }
 
 }  // namespace
 
 F32x8 darkness8(F32x8 qx, F32x8 qy, F32x8 qz, float seed_offset, F32x8 edge) {
   const F32x8 bx = simd::floor(qx - 0.5f), by = simd::floor(qy - 0.5f), bz = simd::floor(qz - 0.5f);
-  if (!simd::any((bx != bx[0]) | (by != by[0]) | (bz != bz[0]) | (edge != edge[0]))) {
-    return darkness8_one_block(qx, qy, qz, bx[0], by[0], bz[0], seed_offset, edge[0]);
+  // Points close together (a pixel's filter samples, as a rule): their cells' dots drawn once.
+  const auto [x0, nx] = block_span(bx);
+  const auto [y0, ny] = block_span(by);
+  const auto [z0, nz] = block_span(bz);
+  if (nx <= 3 && ny <= 3 && nz <= 3 && !simd::any(edge != edge[0])) {
+    return darkness_among(qx, qy, qz, cells_from({x0, y0, z0}, {nx, ny, nz}), seed_offset, edge[0]);
   }
-  const F32x8 wx = mod289(bx), wy = mod289(by), wz = mod289(bz);
+  // Otherwise each lane's own 2 x 2 x 2 cells in turn, shared with the lanes of the same cells.
   F32x8 darkness{};
-  for (int i = 0; i < 2; ++i) {
-    const F32x8 hx = perm(mod289(wx + static_cast<float>(i)) + seed_offset);
-    for (int j = 0; j < 2; ++j) {
-      const F32x8 hy = perm(hx + mod289(wy + static_cast<float>(j)));
-      for (int k = 0; k < 2; ++k) {
-        const F32x8 hash = perm(hy + mod289(wz + static_cast<float>(k)));
-        const F32x8 cell =
-            cell_darkness(qx - (bx + static_cast<float>(i)), qy - (by + static_cast<float>(j)),
-                          qz - (bz + static_cast<float>(k)), hash, edge);
-        darkness = cell > darkness ? cell : darkness;
+  unsigned done = 0;
+  for (int k = 0; k < 8; ++k) {
+    if (done >> k & 1u) continue;
+    const F32x8 value = darkness_among(qx, qy, qz, cells_from({bx[k], by[k], bz[k]}, {2, 2, 2}),
+                                       seed_offset, edge[k]);
+    for (int m = k; m < 8; ++m) {
+      if (!(done >> m & 1u) && bx[m] == bx[k] && by[m] == by[k] && bz[m] == bz[k] &&
+          edge[m] == edge[k]) {
+        darkness[m] = value[m];
+        done |= 1u << m;
       }
     }
   }
