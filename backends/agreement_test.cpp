@@ -227,7 +227,15 @@ double relative_difference(const dslr::LinearFrame& a, const dslr::LinearFrame& 
 }
 
 // The albedo renders as 8-bit sRGB PNGs in `dir`, to look at (RIGC_KEEP_ALBEDO=dir).
-void save_albedos(const std::vector<Rendered>& all, const fs::path& dir) {
+void save_albedos(const std::vector<Rendered>& all, const std::vector<std::uint8_t>& common,
+                  const fs::path& dir) {
+  const std::string mask_path = (dir / "common_mask.png").string();
+  auto mask_out = OIIO::ImageOutput::create(mask_path);
+  ASSERT_TRUE(mask_out &&
+              mask_out->open(mask_path, OIIO::ImageSpec(all[0].frame.width, all[0].frame.height, 1,
+                                                        OIIO::TypeDesc::UINT8)));
+  mask_out->write_image(OIIO::TypeDesc::UINT8, common.data());
+  mask_out->close();
   for (const Rendered& r : all) {
     const dslr::LinearFrame& f = r.frame;
     std::vector<std::uint8_t> pixels(f.rgb.size());
@@ -242,6 +250,13 @@ void save_albedos(const std::vector<Rendered>& all, const fs::path& dir) {
                 out->open(path, OIIO::ImageSpec(f.width, f.height, 3, OIIO::TypeDesc::UINT8)));
     out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
     out->close();
+    // The linear values too, to difference (oiiotool --absdiff).
+    const std::string exr = (dir / (r.backend + "_albedo.exr")).string();
+    auto linear = OIIO::ImageOutput::create(exr);
+    ASSERT_TRUE(linear &&
+                linear->open(exr, OIIO::ImageSpec(f.width, f.height, 3, OIIO::TypeDesc::FLOAT)));
+    linear->write_image(OIIO::TypeDesc::FLOAT, f.rgb.data());
+    linear->close();
   }
 }
 
@@ -273,8 +288,11 @@ void expect_same_albedo(ir::Scene scene, int shot_index, double scale, double cy
   for (size_t i = 1; i < all.size(); ++i) {
     for (float& v : all[i].frame.rgb) v /= static_cast<float>(external::kCandelaPerBlenderUnit);
   }
-  if (const char* keep = std::getenv("RIGC_KEEP_ALBEDO")) save_albedos(all, keep);
   const std::vector<std::uint8_t> common = eroded_common_mask(all);
+  if (const char* keep = std::getenv("RIGC_KEEP_ALBEDO")) {
+    save_albedos(all, common, keep);
+    fs::copy(dir.path(), keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  }
   const double pixels = std::count(common.begin(), common.end(), 255);
   EXPECT_GT(pixels, 2000);
   for (size_t i = 0; i < all.size(); ++i) {
