@@ -262,8 +262,8 @@ void save_albedos(const std::vector<Rendered>& all, const std::vector<std::uint8
 
 // The unlit albedo of one shot from each backend (the preview's albedo_only frame, POV-Ray's
 // and Cycles' emission-only renders) agrees pixel by pixel on the object: one surface in every
-// renderer. Cycles' albedo is not yet within 2 % of the other two (issue #34 is open on it):
-// pairs with Cycles are held to `cycles_limit`, what holds now, so that they cannot get worse.
+// renderer. Cycles' albedo is not yet within 2 % of the preview's (issue #34 is open on it): pairs
+// with Cycles are held to `cycles_limit`, what holds now, so that they cannot get worse.
 void expect_same_albedo(ir::Scene scene, int shot_index, double scale, double cycles_limit = 0.02) {
   RIGC_REQUIRE_TOOL(renderers_installed(), "povray or blender");
   scene.camera.effects.depth_of_field = false;
@@ -329,10 +329,13 @@ TEST(ReferenceAgreement, NoisePatternAlbedo) {
   expect_same_albedo(scene, 2, 0.125);
 }
 
-// A photographed texture over a mesh's UV atlas, at about a texel a pixel.
+// A photographed texture over a mesh's UV atlas, at about a texel a pixel. Cycles reads the
+// texture in linear light as the others do (an 8-bit sRGB one made it 2.8 % darker overall); what
+// remains against the preview is mostly at the object's own occluding edges (the head over the
+// body), which the preview resolves differently, and Cycles' sampling noise.
 TEST(ReferenceAgreement, TexturedSceneAlbedo) {
   const ir::Scene scene = compile_file("scenes/spot-turntable.yaml");
-  expect_same_albedo(scene, 2, 0.125, 0.075);
+  expect_same_albedo(scene, 2, 0.125, 0.035);
 }
 
 // 10 %-90 % width in pixels of the left silhouette edge of a bright box on black, averaged over
