@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
+#include "dslr/image_io.h"
 #include "dslr/lens.h"
 #include "io/files.h"
 #include "scene/speckle.h"
@@ -85,6 +87,29 @@ json light_json(const ir::Light& light, int index) {
 
 std::string texture_file_name(int texture) {
   return fmt::format("texture_{}.png", texture);
+}
+
+// The texture's colour in linear light, as a 16-bit RGB PNG the script reads as Non-Color data.
+// Cycles keeps an 8-bit sRGB image in its code values and decodes after interpolating, so its
+// bilinear blend between texels would be a blend of sRGB codes: darker than the blend of light
+// that the preview and POV-Ray compute (docs/surface-functions.md). Alpha is dropped, as the
+// preview ignores it.
+bool write_linear_texture(const fs::path& path, const ir::Texture& texture, std::string* error) {
+  std::array<std::uint16_t, 256> decode{};
+  for (int i = 0; i < 256; ++i) {
+    const double c = i / 255.0;
+    const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    decode[i] = static_cast<std::uint16_t>(std::lround(linear * 65535));
+  }
+  const size_t texels = static_cast<size_t>(texture.width) * texture.height;
+  std::vector<std::uint16_t> pixels(texels * 3);
+  for (size_t i = 0; i < texels; ++i) {
+    const std::uint8_t* px = &texture.pixels[i * texture.channels];
+    for (int c = 0; c < 3; ++c) pixels[i * 3 + c] = decode[px[texture.channels >= 3 ? c : 0]];
+  }
+  OIIO::ImageSpec spec(texture.width, texture.height, 3, OIIO::TypeDesc::UINT16);
+  spec.attribute("oiio:ColorSpace", "Linear");
+  return dslr::write_pixels(path, spec, pixels.data(), error);
 }
 
 json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material, int index,
@@ -222,8 +247,8 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                    {"amplitude_sum", nz::kAmplitudeSum}};
   data["albedo_only"] = albedo_only;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
-    if (!external::write_texture_png(dir / texture_file_name(static_cast<int>(t)),
-                                     scene.textures[t], error)) {
+    if (!write_linear_texture(dir / texture_file_name(static_cast<int>(t)), scene.textures[t],
+                              error)) {
       return false;
     }
   }
