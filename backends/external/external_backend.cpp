@@ -46,12 +46,6 @@ bool read_linear_image(const fs::path& path, LinearImage* image, std::string* er
   return true;
 }
 
-bool write_texture_png(const fs::path& path, const ir::Texture& texture, std::string* error) {
-  const OIIO::ImageSpec spec(texture.width, texture.height, texture.channels,
-                             OIIO::TypeDesc::UINT8);
-  return dslr::write_pixels(path, spec, texture.pixels.data(), error);
-}
-
 bool prepare_emit_folder(const ir::Scene& scene, const fs::path& dir,
                          const run::RenderSettings& settings, std::string* error) {
   if (!settings.check(error)) return false;

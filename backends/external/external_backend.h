@@ -48,10 +48,6 @@ struct LinearImage {
 };
 bool read_linear_image(const std::filesystem::path& path, LinearImage* image, std::string* error);
 
-// Writes a texture's pixels (8-bit, sRGB) as a PNG, atomically enough for emitting.
-bool write_texture_png(const std::filesystem::path& path, const ir::Texture& texture,
-                       std::string* error);
-
 // The light a renderer's file holds per unit: both POV-Ray and Cycles write Blender's
 // radiometric units, in which 1 W/(m²·sr) of linear Y is ir::kLumensPerWatt cd/m².
 inline constexpr double kCandelaPerBlenderUnit = ir::kLumensPerWatt;
