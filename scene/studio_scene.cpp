@@ -243,6 +243,20 @@ simd::F32x8 pattern_darkness8(const ir::SurfacePattern& pattern, simd::F32x8 qx,
   return darkness;
 }
 
+// What the point-sampled and the box-filtered pattern share: its scale, and the factor of a
+// darkness (in [0, 1]) seen with a footprint, fading to the pattern's mean as it gets too fine.
+struct PatternFade {
+  explicit PatternFade(const ir::SurfacePattern& pattern)
+      : scale(static_cast<float>(pattern.scale_m)),
+        contrast(static_cast<float>(pattern.contrast)),
+        mean(mean_darkness(pattern)) {}
+  float factor(float darkness, float footprint_m) const {
+    const float resolve = pattern_resolve(scale, footprint_m);
+    return 1.0f - contrast * (resolve * darkness + (1 - resolve) * mean);
+  }
+  float scale, contrast, mean;
+};
+
 // pattern_factors with point i's footprint footprint_of(i).
 template <typename FootprintOf>
 void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, const float* y,
@@ -252,9 +266,8 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
     std::fill_n(out, count, 1.0f);
     return;
   }
-  const float scale = static_cast<float>(pattern.scale_m);
-  const float contrast = static_cast<float>(pattern.contrast);
-  const float mean = mean_darkness(pattern);
+  const PatternFade fade(pattern);
+  const float scale = fade.scale;
   for (int first = 0; first < count; first += 8) {
     const int lanes = std::min(8, count - first);
     F32x8 qx{}, qy{}, qz{};
@@ -265,9 +278,7 @@ void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, con
     }
     const F32x8 darkness = pattern_darkness8(pattern, qx, qy, qz, lanes);
     for (int k = 0; k < lanes; ++k) {
-      const float resolve = pattern_resolve(scale, footprint_of(first + k));
-      const float d = resolve * std::clamp(darkness[k], 0.0f, 1.0f) + (1 - resolve) * mean;
-      out[first + k] = 1.0f - contrast * d;
+      out[first + k] = fade.factor(std::clamp(darkness[k], 0.0f, 1.0f), footprint_of(first + k));
     }
   }
 }
@@ -320,9 +331,8 @@ void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface
     std::fill_n(out, count, 1.0f);
     return;
   }
-  const float scale = static_cast<float>(pattern.scale_m);
-  const float contrast = static_cast<float>(pattern.contrast);
-  const float mean = mean_darkness(pattern);
+  const PatternFade fade(pattern);
+  const float scale = fade.scale;
   // out[i] first sums pixel i's sample darknesses, in units of the pattern's scale.
   std::fill_n(out, count, 0.0f);
   SampleStream stream(pattern, out);
@@ -338,13 +348,12 @@ void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface
     }
   }
   stream.flush();
+  // An unresolved pixel took no samples: its sum of 0 is faded away to the mean entirely.
   for (int i = 0; i < count; ++i) {
     const PixelOnSurface& pixel = pixels[i];
-    const float resolve = pattern_resolve(scale, std::max(pixel.dx.norm(), pixel.dy.norm()));
     const int samples =
         filter_side(pixel.dx / scale, max_side) * filter_side(pixel.dy / scale, max_side);
-    const float filtered = resolve > 0 ? out[i] / samples : mean;
-    out[i] = 1.0f - contrast * (resolve * filtered + (1 - resolve) * mean);
+    out[i] = fade.factor(out[i] / samples, std::max(pixel.dx.norm(), pixel.dy.norm()));
   }
 }
 
