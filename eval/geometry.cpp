@@ -551,7 +551,8 @@ IcpResult icp_similarity(const std::vector<Vec3>& source, const std::vector<Vec3
 }
 
 std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
-                                        const std::vector<Vec3>& target, double voxel_size) {
+                                        const std::vector<Vec3>& target, double voxel_size,
+                                        unsigned seed) {
   quiet_open3d();
   namespace reg = o3d::pipelines::registration;
   auto src = to_cloud(source).VoxelDownSample(voxel_size);
@@ -566,7 +567,7 @@ std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
   const double distance = 1.5 * voxel_size;
   reg::CorrespondenceCheckerBasedOnEdgeLength edge(0.9);
   reg::CorrespondenceCheckerBasedOnDistance dist(distance);
-  o3d::utility::random::Seed(1);
+  o3d::utility::random::Seed(static_cast<int>(seed));
   const reg::RegistrationResult r = reg::RegistrationRANSACBasedOnFeatureMatching(
       *src, *tgt, *src_fpfh, *tgt_fpfh, true, distance,
       reg::TransformationEstimationPointToPoint(false), 3, {edge, dist},

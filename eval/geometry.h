@@ -119,9 +119,11 @@ IcpResult icp_similarity(const std::vector<Vec3>& source, const std::vector<Vec3
                          double max_correspondence_distance, int max_iterations = 50);
 
 // Global registration for clouds in unknown relative pose (same scale): FPFH features and RANSAC
-// on voxel-downsampled copies. Returns the rigid transform applied to `source`.
+// on voxel-downsampled copies, RANSAC's samples drawn from `seed`. Returns the rigid transform
+// applied to `source`.
 std::optional<Mat4> global_registration(const std::vector<Vec3>& source,
-                                        const std::vector<Vec3>& target, double voxel_size);
+                                        const std::vector<Vec3>& target, double voxel_size,
+                                        unsigned seed = 1);
 
 // For every query point, the distance to the nearest point of `cloud` (KD-tree; parallel).
 std::vector<double> nearest_distances(const std::vector<Vec3>& queries,

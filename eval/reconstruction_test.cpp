@@ -141,6 +141,17 @@ TEST(EvalReconstruction, MovedNoisyMeshIsRegisteredBackWithoutCameras) {
   EXPECT_LT(move_m, 0.1e-3);
   EXPECT_LT(turn_deg, 0.1);
   EXPECT_NEAR(s.std_mm, kSigma * 1000, 0.1 * kSigma * 1000) << s.report["signed_distance_mm"];
+  // Every RANSAC start was refined and scored; the one kept lies closest to the surface.
+  const auto& alignment = s.report["alignment"];
+  ASSERT_EQ(alignment["starts"].size(), 4u) << alignment;
+  double chosen = 0;
+  for (const auto& start : alignment["starts"]) {
+    if (start["seed"] == alignment["chosen_seed"]) chosen = start["clipped_mean_distance_mm"];
+  }
+  for (const auto& start : alignment["starts"]) {
+    EXPECT_LE(chosen, start["clipped_mean_distance_mm"].get<double>()) << alignment;
+  }
+  EXPECT_LT(chosen, 3 * kSigma * 1000) << alignment;
 }
 
 // A cloud of another object (a box where the statue should be) registers poorly: refused, with
