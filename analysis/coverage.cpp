@@ -10,6 +10,7 @@
 #include <numbers>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
@@ -121,11 +122,11 @@ std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene&
 }
 
 // One shot as the analysis needs it: the camera and the turntable in the object frame, and what
-// the camera sees (a visibility buffer at the reduced canvas).
+// the camera sees (from a visibility buffer at the reduced canvas).
 struct ShotView {
   int index = 0;
   const ir::Shot* shot = nullptr;
-  raster::VisibilityBuffer buffer;
+  std::shared_ptr<const ShotVisibility> visibility;
   Eigen::Matrix3d camera_rotation;  // camera_from_object
   Vector3d camera_translation;
   Vector3d eye;                    // camera centre, object frame
@@ -169,9 +170,11 @@ class CoverageAnalysis {
  private:
   void measure_faces();
   ShotView view_shot(int s, const ir::Shot& shot) const;
+  std::string visibility_key(const ShotView& view) const;
+  ShotVisibility see_faces(const ShotView& view) const;
+  bool sees_face(const ShotView& view, const raster::VisibilityBuffer& buffer, size_t f) const;
   ShotAreas analyse_faces(const ShotView& view);
   void analyse_face(const ShotView& view, size_t f, ShotSums& sum);
-  std::optional<double> visible_depth(const ShotView& view, size_t f, const Vector3d& to_eye) const;
   void count_view(int s, size_t f, double depth_m, ShotAreas& areas, CumulativeGain& gain);
   FaceView measure_face_view(const ShotView& view, size_t f, const Vector3d& to_eye,
                              double depth_m) const;
@@ -195,6 +198,8 @@ class CoverageAnalysis {
   const double cos_max_angle_;
   const double cos_min_triangulation_;
   const bool keep_sights_;
+  const std::shared_ptr<VisibilityCache> visibility_cache_;
+  std::string geometry_key_;  // what the visibility depends on besides the shot's poses
 
   CoverageResult result_;
   std::vector<Vector3d> center_, normal_;  // object frame
@@ -213,6 +218,32 @@ double visibility_scale(const CoverageOptions& options, const ir::Camera& camera
                                       : std::min(1.0, 1400.0 / camera.width_px);
 }
 
+// Appends the bytes of a fixed-size Eigen matrix (its values, not its padding).
+template <class Matrix>
+void append_bytes(std::string& key, const Matrix& m) {
+  const typename Matrix::PlainObject values = m;
+  key.append(reinterpret_cast<const char*>(values.data()),
+             sizeof(typename Matrix::Scalar) * values.size());
+}
+
+template <class T>
+std::size_t hash_of(const std::vector<T>& values) {
+  return std::hash<std::string_view>()(
+      std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
+}
+
+// What the visibility buffers depend on besides the poses: the object's and the studio's
+// meshes (hashed, with their sizes), which solids are closed, and the canvas.
+std::string geometry_key(const scene::StudioScene& studio, const dslr::Intrinsics& canvas) {
+  return fmt::format("{:x}/{}/{:x}/{}/{:x}/{}/{:x}/{}/{}/{}/{}x{}/{}/{}/{}/{}/",
+                     hash_of(studio.object.positions), studio.object.positions.size(),
+                     hash_of(studio.object.triangles), studio.object.triangles.size(),
+                     hash_of(studio.studio.positions), studio.studio.positions.size(),
+                     hash_of(studio.studio.triangles), studio.studio.triangles.size(),
+                     studio.object_closed, studio.closed_studio_triangles, canvas.width,
+                     canvas.height, canvas.fx, canvas.fy, canvas.cx, canvas.cy);
+}
+
 }  // namespace
 
 CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioScene& studio,
@@ -229,12 +260,14 @@ CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioSc
       cos_max_angle_(std::cos(settings_.max_view_angle_rad)),
       cos_min_triangulation_(std::cos(settings_.min_triangulation_angle_rad)),
       keep_sights_(options.keep_sights),
+      visibility_cache_(options.visibility_cache),
       seen_previous_(face_count_, 0),
       seen_now_(face_count_, 0) {
   std::string error;
   if (!options.check(&error)) throw std::invalid_argument(error);
   measure_faces();
   albedo_ = face_albedo(scene_, studio_);
+  if (visibility_cache_) geometry_key_ = geometry_key(studio_, canvas_);
 }
 
 void CoverageAnalysis::add_shot(const ir::Shot& shot) {
@@ -304,15 +337,11 @@ void CoverageAnalysis::measure_faces() {
   }
 }
 
+// The shot's poses, and what it sees: from the cache when it holds this geometry seen from here.
 ShotView CoverageAnalysis::view_shot(int s, const ir::Shot& shot) const {
   ShotView view;
   view.index = s;
   view.shot = &shot;
-  raster::FrameRequest request;
-  request.world_from_camera = shot.world_from_camera;
-  request.turntable_angle_rad = shot.turntable_angle_rad;
-  request.canvas = canvas_;
-  view.buffer = raster::render_visibility(scene_, studio_, request);
   const ir::Mat4 camera_from_object = shot.object_from_camera.inverse();
   view.camera_rotation = camera_from_object.block<3, 3>(0, 0);
   view.camera_translation = camera_from_object.block<3, 1>(0, 3);
@@ -320,19 +349,59 @@ ShotView CoverageAnalysis::view_shot(int s, const ir::Shot& shot) const {
   const ir::Mat4 world_from_object = ir::world_from_object(scene_, shot.turntable_angle_rad);
   view.world_rotation = world_from_object.block<3, 3>(0, 0);
   view.world_translation = world_from_object.block<3, 1>(0, 3);
+  if (!visibility_cache_) {
+    view.visibility = std::make_shared<const ShotVisibility>(see_faces(view));
+    return view;
+  }
+  const std::string key = visibility_key(view);
+  view.visibility = visibility_cache_->find(key);
+  if (!view.visibility) {
+    view.visibility = std::make_shared<const ShotVisibility>(see_faces(view));
+    visibility_cache_->insert(key, view.visibility);
+  }
   return view;
+}
+
+// The geometry's fingerprint, the poses and the canvas, byte for byte.
+std::string CoverageAnalysis::visibility_key(const ShotView& view) const {
+  std::string key = geometry_key_;
+  append_bytes(key, view.shot->world_from_camera);
+  append_bytes(key, view.shot->object_from_camera);
+  append_bytes(key, view.world_rotation);
+  append_bytes(key, view.world_translation);
+  return key;
+}
+
+// Renders the shot's visibility buffer and tells from it which faces the shot sees.
+ShotVisibility CoverageAnalysis::see_faces(const ShotView& view) const {
+  raster::FrameRequest request;
+  request.world_from_camera = view.shot->world_from_camera;
+  request.turntable_angle_rad = view.shot->turntable_angle_rad;
+  request.canvas = canvas_;
+  const raster::VisibilityBuffer buffer = raster::render_visibility(scene_, studio_, request);
+  ShotVisibility sight;
+  sight.seen.assign(face_count_, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, face_count_, 4096),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t f = range.begin(); f != range.end(); ++f) {
+                        sight.seen[f] = sees_face(view, buffer, f);
+                      }
+                    });
+  for (const auto id : buffer.object_triangle) sight.object_pixels += id >= 0;
+  sight.pixels = buffer.object_triangle.size();
+  return sight;
 }
 
 void CoverageAnalysis::analyse_face(const ShotView& view, size_t f, ShotSums& sum) {
   seen_now_[f] = 0;
   const Vector3d to_eye = view.eye - center_[f];
-  const std::optional<double> depth_m = visible_depth(view, f, to_eye);
-  if (!depth_m) return;
+  if (!view.visibility->seen[f]) return;
+  const double depth_m = view.to_camera(center_[f]).z();
   seen_now_[f] = 1;
-  count_view(view.index, f, *depth_m, sum.areas, sum.gain);
+  count_view(view.index, f, depth_m, sum.areas, sum.gain);
 
   const double area = result_.face_area_m2[f];
-  const FaceView face = measure_face_view(view, f, to_eye, *depth_m);
+  const FaceView face = measure_face_view(view, f, to_eye, depth_m);
   add_to_histograms(face, area, sum);
   const ViewFaults faults = judge(face);
   if (faults.out_of_focus) sum.areas.out_of_focus += area;
@@ -351,23 +420,21 @@ void CoverageAnalysis::analyse_face(const ShotView& view, size_t f, ShotSums& su
   }
 }
 
-// The depth of the face's centre if the camera sees it: facing the camera, in front of it, inside
-// the canvas, and not hidden.
-std::optional<double> CoverageAnalysis::visible_depth(const ShotView& view, size_t f,
-                                                      const Vector3d& to_eye) const {
-  if (normal_[f].dot(to_eye) <= 0) return std::nullopt;
+// Whether the camera sees the face's centre: facing the camera, in front of it, inside the
+// canvas, and not hidden.
+bool CoverageAnalysis::sees_face(const ShotView& view, const raster::VisibilityBuffer& buffer,
+                                 size_t f) const {
+  if (normal_[f].dot(view.eye - center_[f]) <= 0) return false;
   const Vector3d p = view.to_camera(center_[f]);
-  if (p.z() <= 0.01) return std::nullopt;
+  if (p.z() <= 0.01) return false;
   const double u = canvas_.fx * p.x() / p.z() + canvas_.cx;
   const double v = canvas_.fy * p.y() / p.z() + canvas_.cy;
-  if (u < 0 || v < 0 || u >= canvas_.width || v >= canvas_.height) return std::nullopt;
+  if (u < 0 || v < 0 || u >= canvas_.width || v >= canvas_.height) return false;
   const size_t pixel = static_cast<size_t>(v) * canvas_.width + static_cast<size_t>(u);
   // The face's own triangle at its centre pixel, or a surface at the same depth there (faces
   // smaller than a pixel of the buffer).
-  const bool visible = view.buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
-                       p.z() <= view.buffer.depth_m[pixel] * 1.004 + 0.0015;
-  if (!visible) return std::nullopt;
-  return p.z();
+  return buffer.object_triangle[pixel] == static_cast<std::int32_t>(f) ||
+         p.z() <= buffer.depth_m[pixel] * 1.004 + 0.0015;
 }
 
 // Records that shot `s` sees face `f`: view counts, first and second sighting, new and
@@ -487,9 +554,8 @@ ShotCoverage CoverageAnalysis::summarise_shot(const ShotView& view, const ShotAr
   coverage.too_oblique = areas.oblique / visible;
   coverage.too_coarse = areas.coarse / visible;
   coverage.nearest_depth_m = areas.nearest_depth_m;
-  size_t object_pixels = 0;
-  for (const auto id : view.buffer.object_triangle) object_pixels += id >= 0;
-  coverage.frame_fill = static_cast<double>(object_pixels) / view.buffer.object_triangle.size();
+  coverage.frame_fill = static_cast<double>(view.visibility->object_pixels) /
+                        static_cast<double>(view.visibility->pixels);
   const double total_area = std::max(result_.total_area_m2, 1e-30);
   coverage.seen_1 = totals_.seen_area[1] / total_area;
   coverage.seen_2 = totals_.seen_area[2] / total_area;

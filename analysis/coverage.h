@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/visibility_cache.h"
 #include "ir/ir.h"
 #include "scene/studio_scene.h"
 
@@ -66,6 +67,9 @@ struct CoverageOptions {
   // coarse to tell which faces are hidden).
   double visibility_scale = 0;
   bool keep_sights = false;  // fill CoverageResult::sights, face_center and face_normal
+  // Where shots' visibility is looked up before it is rendered, and kept after (may be shared by
+  // analyses on several threads).
+  std::shared_ptr<VisibilityCache> visibility_cache;
 
   // Whether every field holds a value the analysis takes; if not, says why in `error` (when
   // given). analyse_coverage throws std::invalid_argument on options that fail it.

@@ -620,7 +620,9 @@ std::optional<nlohmann::json> Session::coverage(bool background) {
   const auto asked = Clock::now();
   std::lock_guard coverage_lock(coverage_mutex_);
   const auto start = Clock::now();
-  const auto result = analyse(coverage_caches_, what, {}, background);
+  analysis::CoverageOptions options;
+  options.visibility_cache = visibility_cache_;
+  const auto result = analyse(coverage_caches_, what, options, background);
   if (!result) return std::nullopt;
   const double ms = ms_since(start);
   nlohmann::json out = coverage_json(*what.scene, *result);
@@ -667,6 +669,7 @@ std::optional<nlohmann::json> Session::advice() {
   });
   analysis::CoverageOptions options;
   options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
+  options.visibility_cache = visibility_cache_;
   const auto coverage = analyse(advice_caches_, what, options, true);
   if (!coverage) return std::nullopt;
   analysis::report_capture_advice(*scene, *what.studio, *coverage, diag);

@@ -184,6 +184,10 @@ class Session {
   std::atomic<int> urgent_requests_{0};          // captures waiting for their coverage
   std::deque<AnalysisCache> coverage_caches_;    // under coverage_mutex_, newest first
   std::deque<AnalysisCache> advice_caches_;      // under analysis_mutex_, newest first
+  // Shots' sights, shared by both analyses: a new exposure re-judges the faces without rendering
+  // their visibility again.
+  const std::shared_ptr<analysis::VisibilityCache> visibility_cache_ =
+      std::make_shared<analysis::VisibilityCache>();
   // The advice given for the last scene texts (a setting turned back and forth), newest first.
   std::deque<std::pair<std::string, nlohmann::json>> advice_given_;  // under analysis_mutex_
   std::deque<RenderCache> render_cache_;  // under render_mutex_, newest first
