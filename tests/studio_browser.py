@@ -260,6 +260,7 @@ def check_reference(driver, checks):
 
 
 def screenshots(rigc, scene, directory):
+    os.makedirs(directory, exist_ok=True)
     for width, height in ((1280, 800), (1920, 1080)):
         proc, url = start_studio(rigc, scene)
         driver = browser(width, height)
@@ -269,7 +270,8 @@ def screenshots(rigc, scene, directory):
                      "document.querySelectorAll('#advice li').length > 0", what='the page')
             time.sleep(1.0)
             path = os.path.join(directory, f'studio-{width}x{height}.png')
-            driver.save_screenshot(path)
+            if not driver.save_screenshot(path):
+                raise RuntimeError(f'could not write {path}')
             print('wrote', path)
         finally:
             driver.quit()
