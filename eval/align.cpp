@@ -127,8 +127,9 @@ std::vector<Vec3> every_nth(const std::vector<Vec3>& points, std::size_t limit) 
   return kept;
 }
 
-// RANSAC seeds register_clouds() tries.
+// RANSAC seeds register_clouds() tries, and the camera-ring candidates it refines.
 constexpr unsigned kRegistrationStarts = 4;
+constexpr std::size_t kRingCandidates = 3;
 
 // One alignment of one reconstruction; align() runs its steps.
 class Aligner {
@@ -247,14 +248,54 @@ class Aligner {
     return true;
   }
 
-  // Photos: no poses. Scale from the spread of the clouds, then FPFH + RANSAC, then ICP with
-  // scale. RANSAC on a partial cloud of a near-symmetric object now and then settles on a wrong
-  // pose, so it starts from several seeds and keeps the result that lies closest to the surface.
+  // Photos: no poses. Candidate similarities, each refined by ICP with scale and scored by its
+  // distance to the surface; the closest wins. RANSAC on FPFH features of a partial cloud of a
+  // near-symmetric object often settles on a wrong pose (seed by seed, 0 to 4 of 4 right on one
+  // statue), so it starts from several seeds, and photos taken as the scene plans add one
+  // candidate per turn of its camera ring.
   bool register_clouds() {
     std::vector<Vec3> samples, normals;
     surface_.sample(50000, 3, &samples, &normals);
-    // 200k points settle a similarity as well as millions do, in a fraction of the time.
-    const std::vector<Vec3> rec = every_nth(rec_points_, 200000);
+    // 20k points tell the candidates apart and settle each similarity; the ICP after
+    // registration refines the winner on up to 100k.
+    const std::vector<Vec3> rec = every_nth(rec_points_, 20000);
+    std::vector<std::pair<json, Similarity>> coarse = ransac_candidates(rec, samples);
+    for (auto& candidate : ring_candidates(rec)) coarse.push_back(std::move(candidate));
+    if (coarse.empty()) {
+      return fail(
+          "global registration found no alignment of the reconstruction to the mesh (RANSAC "
+          "fitness 0: no feature correspondence agreed)");
+    }
+    std::optional<std::pair<Similarity, double>> best;
+    json starts = json::array(), chosen;
+    for (auto& [label, start] : coarse) {
+      std::vector<Vec3> moved = rec;
+      apply_in_place(start, moved);
+      double fitness = 0;
+      const Similarity candidate = refine_with_scale(moved, samples, &fitness) * start;
+      const double distance = clipped_mean_distance(candidate, rec);
+      label["icp_with_scale_fitness"] = fitness;
+      label["clipped_mean_distance_mm"] = distance * 1000;
+      if (!best || distance < best->second) {
+        best = {candidate, distance};
+        chosen = label;
+      }
+      starts.push_back(std::move(label));
+    }
+    a_.transform = best->first;
+    a_.report = {{"method",
+                  "candidates from FPFH + RANSAC (Open3D) with several seeds and from the "
+                  "scene's camera ring, each refined by ICP with scale; the closest to the "
+                  "surface"},
+                 {"starts", starts},
+                 {"chosen", chosen}};
+    views_from_reconstruction();
+    return true;
+  }
+
+  // Scale from the spread of the clouds, then FPFH + RANSAC from each seed.
+  std::vector<std::pair<json, Similarity>> ransac_candidates(const std::vector<Vec3>& rec,
+                                                             const std::vector<Vec3>& samples) {
     const auto [c_rec, r_rec] = robust_radius(rec);
     const auto [c_gt, r_gt] = robust_radius(samples);
     Similarity pre;
@@ -262,39 +303,64 @@ class Aligner {
     pre.translation = c_gt - pre.scale * c_rec;
     std::vector<Vec3> moved = rec;
     apply_in_place(pre, moved);
-    std::optional<std::pair<Similarity, double>> best;
-    unsigned best_seed = 0;
-    json starts = json::array();
+    std::vector<std::pair<json, Similarity>> out;
     for (unsigned seed = 1; seed <= kRegistrationStarts; ++seed) {
-      auto global = global_registration(moved, samples, diag_ / 40, seed);
-      if (!global) continue;
-      const Similarity global_step = Similarity::from_matrix(*global);
-      std::vector<Vec3> start = moved;
-      apply_in_place(global_step, start);
-      const IcpResult scaled = icp_similarity(start, samples, diag_ / 50, 60);
-      const Similarity candidate = Similarity::from_matrix(scaled.transform) * global_step * pre;
-      const double distance = clipped_mean_distance(candidate, rec);
-      starts.push_back({{"seed", seed},
-                        {"icp_with_scale_fitness", scaled.fitness},
-                        {"clipped_mean_distance_mm", distance * 1000}});
-      if (!best || distance < best->second) {
-        best = {candidate, distance};
-        best_seed = seed;
+      const auto global = global_registration(moved, samples, diag_ / 40, seed);
+      if (global)
+        out.push_back(
+            {{{"from", "RANSAC"}, {"seed", seed}}, Similarity::from_matrix(*global) * pre});
+    }
+    return out;
+  }
+
+  // When every photo registered and the scene plans as many shots: the reconstructed camera
+  // centres in file order fitted to the planned ones, the planned order turned by each shot
+  // (where the turntable started is unknown) and reversed. The kRingCandidates closest to the
+  // surface before ICP.
+  std::vector<std::pair<json, Similarity>> ring_candidates(const std::vector<Vec3>& rec) const {
+    const std::vector<Vec3>& planned = truth_.planned_eyes;
+    std::vector<std::pair<json, Similarity>> out;
+    if (planned.size() < 3 || planned.size() != model_.images.size()) return out;
+    std::map<std::string, Vec3> by_name;
+    for (const auto& im : model_.images) by_name[im.name] = camera_centre(im.camera_from_world);
+    std::vector<Vec3> eyes;
+    for (const auto& [name, eye] : by_name) eyes.push_back(eye);
+    const int n = static_cast<int>(planned.size());
+    std::vector<std::pair<double, std::pair<json, Similarity>>> scored;
+    for (const int direction : {1, -1}) {
+      for (int turn = 0; turn < n; ++turn) {
+        std::vector<Vec3> dst;
+        for (int i = 0; i < n; ++i) dst.push_back(planned[((turn + direction * i) % n + n) % n]);
+        const auto fit = fit_similarity(eyes, dst);
+        if (!fit) continue;
+        const double distance = clipped_mean_distance(*fit, rec);
+        json label = {{"from", "planned cameras"},
+                      {"turn", turn},
+                      {"reversed", direction < 0},
+                      {"clipped_mean_distance_before_icp_mm", distance * 1000}};
+        scored.push_back({distance, {std::move(label), *fit}});
       }
     }
-    if (!best) {
-      return fail(
-          "global registration found no alignment of the reconstruction to the mesh (RANSAC "
-          "fitness 0: no feature correspondence agreed)");
+    const std::size_t keep = std::min(scored.size(), kRingCandidates);
+    std::partial_sort(scored.begin(), scored.begin() + keep, scored.end(),
+                      [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < keep; ++i) out.push_back(std::move(scored[i].second));
+    return out;
+  }
+
+  // ICP with scale from coarse to fine correspondence distances: RANSAC's pose on voxels of 1/40
+  // of the object is too rough for the fine step alone, which then settles a few mm off.
+  Similarity refine_with_scale(std::vector<Vec3>& points, const std::vector<Vec3>& samples,
+                               double* fitness) const {
+    Similarity total;
+    for (const double share : {1.0 / 10, 1.0 / 50, 1.0 / 200}) {
+      const IcpResult step = icp_similarity(points, samples, share * diag_, 40);
+      const Similarity s = Similarity::from_matrix(step.transform);
+      apply_in_place(s, points);
+      total = s * total;
+      *fitness = step.fitness;
     }
-    a_.transform = best->first;
-    a_.report = {{"method",
-                  "scale from cloud spread, FPFH + RANSAC (Open3D), ICP with scale; of several "
-                  "RANSAC seeds, the result closest to the surface"},
-                 {"starts", starts},
-                 {"chosen_seed", best_seed}};
-    views_from_reconstruction();
-    return true;
+    return total;
   }
 
   // The mean distance from the surface of `points` moved by `s`, each distance clipped at 2 % of

@@ -226,6 +226,9 @@ bool load_scene_object(const std::string& scene_path, const fs::path& run_dir, c
   gt.triangles = scene->object.mesh.triangles;
   gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
   if (scene->studio.backdrop.green_screen) gt.backdrop_color = scene->studio.backdrop.color;
+  for (const ir::Shot& shot : scene->shots) {
+    gt.planned_eyes.push_back(shot.object_from_camera.block<3, 1>(0, 3));
+  }
   const json& m = manifest;
   if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
       m["inputs"].contains("object_sha256") && m["inputs"]["object_sha256"].is_string() &&

@@ -39,6 +39,9 @@ struct GroundTruth {
   std::map<std::string, ir::Mat4> poses;    // camera_from_world by image name (sparse/images.txt)
   std::optional<run::ColmapCamera> camera;  // sparse/cameras.txt's first camera
   std::optional<ir::Vec3> backdrop_color;   // the scene's green screen (linear RGB), for keying
+  // The scene's camera centres in the object frame, in shot order (from --scene or the run's
+  // scene): photos taken as planned register from them.
+  std::vector<ir::Vec3> planned_eyes;
 };
 
 // Everything evaluate() reads, checked.
