@@ -159,6 +159,10 @@ bool shadow_of(const ir::Vec3& pixel, const ir::Vec3& background) {
 
 }  // namespace
 
+// The share of the photos that must agree on a pixel's colour for it to be still: a turning
+// object's softly textured surface matches its own median in about half of them.
+constexpr float kStillShare = 0.8f;
+
 std::optional<StillBackground> still_background(const std::vector<const KeyImage*>& images) {
   constexpr std::size_t kFewest = 5;
   if (images.size() < kFewest) return std::nullopt;
@@ -184,7 +188,7 @@ std::optional<StillBackground> still_background(const std::vector<const KeyImage
     int agree = 0;
     for (const KeyImage* im : images) agree += same_colour(linear_pixel(im->srgb, i), median);
     still.still_share[i] = static_cast<float>(agree) / static_cast<float>(images.size());
-    still_pixels += still.still_share[i] >= 0.5f;
+    still_pixels += still.still_share[i] >= kStillShare;
   }
   still.still_fraction = static_cast<double>(still_pixels) / static_cast<double>(n);
   return still;
@@ -194,7 +198,7 @@ std::vector<std::uint8_t> key_still(const KeyImage& image, const StillBackground
   std::vector<std::uint8_t> mask(image.pixels(), 255);
   if (image.width != still.width || image.height != still.height) return mask;
   for (std::size_t i = 0; i < image.pixels(); ++i) {
-    if (still.still_share[i] < 0.5f) continue;
+    if (still.still_share[i] < kStillShare) continue;
     const ir::Vec3 pixel = linear_pixel(image.srgb, i);
     const ir::Vec3 background = linear_pixel(still.median_srgb, i);
     if (same_colour(pixel, background) || shadow_of(pixel, background)) mask[i] = 0;

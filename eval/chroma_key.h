@@ -55,14 +55,14 @@ struct StillBackground {
   int width = 0, height = 0;
   std::vector<std::uint8_t> median_srgb;
   std::vector<float> still_share;
-  double still_fraction = 0;  // the share of pixels still in most photos
+  double still_fraction = 0;  // the share of pixels still in 8 photos in 10 or more
 };
 // nullopt for fewer than 5 photos (no median to trust) or photos of different sizes.
 std::optional<StillBackground> still_background(const std::vector<const KeyImage*>& images);
 
-// 255 where a pixel is not the still background: where most photos agree on the background (a
-// share of at least one half), a pixel that matches it or is a shadow of it (darker, same
-// chromaticity) is background; elsewhere every pixel is kept.
+// 255 where a pixel is not the still background: where most photos agree on the background (8
+// in 10 or more), a pixel that matches it or is a shadow of it (darker, same chromaticity) is
+// background; elsewhere every pixel is kept.
 std::vector<std::uint8_t> key_still(const KeyImage& image, const StillBackground& still);
 
 // The object from a raw key: specks opened away, the components much smaller than the largest
