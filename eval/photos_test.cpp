@@ -61,20 +61,26 @@ nlohmann::json eval_json(const fs::path& out) {
   return nlohmann::json::parse(in);
 }
 
+// The paper scene with its speckle painted 5 mm instead of 2 mm: at 0.15 (821 x 547 px, a pixel
+// about 1.6 mm on the statue) the preview box-filters 2 mm dots as a camera would, to a grey
+// that leaves SfM too few features. Returns its path ("" when the scene has changed).
+std::string write_paper_scene(const rigc::testing::TempDir& dir) {
+  std::string text = rigc::testing::read_text(source_path("scenes/paper-turntable.yaml"));
+  const std::size_t speckle = text.find("pattern: speckle, scale: 2mm");
+  if (speckle == std::string::npos) return "";
+  text.replace(text.find("2mm", speckle), 3, "5mm");
+  const std::string scene = dir.file("paper-turntable.yaml");
+  rigc::testing::write_text(scene, text);
+  return scene;
+}
+
 // The paper scene rendered by `render_args` (after the scene), its run folder evaluated, then its
 // images as photos with their EXIF and stripped of it with the camera stated: both must register
 // every image and measure like the run folder.
 void expect_photos_register_like_the_run_folder(const std::vector<std::string>& render_args) {
   rigc::testing::TempDir dir;
-  // The paper scene with its speckle painted 5 mm instead of 2 mm: at 0.15 (821 x 547 px, a pixel
-  // about 1.6 mm on the statue) the preview box-filters 2 mm dots as a camera would, to a grey
-  // that leaves SfM too few features.
-  std::string text = rigc::testing::read_text(source_path("scenes/paper-turntable.yaml"));
-  const std::size_t speckle = text.find("pattern: speckle, scale: 2mm");
-  ASSERT_NE(speckle, std::string::npos);
-  text.replace(text.find("2mm", speckle), 3, "5mm");
-  const std::string scene = dir.file("paper-turntable.yaml");
-  rigc::testing::write_text(scene, text);
+  const std::string scene = write_paper_scene(dir);
+  ASSERT_FALSE(scene.empty());
   const fs::path run = dir.path() / "run";
   std::vector<std::string> render = {"render", scene, "-o", run.string()};
   render.insert(render.end(), render_args.begin(), render_args.end());
@@ -136,6 +142,34 @@ TEST(EvalEndToEnd, SlowPaperSceneCyclesPhotosRegisterLikeTheRunFolder) {
   RIGC_REQUIRE_TOOL(std::system("blender --version > /dev/null 2>&1") == 0, "blender");
   expect_photos_register_like_the_run_folder(
       {"--backend", "cycles", "--scale", "0.15", "--samples", "16"});
+}
+
+// The paper's Table 1 in one command: `compare --photos` adds the photos as a row beside the
+// renderer's, measured like it.
+TEST(EvalEndToEnd, SlowCompareWithPhotosGivesTheRendererAndThePhotosRows) {
+  RIGC_REQUIRE_TOOL(have_colmap(), "colmap");
+  rigc::testing::TempDir dir;
+  const std::string scene = write_paper_scene(dir);
+  ASSERT_FALSE(scene.empty());
+  const fs::path run = dir.path() / "run";
+  auto r =
+      run_rigc({"render", scene, "--backend", "preview", "--scale", "0.15", "-o", run.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  copy_as_photos(run, dir.path() / "photos", false);
+  const fs::path out = dir.path() / "compare";
+  r = run_rigc({"compare", scene, "--backends", "preview", "--scale", "0.15", "--photos",
+                (dir.path() / "photos").string(), "-o", out.string(), "--samples", "20000"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| preview | 18 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| photos | 18 |"), std::string::npos) << r.out;
+  const auto preview = eval_json(out / "preview" / "eval");
+  const auto photos = eval_json(out / "photos_eval");
+  EXPECT_EQ(preview["reconstruction"]["registered_images"], 18);
+  EXPECT_EQ(photos["reconstruction"]["registered_images"], 18);
+  EXPECT_LT(photos["signed_distance_mm"]["mean_abs"].get<double>(),
+            1.15 * preview["signed_distance_mm"]["mean_abs"].get<double>());
+  std::string markdown = rigc::testing::read_text((out / "compare.md").string());
+  EXPECT_NE(markdown.find("| photos |"), std::string::npos);
 }
 
 }  // namespace
