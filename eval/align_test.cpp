@@ -1,5 +1,5 @@
 // Registration without poses: photos taken as the scene plans register from its camera ring
-// whatever turn of the turntable they started at.
+// whatever turn of the turntable they started at (the statue fixture's plan: two rings of six).
 #include "eval/align.h"
 
 #include <gtest/gtest.h>
@@ -9,22 +9,12 @@
 #include <string>
 
 #include "compiler/frontend.h"
+#include "eval/inputs.h"
+#include "eval/reconstruction_test_support.h"
 #include "ir/ir.h"
 
 namespace rigc::eval {
 namespace {
-
-constexpr const char* kRingScene = R"(rigc: 1
-object:
-  primitive: {shape: statue, detail: 4, seed: 3}
-  fit: {height: 25cm}
-camera:
-  body: canon-6d
-  lens: {focal_length: 50mm}
-  exposure: {aperture: f/11, shutter: 1/125, iso: 200}
-shots:
-  - turntable: {steps: 12, step: 30deg, camera: {distance: 70cm, height: 10cm}}
-)";
 
 struct RingCase {
   GroundTruth truth;
@@ -38,14 +28,12 @@ RingCase ring_case(int turn) {
   DiagnosticEngine diag;
   std::string messages;
   diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
-  auto scene = compile_scene_text(kRingScene, "ring.yaml", ".", diag);
+  auto scene = compile_scene_text(test_inputs::kStatueScene, "statue.yaml", ".", diag);
   EXPECT_TRUE(scene) << messages;
   RingCase c;
   c.truth.positions = ir::object_frame_positions(scene->object);
   c.truth.triangles = scene->object.mesh.triangles;
-  for (const ir::Shot& shot : scene->shots) {
-    c.truth.planned_eyes.push_back(shot.object_from_camera.block<3, 1>(0, 3));
-  }
+  c.truth.planned_eyes = planned_eyes(*scene);
   c.rec_from_gt.scale = 3.7;
   c.rec_from_gt.rotation = Eigen::AngleAxisd(1.2, Vec3(0.3, -0.5, 0.8).normalized()).matrix();
   c.rec_from_gt.translation = Vec3(0.4, -1.1, 2.0);

@@ -30,6 +30,13 @@ bool every_image_planned(const std::vector<std::string>& image_names,
                      [&](const std::string& name) { return planned_poses.count(name) > 0; });
 }
 
+std::vector<ir::Vec3> planned_eyes(const ir::Scene& scene) {
+  std::vector<ir::Vec3> eyes;
+  for (const ir::Shot& shot : scene.shots)
+    eyes.push_back(shot.object_from_camera.block<3, 1>(0, 3));
+  return eyes;
+}
+
 namespace {
 
 bool is_image_file(const fs::path& p) {
@@ -226,9 +233,7 @@ bool load_scene_object(const std::string& scene_path, const fs::path& run_dir, c
   gt.triangles = scene->object.mesh.triangles;
   gt.description = fmt::format("{} object ({}), object frame", scene_path, scene->object.source);
   if (scene->studio.backdrop.green_screen) gt.backdrop_color = scene->studio.backdrop.color;
-  for (const ir::Shot& shot : scene->shots) {
-    gt.planned_eyes.push_back(shot.object_from_camera.block<3, 1>(0, 3));
-  }
+  gt.planned_eyes = planned_eyes(*scene);
   const json& m = manifest;
   if (m.is_object() && m.contains("inputs") && m["inputs"].is_object() &&
       m["inputs"].contains("object_sha256") && m["inputs"]["object_sha256"].is_string() &&

@@ -57,6 +57,9 @@ struct EvalInputs {
 bool every_image_planned(const std::vector<std::string>& image_names,
                          const std::map<std::string, ir::Mat4>& planned_poses);
 
+// The scene's camera centres in the object frame, in shot order (GroundTruth::planned_eyes).
+std::vector<ir::Vec3> planned_eyes(const ir::Scene& scene);
+
 // Checks the inputs and creates the output folder (only once they pass: a refused input leaves
 // nothing behind). Errors go to `log`; nullopt means a user error (exit 1). Sets summary.images
 // once the images are read and summary.output_dir once the folder exists.
