@@ -221,13 +221,20 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
   // The sensor width that gives the canvas's fx at the true focal length, so that Cycles' pupil
   // (focal length / f-number) is the real one.
   const double focal_mm = camera.focal_length_m * 1000;
-  const double max_side = std::max(canvas.width, canvas.height);
-  data["camera"] = {{"focal_mm", focal_mm},
-                    {"sensor_width_mm", canvas.width * focal_mm / canvas.fx},
-                    {"shift_x", (canvas.width / 2.0 - canvas.cx) / max_side},
-                    {"shift_y", (canvas.cy - canvas.height / 2.0) / max_side},
-                    {"f_number", camera.aperture_f_number},
-                    {"depth_of_field", camera.effects.depth_of_field}};
+  // A pixel's height over its width as angles (fx / fy differs from 1 when the sensor's size in mm
+  // is rounded): Blender's pixel aspect, which it takes as two values of at least 1 each. With
+  // the sensor fitted horizontally, both shifts are in units of the image's width, and the
+  // vertical one in pixels of that aspect.
+  const double pixel_height_over_width = canvas.fx / canvas.fy;
+  data["camera"] = {
+      {"focal_mm", focal_mm},
+      {"sensor_width_mm", canvas.width * focal_mm / canvas.fx},
+      {"pixel_aspect_x", std::max(1.0, 1 / pixel_height_over_width)},
+      {"pixel_aspect_y", std::max(1.0, pixel_height_over_width)},
+      {"shift_x", (canvas.width / 2.0 - canvas.cx) / canvas.width},
+      {"shift_y", (canvas.cy - canvas.height / 2.0) * pixel_height_over_width / canvas.width},
+      {"f_number", camera.aperture_f_number},
+      {"depth_of_field", camera.effects.depth_of_field}};
 
   json materials = json::array();
   for (int m = 0; m < total_materials; ++m) {
