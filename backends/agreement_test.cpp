@@ -229,6 +229,7 @@ double relative_difference(const dslr::LinearFrame& a, const dslr::LinearFrame& 
 // The albedo renders as 8-bit sRGB PNGs in `dir`, to look at (RIGC_KEEP_ALBEDO=dir).
 void save_albedos(const std::vector<Rendered>& all, const std::vector<std::uint8_t>& common,
                   const fs::path& dir) {
+  fs::create_directories(dir);
   const std::string mask_path = (dir / "common_mask.png").string();
   auto mask_out = OIIO::ImageOutput::create(mask_path);
   ASSERT_TRUE(mask_out &&
