@@ -39,7 +39,13 @@ void halve_rows(const float* top, const float* bottom, const float* top_held,
                 const float* bottom_held, int finer_size, float* nearest, float* held) {
   const float inf = std::numeric_limits<float>::infinity();
   const Float8 one = Float8{} + 1.0f, none = {};
-  constexpr Int8 kEven = {0, 2, 4, 6, 8, 10, 12, 14}, kOdd = {1, 3, 5, 7, 9, 11, 13, 15};
+  // The even and the odd lanes of sixteen (GCC 12 and clang both have __builtin_shufflevector).
+  auto even_lanes = [](Float8 a, Float8 b) -> Float8 {
+    return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14);
+  };
+  auto odd_lanes = [](Float8 a, Float8 b) -> Float8 {
+    return __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
+  };
   auto held8 = [&](int x) {  // how many of the two rows' eight columns from x hold a caster
     if (top_held) return simd::load8(top_held + x) + simd::load8(bottom_held + x);
     return (simd::load8(top + x) < inf ? one : none) + (simd::load8(bottom + x) < inf ? one : none);
@@ -50,12 +56,11 @@ void halve_rows(const float* top, const float* bottom, const float* top_held,
     const Float8 bottom0 = simd::load8(bottom + x), bottom1 = simd::load8(bottom + x + 8);
     const Float8 near0 = top0 < bottom0 ? top0 : bottom0;
     const Float8 near1 = top1 < bottom1 ? top1 : bottom1;
-    const Float8 even = __builtin_shuffle(near0, near1, kEven);
-    const Float8 odd = __builtin_shuffle(near0, near1, kOdd);
+    const Float8 even = even_lanes(near0, near1);
+    const Float8 odd = odd_lanes(near0, near1);
     const Float8 out = even < odd ? even : odd;
     const Float8 held0 = held8(x), held1 = held8(x + 8);
-    const Float8 fraction =
-        (__builtin_shuffle(held0, held1, kEven) + __builtin_shuffle(held0, held1, kOdd)) * 0.25f;
+    const Float8 fraction = (even_lanes(held0, held1) + odd_lanes(held0, held1)) * 0.25f;
     std::memcpy(nearest + x / 2, &out, sizeof(out));
     std::memcpy(held + x / 2, &fraction, sizeof(fraction));
   }
@@ -202,7 +207,7 @@ void rasterize_band_keys(ShadowMap& map, const CasterPlanes& planes, const CellB
         const Float8 key = p.key_plane[0] * px + key_y + p.key_plane[2];
         Float8 current;
         std::memcpy(&current, row + x, sizeof(current));
-        const Float8 merged = inside & (key > current) ? key : current;
+        const Float8 merged = (inside & (key > current)) ? key : current;
         std::memcpy(row + x, &merged, sizeof(merged));
       }
     }

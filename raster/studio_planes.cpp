@@ -161,7 +161,12 @@ void StudioPlanes::write_tile(const PlaneCorners& cache, const ScreenTriangle& p
     static constexpr Float4 kWeight[3] = {{0.125f, 0.125f, 0.125f, 0.375f},
                                           {0.375f, 0.375f, 0.625f, 0.625f},
                                           {0.625f, 0.875f, 0.875f, 0.875f}};
-    static constexpr Int4 kChannel[3] = {{0, 1, 2, 0}, {1, 2, 0, 1}, {2, 0, 1, 2}};
+    // An RGB corner's channels in the order the block's three vectors of four hold them.
+    auto rotations = [](Float4 v) {
+      return std::array<Float4, 3>{__builtin_shufflevector(v, v, 0, 1, 2, 0),
+                                   __builtin_shufflevector(v, v, 1, 2, 0, 1),
+                                   __builtin_shufflevector(v, v, 2, 0, 1, 2)};
+    };
     // The corners' rows read directly: loading four floats just stored as three stalls.
     const float* upper_row = cache.color[cy * kCorners].data();
     const float* lower_row = cache.color[(cy + 1) * kCorners].data();
@@ -169,11 +174,9 @@ void StudioPlanes::write_tile(const PlaneCorners& cache, const ScreenTriangle& p
       return fy * load4(lower_row + 3 * cx) + (1 - fy) * load4(upper_row + 3 * cx);
     };
     for (int cx = 0; cx < whole_blocks; ++cx) {
-      const Float4 left = edge_at(cx), right = edge_at(cx + 1);
+      const std::array<Float4, 3> from = rotations(edge_at(cx)), to = rotations(edge_at(cx + 1));
       for (int k = 0; k < 3; ++k) {
-        const Float4 from = __builtin_shuffle(left, kChannel[k]);
-        const Float4 to = __builtin_shuffle(right, kChannel[k]);
-        store4(rgb + 3 * kBlock * cx + 4 * k, kWeight[k] * to + (1 - kWeight[k]) * from);
+        store4(rgb + 3 * kBlock * cx + 4 * k, kWeight[k] * to[k] + (1 - kWeight[k]) * from[k]);
       }
     }
     // A last, partial block (the canvas's right edge): pixel by pixel.
