@@ -51,7 +51,7 @@ std::vector<float> gaussian_kernel(double sigma, int radius) {
 template <typename Fn>
 void with_common_tap_count(int taps, Fn&& fn) {
   [&]<int... kTaps>(std::integer_sequence<int, kTaps...>) {
-    ((taps == kTaps && (fn(std::integral_constant<int, kTaps>{}), true)) || ...);
+    static_cast<void>(((taps == kTaps && (fn(std::integral_constant<int, kTaps>{}), true)) || ...));
   }
   (std::integer_sequence<int, 3, 5, 7, 9>{});
 }
