@@ -6,6 +6,7 @@
 #
 # Usage: bench/fidelity_table.sh [OUT_DIR] [SCALE] [CYCLES_SAMPLES] [RUNS] [SCENES]
 #   defaults: out/fidelity-table, 0.25, 0 (Cycles' default, 64), 2, "paper spot".
+#   RIGC: the rigc binary (default ./build/rigc).
 #   SCENES: paper (scenes/paper-turntable.yaml) and/or spot (scenes/spot-turntable.yaml: Spot
 #   with a photographed texture). The Cycles renders of the paper scene take about 20 minutes at
 #   0.25 with 64 samples on 2 quiet cores.
@@ -13,7 +14,7 @@
 # mean ± std (mm), F-score at 1 mm, and per scene the preview/Cycles ratios of std and points.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-rigc=./build/rigc
+rigc=${RIGC:-./build/rigc}
 out=${1:-out/fidelity-table}
 scale=${2:-0.25}
 samples=${3:-0}
