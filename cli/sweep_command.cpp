@@ -29,6 +29,7 @@ struct SweepArguments {
   std::vector<std::string> vary, sbatch;
   std::string partition, time, cpus_per_task, mem;
   double scale = 0.25;
+  int samples = 0;
   int jobs = 1;
   bool status = false, retry_failed = false, no_wait = false;
   std::string run_task;
@@ -43,6 +44,10 @@ void add_sweep_options(CLI::App& app, SweepArguments& a) {
   app.add_option("--scale", a.scale, "with --vary: render scale")
       ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
+      ->capture_default_str();
+  app.add_option("--samples", a.samples,
+                 "with --vary: the ray tracers' samples per pixel (0: each backend's default)")
+      ->check(CLI::Range(0, 65536))
       ->capture_default_str();
   app.add_option("--measure", a.measure, "with --vary: coverage, eval or coverage,eval")
       ->capture_default_str();
@@ -73,6 +78,7 @@ std::optional<sweep::SweepSpec> spec_from_options(const SweepArguments& a, Diagn
   spec.scene_path = a.input;
   spec.name = sweep::folder_name(fs::path(a.input).stem().string()) + "-sweep";
   spec.scale = a.scale;
+  spec.samples = a.samples;
   std::string error;
   for (const std::string& text : a.vary) {
     auto axis = sweep::parse_vary_option(text, &error);

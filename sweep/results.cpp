@@ -142,10 +142,11 @@ std::string rank_agreement(const SweepSpec& spec, const std::vector<ResultRow>& 
 
 std::string markdown_text(const SweepSpec& spec, const std::vector<ResultRow>& rows,
                           const std::vector<std::string>& plots) {
-  std::string md =
-      fmt::format("# Sweep {}\n\nScene `{}`, render scale {}, measured: {}{}.\n\n", spec.name,
-                  spec.scene_path, spec.scale, spec.coverage ? "coverage" : "",
-                  spec.eval ? (spec.coverage ? ", eval" : "eval") : "");
+  std::string md = fmt::format(
+      "# Sweep {}\n\nScene `{}`, render scale {}{}, measured: {}{}.\n\n", spec.name,
+      spec.scene_path, spec.scale,
+      spec.samples > 0 ? fmt::format(", {} samples a pixel", spec.samples) : "",
+      spec.coverage ? "coverage" : "", spec.eval ? (spec.coverage ? ", eval" : "eval") : "");
   md += markdown_table(spec, rows);
   const int best = best_variant(rows);
   if (best >= 0) {

@@ -110,10 +110,21 @@ void read_scale(const YAML::Node& node, const std::string& file, SweepSpec& spec
   spec.scale = scale;
 }
 
+void read_samples(const YAML::Node& node, const std::string& file, SweepSpec& spec,
+                  DiagnosticEngine& diag) {
+  int samples = 0;
+  std::istringstream in(node.IsScalar() ? node.Scalar() : "");
+  if (!(in >> samples) || !in.eof() || samples < 1 || samples > 65536) {
+    diag.error(loc_of(node, file), "samples: must be a whole number within 1..65536");
+    return;
+  }
+  spec.samples = samples;
+}
+
 void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& spec,
                     DiagnosticEngine& diag) {
-  static const std::vector<std::string> kKeys = {"rigc-sweep", "name",    "scene", "vary",
-                                                 "zip",        "backend", "scale", "measure"};
+  static const std::vector<std::string> kKeys = {"rigc-sweep", "name",  "scene",   "vary",   "zip",
+                                                 "backend",    "scale", "samples", "measure"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = it->first.Scalar();
     if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) {
@@ -139,6 +150,7 @@ void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& 
   }
   if (const YAML::Node n = root["zip"]) read_zip(n, file, spec, diag);
   if (const YAML::Node n = root["scale"]) read_scale(n, file, spec, diag);
+  if (const YAML::Node n = root["samples"]) read_samples(n, file, spec, diag);
   if (const YAML::Node n = root["measure"]) read_measure(n, file, spec, diag);
 }
 

@@ -1,6 +1,6 @@
 // The sweep file (`rigc-sweep: 1`) and `--vary PATH=V1,V2,...`: a scene, the values to vary in it
 // (axes, combined as a grid unless `zip:` pairs them), the backend (possibly an axis), the render
-// scale and what to measure.
+// scale, the ray tracers' samples and what to measure.
 #pragma once
 
 #include <optional>
@@ -31,6 +31,7 @@ struct SweepSpec {
   std::vector<std::vector<int>> zip_groups;  // axes (indices) paired value by value
   std::string backend = "preview";           // when the backend is no axis
   double scale = 0.25;
+  int samples = 0;  // the ray tracers' samples per pixel; 0 = each backend's default
   bool coverage = true, eval = false;
 };
 

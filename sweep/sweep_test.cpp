@@ -124,6 +124,36 @@ TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
   EXPECT_NE(all_diagnostics(other).find("starts with `rigc-sweep: 1`"), std::string::npos);
 }
 
+// A Cycles sweep at fewer samples than a final render: the count reaches every variant's render
+// and its key, so changing it reruns them.
+TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
+  const std::string scene = source_path("scenes/paper-turntable.yaml");
+  const std::string text =
+      "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.aperture: [f/8]\n";
+  auto key_with = [&](const std::string& samples_line) {
+    DiagnosticEngine diag;
+    capture(diag);
+    const auto spec = parse_sweep_text(text + samples_line, "s.yaml", diag);
+    EXPECT_TRUE(spec) << all_diagnostics(diag);
+    std::vector<Variant> variants = expand_variants(*spec);
+    EXPECT_TRUE(build_variants(*spec, read_text(scene), "/nonexistent", variants, diag));
+    EXPECT_EQ(sweep_json(*spec, variants).at("samples"), spec->samples);
+    return variants.at(0).key;
+  };
+  const std::string by_default = key_with(""), sixteen = key_with("samples: 16\n");
+  EXPECT_NE(sixteen, by_default);
+  EXPECT_EQ(key_with("samples: 16\n"), sixteen);
+
+  for (const std::string bad : {"samples: 0\n", "samples: 1.5\n", "samples: [16]\n"}) {
+    DiagnosticEngine diag;
+    capture(diag);
+    EXPECT_FALSE(parse_sweep_text(text + bad, "s.yaml", diag));
+    EXPECT_NE(all_diagnostics(diag).find("s.yaml:5:10: samples: must be a whole number"),
+              std::string::npos)
+        << bad << all_diagnostics(diag);
+  }
+}
+
 TEST(SweepFile, FolderNamesAreSanitised) {
   EXPECT_EQ(folder_name("../../etc/passwd"), "..-..-etc-passwd");
   EXPECT_EQ(folder_name(".."), "_..");

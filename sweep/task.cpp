@@ -109,6 +109,7 @@ nlohmann::json run_stages(const nlohmann::json& variant, const fs::path& dir, st
   run::RunOptions options;
   options.output_dir = dir;
   options.settings.scale = variant.at("scale").get<double>();
+  options.settings.samples = variant.value("samples", 0);
   const auto start = Clock::now();
   const int render_status = run::run_backend(*scene, *entry->make(), options, log);
   result["render_wall_s"] = seconds_since(start);

@@ -91,10 +91,10 @@ std::vector<std::pair<std::string, std::string>> variant_edits(const SweepSpec& 
 // The scene's text does not hold its mesh and textures: `content_hash` (run::scene_content_hash)
 // stands for them, so editing a model file in place reruns the variants that use it.
 std::string variant_key(const SweepSpec& spec, const Variant& v, const std::string& content_hash) {
-  const nlohmann::json inputs = {{"scene", v.scene_text},     {"content", content_hash},
-                                 {"backend", v.backend},      {"scale", spec.scale},
-                                 {"coverage", spec.coverage}, {"eval", spec.eval},
-                                 {"rigc", RIGC_VERSION}};
+  const nlohmann::json inputs = {{"scene", v.scene_text},   {"content", content_hash},
+                                 {"backend", v.backend},    {"scale", spec.scale},
+                                 {"samples", spec.samples}, {"coverage", spec.coverage},
+                                 {"eval", spec.eval},       {"rigc", RIGC_VERSION}};
   return sha256_hex(inputs.dump());
 }
 
@@ -217,9 +217,11 @@ nlohmann::json sweep_json(const SweepSpec& spec, const std::vector<Variant>& var
     list.push_back(
         {{"name", v.name}, {"values", v.values}, {"backend", v.backend}, {"key", v.key}});
   }
-  return {{"rigc-sweep", 1},     {"name", spec.name},         {"scene", spec.scene_path},
-          {"scale", spec.scale}, {"coverage", spec.coverage}, {"eval", spec.eval},
-          {"axes", axes},        {"variants", list}};
+  return {{"rigc-sweep", 1},          {"name", spec.name},
+          {"scene", spec.scene_path}, {"scale", spec.scale},
+          {"samples", spec.samples},  {"coverage", spec.coverage},
+          {"eval", spec.eval},        {"axes", axes},
+          {"variants", list}};
 }
 
 bool write_variant_folders(const SweepSpec& spec, const std::vector<Variant>& variants,
@@ -235,9 +237,10 @@ bool write_variant_folders(const SweepSpec& spec, const std::vector<Variant>& va
     nlohmann::json values;
     for (std::size_t a = 0; a < spec.axes.size(); ++a) values[spec.axes[a].path] = v.values[a];
     const std::string variant_text =
-        nlohmann::json{{"name", v.name},      {"values", values},          {"backend", v.backend},
-                       {"scale", spec.scale}, {"coverage", spec.coverage}, {"eval", spec.eval},
-                       {"key", v.key}}
+        nlohmann::json{{"name", v.name},          {"values", values},
+                       {"backend", v.backend},    {"scale", spec.scale},
+                       {"samples", spec.samples}, {"coverage", spec.coverage},
+                       {"eval", spec.eval},       {"key", v.key}}
             .dump(2) +
         "\n";
     if (read_text(dir / "scene.yaml") != v.scene_text &&
