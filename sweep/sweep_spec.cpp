@@ -1,6 +1,7 @@
 #include "sweep/sweep_spec.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -236,10 +237,30 @@ std::optional<Axis> parse_vary_option(const std::string& text, std::string* erro
   return axis;
 }
 
+namespace {
+
+// Each value of a zip group's axes taken together (a configuration) is given once.
+void check_zipped_tuples(const SweepSpec& spec, const std::vector<int>& group,
+                         DiagnosticEngine& diag) {
+  std::set<std::vector<std::string>> seen;
+  for (std::size_t i = 0; i < spec.axes[group[0]].values.size(); ++i) {
+    std::vector<std::string> tuple;
+    for (const int a : group) tuple.push_back(spec.axes[a].values[i].text);
+    if (seen.insert(tuple).second) continue;
+    diag.error(spec.axes[group[0]].values[i].loc,
+               fmt::format("the zipped values ({}) are given twice", fmt::join(tuple, ", ")));
+  }
+}
+
+}  // namespace
+
 bool check_axes(const SweepSpec& spec, DiagnosticEngine& diag) {
   const int errors_before = diag.error_count();
+  std::set<int> zipped;
+  for (const auto& group : spec.zip_groups) zipped.insert(group.begin(), group.end());
   std::set<std::string> paths;
-  for (const Axis& axis : spec.axes) {
+  for (std::size_t a = 0; a < spec.axes.size(); ++a) {
+    const Axis& axis = spec.axes[a];
     if (!paths.insert(axis.path).second) {
       diag.error(axis.loc, fmt::format("'{}' is varied twice", axis.path));
     }
@@ -248,7 +269,8 @@ bool check_axes(const SweepSpec& spec, DiagnosticEngine& diag) {
     }
     std::set<std::string> seen;
     for (const AxisValue& v : axis.values) {
-      if (!seen.insert(v.text).second) {
+      // A zipped axis may repeat a value (f/13 with 12 and with 36 steps); its tuples may not.
+      if (!seen.insert(v.text).second && !zipped.count(static_cast<int>(a))) {
         diag.error(v.loc, fmt::format("'{}' is given twice for '{}'", v.text, axis.path));
       }
       if (axis.is_backend() && !backends::find_backend(v.text)) {
@@ -257,14 +279,17 @@ bool check_axes(const SweepSpec& spec, DiagnosticEngine& diag) {
     }
   }
   for (const auto& group : spec.zip_groups) {
+    bool same_sizes = true;
     for (const int a : group) {
       if (spec.axes[a].values.size() != spec.axes[group[0]].values.size()) {
+        same_sizes = false;
         diag.error(spec.axes[a].loc,
                    fmt::format("zipped axes need as many values: '{}' has {}, '{}' has {}",
                                spec.axes[a].path, spec.axes[a].values.size(),
                                spec.axes[group[0]].path, spec.axes[group[0]].values.size()));
       }
     }
+    if (same_sizes) check_zipped_tuples(spec, group, diag);
   }
   return diag.error_count() == errors_before;
 }

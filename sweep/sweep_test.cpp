@@ -106,8 +106,7 @@ TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
   capture(diag);
   EXPECT_FALSE(parse_sweep_text(
       "rigc-sweep: 1\nscene: a.yaml\nvary:\n  camera.exposure.aperture: [f/4, f/4]\n"
-      "  shots[0].turntable.steps: [12]\nzip: [camera.exposure.aperture, "
-      "\"shots[0].turntable.steps\"]"
+      "  shots[0].turntable.steps: [12]\nzip: [\"shots[0].turntable.steps\", backend]"
       "\nbackend: [preview, dali]\nmesure: [eval]\n",
       "s.yaml", diag));
   const std::string text = all_diagnostics(diag);
@@ -122,6 +121,29 @@ TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
   capture(other);
   EXPECT_FALSE(parse_sweep_text("rigc: 1\n", "s.yaml", other));
   EXPECT_NE(all_diagnostics(other).find("starts with `rigc-sweep: 1`"), std::string::npos);
+}
+
+// Six configurations that are no grid: the zipped axes repeat values, their tuples do not.
+TEST(SweepFile, ZippedAxesMayRepeatAValueButNotAConfiguration) {
+  const std::string head =
+      "rigc-sweep: 1\nscene: a.yaml\nvary:\n  camera.exposure.aperture: [f/8, f/13, f/13]\n"
+      "  shots[0].turntable.steps: ";
+  const std::string zip = "\nzip: [camera.exposure.aperture, \"shots[0].turntable.steps\"]\n";
+  DiagnosticEngine diag;
+  capture(diag);
+  const auto spec = parse_sweep_text(head + "[18, 12, 36]" + zip, "s.yaml", diag);
+  ASSERT_TRUE(spec) << all_diagnostics(diag);
+  const auto variants = expand_variants(*spec);
+  ASSERT_EQ(variants.size(), 3u);
+  EXPECT_EQ(variants[2].name, "aperture-f-13_steps-36");
+
+  DiagnosticEngine twice;
+  capture(twice);
+  EXPECT_FALSE(parse_sweep_text(head + "[18, 36, 36]" + zip, "s.yaml", twice));
+  EXPECT_NE(
+      all_diagnostics(twice).find("s.yaml:4:41: the zipped values (f/13, 36) are given twice"),
+      std::string::npos)
+      << all_diagnostics(twice);
 }
 
 // A Cycles sweep at fewer samples than a final render: the count reaches every variant's render
