@@ -71,7 +71,7 @@ run_harness() {
 # One line per harness: executions, corpus, findings (new files in tests/fuzz_regressions/).
 summarize() {
   local h=$1 log=$build/fuzz-logs/$1.log status
-  status=$(grep -E '^#[0-9]+' "$log" | tail -n 1 || true)
+  status=$(grep -oE '#[0-9]+: cov: .*' "$log" | tail -n 1 || true)
   local found=0
   for f in "$build/fuzz-artifacts/$h"/*; do
     [[ -f $f ]] || continue
