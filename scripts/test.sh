@@ -12,13 +12,12 @@ trap '"${sudo_cmd[@]}" bash scripts/slurm_cluster.sh stop' EXIT
 export SLURM_CONF=${RIGC_SLURM_DIR:-/tmp/rigc-slurm}/slurm.conf
 # Tools are installed by setup.sh, so a test that would skip for a missing tool fails here.
 RIGC_REQUIRE_TOOLS=1 ctest --test-dir build --output-on-failure -j "$(nproc)"
-# The suite under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/, GCC: docs/fuzzing.md).
-# RIGC_SANITIZE_TESTS says how much of it: `0` (the default) none; `fast` the tests labelled fast;
-# `1` every label but slow-external, then every fuzz harness for a few seconds over its corpus and
-# the regression inputs (build-fuzz/, clang). RIGC_SANITIZE_LABELS=REGEX runs those labels instead.
-# Opt-in until one whole sanitizer run has passed (docs/fuzzing.md: "What the sanitizer build
-# costs").
-sanitize=${RIGC_SANITIZE_TESTS:-0}
+# The suite under AddressSanitizer + UndefinedBehaviorSanitizer, then a short fuzz run: one clang
+# build serves both (build-fuzz/, RIGC_FUZZ=ON: docs/fuzzing.md). RIGC_SANITIZE_TESTS says how
+# much: `fast` (the default) the tests labelled fast, then every fuzz harness for 5 s over its
+# corpus and the regression inputs; `1` every label but slow-external, then the same fuzz run;
+# `0` neither. RIGC_SANITIZE_LABELS=REGEX runs those labels instead.
+sanitize=${RIGC_SANITIZE_TESTS:-fast}
 case $sanitize in
   0) exit 0 ;;
   fast) labels=${RIGC_SANITIZE_LABELS:-fast} ;;
@@ -30,11 +29,13 @@ case $sanitize in
 esac
 launcher=()
 if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRIGC_SANITIZE=ON \
-  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" "${launcher[@]}" >/dev/null
-cmake --build build-asan -j "$(nproc)" --target rigc_tests
+# The same configuration as scripts/fuzz.sh, which then builds only its harnesses.
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only -DNDEBUG" -DRIGC_FUZZ=ON \
+  "${launcher[@]}" >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target rigc_tests rigc
 ASAN_OPTIONS=abort_on_error=1 LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 RIGC_REQUIRE_TOOLS=1 \
-  ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -LE slow-external \
+  ctest --test-dir build-fuzz --output-on-failure -j "$(nproc)" -LE slow-external \
   ${labels:+-L "$labels"}
-if [[ $sanitize == 1 ]]; then bash scripts/fuzz.sh 5; fi
+bash scripts/fuzz.sh 5
