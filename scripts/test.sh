@@ -14,10 +14,10 @@ export SLURM_CONF=${RIGC_SLURM_DIR:-/tmp/rigc-slurm}/slurm.conf
 RIGC_REQUIRE_TOOLS=1 ctest --test-dir build --output-on-failure -j "$(nproc)"
 # The suite under AddressSanitizer + UndefinedBehaviorSanitizer, then a short fuzz run: one clang
 # build serves both (build-fuzz/, RIGC_FUZZ=ON: docs/fuzzing.md). RIGC_SANITIZE_TESTS says how
-# much: `fast` (the default) the tests labelled fast, then every fuzz harness for 5 s over its
-# corpus and the regression inputs; `1` every label but slow-external, then the same fuzz run;
-# `0` neither. RIGC_SANITIZE_LABELS=REGEX runs those labels instead.
-sanitize=${RIGC_SANITIZE_TESTS:-fast}
+# much: `1` (the default) every label but slow-external, then every fuzz harness for 5 s over its
+# corpus and the regression inputs; `fast` the tests labelled fast, then the same fuzz run; `0`
+# neither. RIGC_SANITIZE_LABELS=REGEX runs those labels instead.
+sanitize=${RIGC_SANITIZE_TESTS:-1}
 case $sanitize in
   0) exit 0 ;;
   fast) labels=${RIGC_SANITIZE_LABELS:-fast} ;;
