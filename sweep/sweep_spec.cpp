@@ -100,26 +100,33 @@ void read_zip(const YAML::Node& node, const std::string& file, SweepSpec& spec,
   if (group.size() >= 2) spec.zip_groups.push_back(group);
 }
 
+// The node as one number of type T within [low, high], or nullopt.
+template <typename T>
+std::optional<T> number_within(const YAML::Node& node, T low, T high) {
+  T value{};
+  std::istringstream in(node.IsScalar() ? node.Scalar() : "");
+  if (!(in >> value) || !in.eof() || !(value >= low && value <= high)) return std::nullopt;
+  return value;
+}
+
 void read_scale(const YAML::Node& node, const std::string& file, SweepSpec& spec,
                 DiagnosticEngine& diag) {
-  double scale = 0;
-  std::istringstream in(node.IsScalar() ? node.Scalar() : "");
-  if (!(in >> scale) || !in.eof() || !(scale >= 0.01 && scale <= 4.0)) {
+  const auto scale = number_within(node, 0.01, 4.0);
+  if (!scale) {
     diag.error(loc_of(node, file), "scale: must be a number within 0.01..4");
     return;
   }
-  spec.scale = scale;
+  spec.scale = *scale;
 }
 
 void read_samples(const YAML::Node& node, const std::string& file, SweepSpec& spec,
                   DiagnosticEngine& diag) {
-  int samples = 0;
-  std::istringstream in(node.IsScalar() ? node.Scalar() : "");
-  if (!(in >> samples) || !in.eof() || samples < 1 || samples > 65536) {
+  const auto samples = number_within(node, 1, 65536);
+  if (!samples) {
     diag.error(loc_of(node, file), "samples: must be a whole number within 1..65536");
     return;
   }
-  spec.samples = samples;
+  spec.samples = *samples;
 }
 
 void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& spec,
