@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -95,6 +96,19 @@ TEST(CliSweep, AFailingVariantIsReportedAndTheOthersComplete) {
                           "--scale", "0.05", "-o", out, "--status"});
   EXPECT_NE(status.out.find("steps-4"), std::string::npos);
   EXPECT_NE(status.out.find("1/2 variants done"), std::string::npos) << status.out;
+}
+
+// The sweep's samples reach each variant's render, which records them in its manifest (POV-Ray:
+// the preview takes none).
+TEST(CliSweepPovray, SamplesReachEachVariantsRender) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::string out = dir.file("out");
+  auto result = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "shots[0].turntable.steps=3",
+                          "--backend", "povray", "--scale", "0.05", "--samples", "3", "-o", out});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto manifest = nlohmann::json::parse(read_text(out + "/steps-3/manifest.json"));
+  EXPECT_EQ(manifest.at("inputs").at("samples"), 3) << manifest.dump();
 }
 
 // sweep registered no inputs: a scene file named like one of its outputs was written over.
