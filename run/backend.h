@@ -51,6 +51,9 @@ class Backend {
   virtual bool emits_scripts() const { return false; }
   // Whether RenderSettings::samples changes its output (then it is part of the shot key).
   virtual bool takes_samples() const { return false; }
+  // The backend's own options that change its output, as text for the shot key ("" when none
+  // differs from the default).
+  virtual std::string options_key() const { return ""; }
 
   // Checked before anything is written: e.g. that the external program is installed. False with
   // a one-line `error` naming what to install.

@@ -165,8 +165,10 @@ bool RunLoop::open_run_folder() {
 }
 
 std::string RunLoop::key_of(const ir::Shot& shot) const {
-  const std::string extra =
-      backend_.takes_samples() ? fmt::format("samples={}", settings_.samples) : "";
+  std::string extra = backend_.takes_samples() ? fmt::format("samples={}", settings_.samples) : "";
+  if (const std::string options = backend_.options_key(); !options.empty()) {
+    extra += (extra.empty() ? "" : ";") + options;
+  }
   return shot_key(scene_, content_hash_, shot, backend_.name(), settings_.scale, settings_.seed,
                   extra);
 }

@@ -198,6 +198,14 @@ std::string script_text(const json& data) {
 
 }  // namespace
 
+std::string CyclesBackend::options_key() const {
+  std::string key = albedo_only ? "albedo_only" : "";
+  if (max_bounces != kDefaultMaxBounces) {
+    key += fmt::format("{}max_bounces={}", key.empty() ? "" : ";", max_bounces);
+  }
+  return key;
+}
+
 bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studio,
                          const fs::path& dir, const run::RenderSettings& settings,
                          std::string* error) {
@@ -253,6 +261,7 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
                    {"amplitudes", nz::kAmplitudes},
                    {"amplitude_sum", nz::kAmplitudeSum}};
   data["albedo_only"] = albedo_only;
+  data["max_bounces"] = max_bounces;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     if (!write_linear_texture(dir / texture_file_name(static_cast<int>(t)), scene.textures[t],
                               error)) {

@@ -27,6 +27,11 @@ class CyclesBackend : public external::ExternalBackend {
   // texture x pattern, no lights or world) instead of the lit image: for the albedo agreement
   // test.
   bool albedo_only = false;
+  // Cycles' light paths: 0 renders direct light only (no inter-reflection), for the benchmark
+  // that weighs what the preview's lack of indirect light costs (bench/ablation_table.cpp).
+  static constexpr int kDefaultMaxBounces = 8;
+  int max_bounces = kDefaultMaxBounces;
+  std::string options_key() const override;
   // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
   // the script's default Cycles sample count (0: 64).
   bool emit(const ir::Scene& scene, const scene::StudioScene& studio,

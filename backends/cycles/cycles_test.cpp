@@ -52,6 +52,25 @@ TEST(CyclesEmit, ScriptCarriesUserTextOnlyAsEscapedData) {
   EXPECT_TRUE(fs::exists(dir.path() / "cycles" / "geometry.bin"));
 }
 
+// Direct light only reaches the script, and the shot keys: a run folder never mixes the two.
+TEST(CyclesEmit, MaxBouncesReachTheScriptAndTheShotKey) {
+  TempDir dir;
+  const ir::Scene scene = hostile_scene(dir);
+  CyclesBackend direct;
+  direct.max_bounces = 0;
+  run::RenderSettings settings;
+  settings.scale = 0.02;
+  std::string error;
+  ASSERT_TRUE(direct.emit(scene, scene::prepare_studio_scene(scene), dir.path() / "direct",
+                          settings, &error))
+      << error;
+  const std::string script = read_text((dir.path() / "direct" / "scene.py").string());
+  EXPECT_NE(script.find(R"(\"max_bounces\":0)"), std::string::npos);
+  EXPECT_NE(script.find(R"(DATA["max_bounces"])"), std::string::npos);
+  EXPECT_EQ(CyclesBackend().options_key(), "");
+  EXPECT_EQ(direct.options_key(), "max_bounces=0");
+}
+
 TEST(CyclesRun, MissingExecutableNamesThePackage) {
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);

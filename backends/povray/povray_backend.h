@@ -32,6 +32,7 @@ class PovrayBackend : public external::ExternalBackend {
   // Emits shots that render the unlit albedo (every surface its own pigment at ambient 1, no
   // lights) instead of the lit image: for the albedo agreement test.
   bool albedo_only = false;
+  std::string options_key() const override { return albedo_only ? "albedo_only" : ""; }
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
   // samples (0: defaults).

@@ -78,7 +78,7 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
-  *out = render_linear(scene, studio, shot, settings.scale);
+  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface);
   return true;
 }
 

@@ -19,6 +19,10 @@ namespace rigc::preview {
 class PreviewBackend : public run::Backend {
  public:
   std::string name() const override { return "preview"; }
+  // Point-samples textures and patterns as the studio's drafts do: for the benchmark that weighs
+  // what the surface filter does to a reconstruction (bench/ablation_table.cpp).
+  bool draft_surface = false;
+  std::string options_key() const override { return draft_surface ? "draft_surface" : ""; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;

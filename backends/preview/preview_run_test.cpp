@@ -68,6 +68,21 @@ TEST(PreviewRun, RunWritesTheLayoutAndResumes) {
   EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
 }
 
+// Point-sampled shots have keys of their own: the filtered ones are rendered again over them.
+TEST(PreviewRun, PointSampledShotsAreNotTakenForFilteredOnes) {
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(2, "180deg");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  PreviewBackend point_sampled;
+  point_sampled.draft_surface = true;
+  ASSERT_EQ(run::run_backend(scene, point_sampled, options, log), 0) << log.str();
+  std::vector<run::ShotTiming> timings;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0) << log.str();
+  ASSERT_EQ(timings.size(), 2u);
+  for (const auto& t : timings) EXPECT_FALSE(t.skipped);
+}
+
 // A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
 // rerun after the scene lost shots, or changed its image format, removes what it no longer makes.
 TEST(PreviewRun, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
