@@ -1,0 +1,160 @@
+// What each way the preview differs from Cycles does to a reconstruction (issue #34, item 3;
+// measured, not asserted). One scene rendered four ways, each reconstructed RUNS times (COLMAP is
+// not deterministic):
+//   preview           as `rigc render` renders it
+//   preview-point     its textures and patterns point-sampled (no surface filter)
+//   cycles            the reference, at SAMPLES samples a pixel
+//   cycles-direct     the reference without inter-reflection (direct light only), which the
+//                     preview does not model
+// Renders resume and COLMAP models are reused, so a rerun only measures again.
+// Usage: ablation_table [OUT_DIR] [--scene FILE] [--scale S] [--samples N] [--runs N]
+//                       [--only NAME[,NAME...]]
+#include <fmt/format.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "backends/cycles/cycles_backend.h"
+#include "backends/preview/preview_backend.h"
+#include "compiler/frontend.h"
+#include "eval/eval.h"
+#include "io/allocator.h"
+#include "run/manifest.h"
+#include "run/run_loop.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Way {
+  std::string name;
+  std::function<std::unique_ptr<rigc::run::Backend>()> make;
+};
+
+std::vector<Way> ways() {
+  return {
+      {"preview", [] { return std::make_unique<rigc::preview::PreviewBackend>(); }},
+      {"preview-point",
+       [] {
+         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
+         backend->draft_surface = true;
+         return backend;
+       }},
+      {"cycles", [] { return std::make_unique<rigc::cycles::CyclesBackend>(); }},
+      {"cycles-direct",
+       [] {
+         auto backend = std::make_unique<rigc::cycles::CyclesBackend>();
+         backend->max_bounces = 0;
+         return backend;
+       }},
+  };
+}
+
+struct Args {
+  fs::path out = "out/ablation-table";
+  std::string scene = "scenes/paper-turntable.yaml";
+  double scale = 0.25;
+  int samples = 16;
+  int runs = 2;
+  std::string only;
+};
+
+Args parse_args(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
+    if (!std::strcmp(argv[i], "--scene") && has_value) {
+      args.scene = argv[++i];
+    } else if (!std::strcmp(argv[i], "--scale") && has_value) {
+      args.scale = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--samples") && has_value) {
+      args.samples = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--runs") && has_value) {
+      args.runs = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--only") && has_value) {
+      args.only = argv[++i];
+    } else {
+      args.out = argv[i];
+    }
+  }
+  return args;
+}
+
+bool wanted(const Args& args, const std::string& name) {
+  if (args.only.empty()) return true;
+  std::stringstream list(args.only);
+  for (std::string item; std::getline(list, item, ',');) {
+    if (item == name) return true;
+  }
+  return false;
+}
+
+// Renders the scene one way into `dir`; the seconds the renders took, or a negative on failure.
+double render(const rigc::ir::Scene& scene, const Way& way, const Args& args, const fs::path& dir) {
+  rigc::run::RunOptions options;
+  options.output_dir = dir;
+  options.settings.scale = args.scale;
+  options.settings.samples = args.samples;
+  std::ofstream log(dir.string() + "-render.log");
+  const int code = rigc::run::run_backend(scene, *way.make(), options, log);
+  if (code != 0) return -1;
+  const auto manifest = rigc::run::Manifest::load(dir / "manifest.json");
+  double ms = 0;
+  for (const auto& [name, shot] : manifest.shots()) ms += shot.render_ms;
+  return ms / 1000;
+}
+
+void print_eval_row(const std::string& name, double render_s, int run, const Args& args,
+                    const fs::path& dir) {
+  rigc::eval::EvalOptions options;
+  options.run_dir = dir.string();
+  options.scene = args.scene;
+  options.output_dir = (dir / fmt::format("eval{}", run)).string();
+  options.reuse_colmap = true;
+  options.quiet = true;
+  std::ofstream log(options.output_dir + ".log");
+  rigc::eval::EvalSummary summary;
+  const int code = rigc::eval::evaluate(options, log, &summary);
+  if (code != 0 || !summary.reconstructed) {
+    fmt::print("{:<14} {:>8.0f} {:>4}  failed: {} (see {}.log)\n", name, render_s, run,
+               summary.failure, options.output_dir);
+    return;
+  }
+  fmt::print("{:<14} {:>8.0f} {:>4} {:>5}/{:<3} {:>7} {:>+8.3f} ± {:.3f} {:>7.3f}\n", name,
+             render_s, run, summary.registered, summary.images, summary.points, summary.mean_mm,
+             summary.std_mm, summary.fscore);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  rigc::keep_freed_memory();  // as the rigc command does
+  const Args args = parse_args(argc, argv);
+  rigc::DiagnosticEngine diag;
+  const auto scene = rigc::compile_scene_file(args.scene, diag);
+  if (!scene) return 1;
+  fs::create_directories(args.out);
+  fmt::print("{} at scale {}, Cycles at {} samples a pixel, {} evaluations each\n", scene->name,
+             args.scale, args.samples, args.runs);
+  fmt::print("{:<14} {:>8} {:>4} {:>9} {:>7} {:>16} {:>7}\n", "way", "render s", "eval",
+             "registered", "points", "mean ± std (mm)", "F(1mm)");
+  for (const Way& way : ways()) {
+    if (!wanted(args, way.name)) continue;
+    const fs::path dir = args.out / way.name;
+    const double render_s = render(*scene, way, args, dir);
+    if (render_s < 0) {
+      fmt::print("{:<14} render failed (see {}-render.log)\n", way.name, dir.string());
+      continue;
+    }
+    for (int run = 1; run <= args.runs; ++run) print_eval_row(way.name, render_s, run, args, dir);
+    std::fflush(stdout);
+  }
+  return 0;
+}
