@@ -1,8 +1,10 @@
 // What each way the preview differs from Cycles does to a reconstruction (issue #34, item 3;
-// measured, not asserted). One scene rendered four ways, each reconstructed RUNS times (COLMAP is
+// measured, not asserted). One scene rendered six ways, each reconstructed RUNS times (COLMAP is
 // not deterministic):
 //   preview           as `rigc render` renders it
 //   preview-point     its textures and patterns point-sampled (no surface filter)
+//   preview-2x2, preview-4x4  each pixel rendered as 2 x 2 or 4 x 4 pixels averaged (shading
+//                     and geometry antialiased as a reference's samples do)
 //   cycles            the reference, at SAMPLES samples a pixel
 //   cycles-direct     the reference without inter-reflection (direct light only), which the
 //                     preview does not model
@@ -38,6 +40,12 @@ struct Way {
   std::function<std::unique_ptr<rigc::run::Backend>()> make;
 };
 
+std::unique_ptr<rigc::run::Backend> supersampled_preview(int side) {
+  auto backend = std::make_unique<rigc::preview::PreviewBackend>();
+  backend->supersample = side;
+  return backend;
+}
+
 std::vector<Way> ways() {
   return {
       {"preview", [] { return std::make_unique<rigc::preview::PreviewBackend>(); }},
@@ -47,6 +55,8 @@ std::vector<Way> ways() {
          backend->draft_surface = true;
          return backend;
        }},
+      {"preview-2x2", [] { return supersampled_preview(2); }},
+      {"preview-4x4", [] { return supersampled_preview(4); }},
       {"cycles", [] { return std::make_unique<rigc::cycles::CyclesBackend>(); }},
       {"cycles-direct",
        [] {

@@ -1,7 +1,10 @@
 #include "backends/preview/preview_backend.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "dslr/lens.h"
 #include "raster/rasterizer.h"
@@ -38,17 +41,61 @@ dslr::LinearFrame render_motion_blurred(const ir::Scene& scene, const scene::Stu
   return frame;
 }
 
+// The frame `factor` times smaller on each side: radiance averaged, the nearest depth kept (the
+// depth of field blurs a pixel by its foreground), the mask set where most samples were object.
+dslr::LinearFrame box_downsample(const dslr::LinearFrame& fine, int factor,
+                                 const dslr::Intrinsics& canvas) {
+  dslr::LinearFrame out;
+  out.set_intrinsics(canvas);
+  out.rgb_clean = fine.rgb_clean;
+  const std::size_t pixels = static_cast<std::size_t>(canvas.width) * canvas.height;
+  out.rgb.assign(3 * pixels, 0.0f);
+  out.depth_m.assign(pixels, std::numeric_limits<float>::infinity());
+  if (!fine.mask.empty()) out.mask.assign(pixels, 0);
+  const float weight = 1.0f / static_cast<float>(factor * factor);
+  for (int y = 0; y < canvas.height; ++y) {
+    for (int x = 0; x < canvas.width; ++x) {
+      const std::size_t o = static_cast<std::size_t>(y) * canvas.width + x;
+      int object_samples = 0;
+      for (int sy = 0; sy < factor; ++sy) {
+        for (int sx = 0; sx < factor; ++sx) {
+          const std::size_t i = static_cast<std::size_t>(y * factor + sy) * fine.width +
+                                static_cast<std::size_t>(x * factor + sx);
+          for (int c = 0; c < 3; ++c) out.rgb[3 * o + c] += weight * fine.rgb[3 * i + c];
+          out.depth_m[o] = std::min(out.depth_m[o], fine.depth_m[i]);
+          if (!fine.mask.empty() && fine.mask[i] != 0) ++object_samples;
+        }
+      }
+      if (!out.mask.empty() && 2 * object_samples >= factor * factor) out.mask[o] = 255;
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+std::string PreviewBackend::options_key() const {
+  std::string key = draft_surface ? "draft_surface" : "";
+  if (supersample != 1) key += fmt::format("{}supersample={}", key.empty() ? "" : ";", supersample);
+  return key;
+}
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
-                                raster::ShadowMapCache* shadow_cache, bool draft_surface) {
+                                raster::ShadowMapCache* shadow_cache, bool draft_surface,
+                                int supersample) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   raster::FrameRequest request;
   request.draft_surface = draft_surface;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
-  request.shadow_map_size = std::clamp(geometry.width / 2, 512, 2048);
+  request.canvas.width *= supersample;
+  request.canvas.height *= supersample;
+  for (double* v :
+       {&request.canvas.fx, &request.canvas.fy, &request.canvas.cx, &request.canvas.cy}) {
+    *v *= supersample;
+  }
+  request.shadow_map_size = std::clamp(request.canvas.width / 2, 512, 2048);
   run::RenderedShot out;
   out.subframes = scene::motion_blur_subframes(scene, studio, shot, scale);
   raster::RasterTimings timings;
@@ -58,6 +105,7 @@ run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene
   } else {
     out.frame = render_motion_blurred(scene, studio, shot, out.subframes, request, &timings);
   }
+  if (supersample > 1) out.frame = box_downsample(out.frame, supersample, geometry);
   out.stage_ms = {{"shadows", timings.shadow_ms},
                   {"setup", timings.setup_ms},
                   {"raster_and_shading", timings.raster_ms}};
@@ -78,7 +126,7 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
-  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface);
+  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface, supersample);
   return true;
 }
 

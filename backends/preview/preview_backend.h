@@ -22,7 +22,11 @@ class PreviewBackend : public run::Backend {
   // Point-samples textures and patterns as the studio's drafts do: for the benchmark that weighs
   // what the surface filter does to a reconstruction (bench/ablation_table.cpp).
   bool draft_surface = false;
-  std::string options_key() const override { return draft_surface ? "draft_surface" : ""; }
+  // Renders each pixel as supersample x supersample pixels averaged (shading, geometry and surface
+  // sampled that much finer): for the same benchmark, to weigh the preview's one shading point a
+  // pixel against a reference's many samples.
+  int supersample = 1;
+  std::string options_key() const override;
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
@@ -34,7 +38,7 @@ class PreviewBackend : public run::Backend {
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache = nullptr,
-                                bool draft_surface = false);
+                                bool draft_surface = false, int supersample = 1);
 
 // The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
 // lights, shadows or motion blur.

@@ -137,6 +137,36 @@ TEST(Preview, AbsoluteSignalMatchesTheExposureEquation) {
 }
 
 // The streak of a ball on a turning table is ω·t·R·f/Z pixels longer than the ball.
+// A supersampled frame is the same picture at the same size: the object in the same place and as
+// bright, its edges averaged from the finer samples.
+TEST(Preview, SupersampledFramesKeepTheirPlaceSizeAndBrightness) {
+  const ir::Scene scene = turntable_ball(1, "0deg");
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  const run::RenderedShot plain = render_linear(scene, studio, scene.shots[0], 0.1);
+  const run::RenderedShot fine =
+      render_linear(scene, studio, scene.shots[0], 0.1, nullptr, false, 3);
+  const dslr::LinearFrame &a = plain.frame, &b = fine.frame;
+  ASSERT_EQ(b.width, a.width);
+  ASSERT_EQ(b.height, a.height);
+  EXPECT_EQ(b.fx, a.fx);
+  EXPECT_EQ(b.cx, a.cx);
+  ASSERT_EQ(b.mask.size(), a.mask.size());
+  ASSERT_EQ(b.depth_m.size(), a.depth_m.size());
+  int both = 0, either = 0;
+  double sum_a = 0, sum_b = 0;
+  for (std::size_t i = 0; i < a.mask.size(); ++i) {
+    both += a.mask[i] && b.mask[i];
+    either += a.mask[i] || b.mask[i];
+    for (int c = 0; c < 3; ++c) {
+      sum_a += a.rgb[3 * i + c];
+      sum_b += b.rgb[3 * i + c];
+    }
+  }
+  ASSERT_GT(both, 100);
+  EXPECT_GT(static_cast<double>(both) / either, 0.97);
+  EXPECT_NEAR(sum_b / sum_a, 1.0, 0.02);
+}
+
 TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
   auto extent = [](const std::string& speed) {
     ir::Scene scene = compile(ball_scene("}",
