@@ -1,10 +1,12 @@
 // What each way the preview differs from Cycles does to a reconstruction (issue #34, item 3;
-// measured, not asserted). One scene rendered six ways, each reconstructed RUNS times (COLMAP is
+// measured, not asserted). One scene rendered eight ways, each reconstructed RUNS times (COLMAP is
 // not deterministic):
 //   preview           as `rigc render` renders it
 //   preview-point     its textures and patterns point-sampled (no surface filter)
 //   preview-2x2, preview-4x4  each pixel rendered as 2 x 2 or 4 x 4 pixels averaged (shading
 //                     and geometry antialiased as a reference's samples do)
+//   preview-hard-shadows  its area lights casting hard shadows (its penumbra filter left out)
+//   preview-no-specular   without the lights' specular lobe
 //   cycles            the reference, at SAMPLES samples a pixel
 //   cycles-direct     the reference without inter-reflection (direct light only), which the
 //                     preview does not model
@@ -38,7 +40,17 @@ namespace fs = std::filesystem;
 struct Way {
   std::string name;
   std::function<std::unique_ptr<rigc::run::Backend>()> make;
+  std::function<void(rigc::ir::Scene&)> edit = nullptr;  // of the scene it renders, if set
+
+  Way(std::string way_name, std::function<std::unique_ptr<rigc::run::Backend>()> make_backend,
+      std::function<void(rigc::ir::Scene&)> edit_scene = nullptr)
+      : name(std::move(way_name)), make(std::move(make_backend)), edit(std::move(edit_scene)) {}
 };
+
+// Area lights of no size: their shadows are hard (their size only sets the preview's penumbrae).
+void point_like_lights(rigc::ir::Scene& scene) {
+  for (rigc::ir::Light& light : scene.studio.lights) light.size_m = rigc::ir::Vec2::Zero();
+}
 
 std::unique_ptr<rigc::run::Backend> supersampled_preview(int side) {
   auto backend = std::make_unique<rigc::preview::PreviewBackend>();
@@ -57,6 +69,14 @@ std::vector<Way> ways() {
        }},
       {"preview-2x2", [] { return supersampled_preview(2); }},
       {"preview-4x4", [] { return supersampled_preview(4); }},
+      {"preview-hard-shadows", [] { return std::make_unique<rigc::preview::PreviewBackend>(); },
+       point_like_lights},
+      {"preview-no-specular",
+       [] {
+         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
+         backend->specular = false;
+         return backend;
+       }},
       {"cycles", [] { return std::make_unique<rigc::cycles::CyclesBackend>(); }},
       {"cycles-direct",
        [] {
@@ -113,7 +133,9 @@ double render(const rigc::ir::Scene& scene, const Way& way, const Args& args, co
   options.settings.scale = args.scale;
   options.settings.samples = args.samples;
   std::ofstream log(dir.string() + "-render.log");
-  const int code = rigc::run::run_backend(scene, *way.make(), options, log);
+  rigc::ir::Scene edited = scene;
+  if (way.edit) way.edit(edited);
+  const int code = rigc::run::run_backend(edited, *way.make(), options, log);
   if (code != 0) return -1;
   const auto manifest = rigc::run::Manifest::load(dir / "manifest.json");
   double ms = 0;

@@ -217,7 +217,7 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
                      material.roughness, f0, &fresnel);
     const Vector3f arriving = sample.illuminance * (n_dot_l * visibility);
     diffuse += arriving * ((1 - fresnel) / kPi);
-    specular_sum += arriving * specular;
+    if (request_.specular) specular_sum += arriving * specular;
   }
   // brdf = albedo·(1 - metallic)·(1 - F)/π + spec_colour·specular, where the specular colour
   // is white for dielectrics and blends towards the albedo with the metallic factor.

@@ -31,6 +31,9 @@ struct FrameRequest {
   // still fades to its mean where too fine) instead of box-filtered over the pixel: the
   // studio's frames while the camera moves.
   bool draft_surface = false;
+  // False leaves the lights' specular lobe out (the diffuse part is unchanged): for the benchmark
+  // that weighs what the specular response does to a reconstruction (bench/ablation_table.cpp).
+  bool specular = true;
 };
 
 struct RasterTimings {

@@ -77,16 +77,18 @@ dslr::LinearFrame box_downsample(const dslr::LinearFrame& fine, int factor,
 std::string PreviewBackend::options_key() const {
   std::string key = draft_surface ? "draft_surface" : "";
   if (supersample != 1) key += fmt::format("{}supersample={}", key.empty() ? "" : ";", supersample);
+  if (!specular) key += key.empty() ? "no_specular" : ";no_specular";
   return key;
 }
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache, bool draft_surface,
-                                int supersample) {
+                                int supersample, bool specular) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   raster::FrameRequest request;
   request.draft_surface = draft_surface;
+  request.specular = specular;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
   request.canvas.width *= supersample;
@@ -126,7 +128,8 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
-  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface, supersample);
+  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface, supersample,
+                       specular);
   return true;
 }
 

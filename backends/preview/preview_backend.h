@@ -26,6 +26,8 @@ class PreviewBackend : public run::Backend {
   // sampled that much finer): for the same benchmark, to weigh the preview's one shading point a
   // pixel against a reference's many samples.
   int supersample = 1;
+  // False leaves the lights' specular lobe out (raster::FrameRequest::specular).
+  bool specular = true;
   std::string options_key() const override;
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
@@ -38,7 +40,8 @@ class PreviewBackend : public run::Backend {
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache = nullptr,
-                                bool draft_surface = false, int supersample = 1);
+                                bool draft_surface = false, int supersample = 1,
+                                bool specular = true);
 
 // The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
 // lights, shadows or motion blur.

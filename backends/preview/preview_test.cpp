@@ -167,6 +167,28 @@ TEST(Preview, SupersampledFramesKeepTheirPlaceSizeAndBrightness) {
   EXPECT_NEAR(sum_b / sum_a, 1.0, 0.02);
 }
 
+// Without the specular lobe the lit statue loses light, and no pixel gets brighter but a few
+// where the choice between a quad's shared lighting and per-pixel lighting went the other way.
+TEST(Preview, LeavingSpecularOutOnlyTakesLightAway) {
+  const ir::Scene scene = testing::paper_scene();
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  const auto lit = render_linear(scene, studio, scene.shots[0], 0.05).frame;
+  const auto diffuse =
+      render_linear(scene, studio, scene.shots[0], 0.05, nullptr, false, 1, false).frame;
+  ASSERT_EQ(lit.rgb.size(), diffuse.rgb.size());
+  double lit_sum = 0, diffuse_sum = 0;
+  int brighter = 0, values = 0;
+  for (std::size_t i = 0; i < lit.rgb.size(); ++i) {
+    if (!lit.mask[i / 3]) continue;
+    lit_sum += lit.rgb[i];
+    diffuse_sum += diffuse.rgb[i];
+    ++values;
+    brighter += diffuse.rgb[i] > lit.rgb[i] * 1.02f;
+  }
+  EXPECT_LT(brighter, values / 500) << values;
+  EXPECT_LT(diffuse_sum, 0.99 * lit_sum) << diffuse_sum << " " << lit_sum;
+}
+
 TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
   auto extent = [](const std::string& speed) {
     ir::Scene scene = compile(ball_scene("}",
