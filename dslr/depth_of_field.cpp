@@ -569,7 +569,7 @@ DepthOfFieldLevel::DepthOfFieldLevel(const LevelInput& in)
   const double f = in.camera.focal_length_m, f_number = in.camera.aperture_f_number;
   radius_at_.radius_at_infinity = static_cast<float>(
       0.5 *
-      coc_diameter_m(f, f_number, in.focus_distance_m, std::numeric_limits<double>::infinity()) *
+      coc_in_image_m(f, f_number, in.focus_distance_m, std::numeric_limits<double>::infinity()) *
       in.canvas.fx / f);
   radius_at_.focus = static_cast<float>(in.focus_distance_m);
   for (int k = 0; k < in.level; ++k) radius_at_.removed_radius_sq += std::ldexp(1.0f, -2 * k);

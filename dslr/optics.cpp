@@ -12,6 +12,12 @@ double coc_diameter_m(double focal_length_m, double f_number, double focus_m, do
   return aperture * f * relative / (focus_m - f);
 }
 
+double coc_in_image_m(double focal_length_m, double f_number, double focus_m, double depth_m) {
+  if (!(focus_m > focal_length_m)) return 0;
+  return coc_diameter_m(focal_length_m, f_number, focus_m, depth_m) * (focus_m - focal_length_m) /
+         focus_m;
+}
+
 double hyperfocal_m(double focal_length_m, double f_number, double coc_m) {
   return focal_length_m * focal_length_m / (f_number * coc_m) + focal_length_m;
 }

@@ -12,6 +12,12 @@ namespace rigc::dslr {
 // (f/N)·f/(S1 - f). Zero when the focus is inside the focal length (not a real focus).
 double coc_diameter_m(double focal_length_m, double f_number, double focus_m, double depth_m);
 
+// The same circle in the picture the renderers make, a pinhole of focal length f (no focus
+// breathing): the sensor's circle times f/v = (S1 - f)/S1, c' = (f/N)·f·|S2 - S1| / (S2·S1). A real
+// lens focused at S1 images at v = f·S1/(S1 - f), a picture v/f larger with the blur c; Cycles'
+// lens renders c'. Zero where coc_diameter_m is.
+double coc_in_image_m(double focal_length_m, double f_number, double focus_m, double depth_m);
+
 // Hyperfocal distance H = f²/(N·c0) + f.
 double hyperfocal_m(double focal_length_m, double f_number, double coc_m);
 

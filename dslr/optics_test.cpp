@@ -88,6 +88,10 @@ TEST(DslrDepthOfField, CircleOfConfusionFollowsTheThinLens) {
   EXPECT_NEAR(coc_diameter_m(0.05, 2.8, 0.8, 2.0), 0.05 / 2.8 * 0.05 * 1.2 / (2.0 * 0.75), 1e-12);
   EXPECT_NEAR(coc_diameter_m(0.05, 8, 0.8, INFINITY), 0.05 / 8 * 0.05 / 0.75, 1e-12);
   EXPECT_EQ(coc_diameter_m(0.05, 8, 0.8, 0.8), 0);
+  // In the pinhole picture: (S1 - f)/S1 of it, (f/N)·f·|S2 - S1|/(S2·S1).
+  EXPECT_NEAR(coc_in_image_m(0.05, 2.8, 0.8, 2.0), 0.05 / 2.8 * 0.05 * 1.2 / (2.0 * 0.8), 1e-12);
+  EXPECT_EQ(coc_in_image_m(0.05, 8, 0.04, 2.0), 0);
+  EXPECT_EQ(coc_in_image_m(0.05, 8, 0, 2.0), 0);
   EXPECT_NEAR(hyperfocal_m(0.05, 8, 0.03e-3), 0.0025 / (8 * 0.03e-3) + 0.05, 1e-9);
   // At the hyperfocal distance, infinity is blurred by exactly c0.
   EXPECT_NEAR(coc_diameter_m(0.05, 8, hyperfocal_m(0.05, 8, 0.03e-3), INFINITY), 0.03e-3, 1e-9);
@@ -222,7 +226,7 @@ TEST(DslrDepthOfField, BlurredForegroundSpreadsOverASharpBackground) {
     }
   }
   const double pitch_m = camera.sensor_width_m / w;
-  const double radius_px = 0.5 * coc_diameter_m(0.05, 2.8, kFocus, 0.4) / pitch_m;
+  const double radius_px = 0.5 * coc_in_image_m(0.05, 2.8, kFocus, 0.4) / pitch_m;
   ASSERT_GT(radius_px, 8);
   const DevelopResult r = develop_frame(camera, frame, {kFocus, 0, 1}, scale);
   const double peak = 1000 * exposure_scale(camera);
