@@ -1,10 +1,11 @@
 // What each way the preview differs from Cycles does to a reconstruction (issue #34, item 3;
-// measured, not asserted). One scene rendered nine ways, each reconstructed RUNS times (COLMAP is
+// measured, not asserted). One scene rendered ten ways, each reconstructed RUNS times (COLMAP is
 // not deterministic):
 //   preview           as `rigc render` renders it
 //   preview-point     its textures and patterns point-sampled (no surface filter)
 //   preview-2x2, preview-4x4  each pixel rendered as 2 x 2 or 4 x 4 pixels averaged (shading
 //                     and geometry antialiased as a reference's samples do)
+//   preview-pixel-lighting  its lights summed for every pixel, not once per 2 x 2 quad
 //   preview-hard-shadows  its area lights casting hard shadows (its penumbra filter left out)
 //   preview-no-specular   without the lights' specular lobe
 //   preview-darker    exposed 0.28 stop less: as dark as Cycles renders the paper scene's statue
@@ -77,6 +78,12 @@ std::vector<Way> ways() {
        }},
       {"preview-2x2", [] { return supersampled_preview(2); }},
       {"preview-4x4", [] { return supersampled_preview(4); }},
+      {"preview-pixel-lighting",
+       [] {
+         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
+         backend->per_pixel_lighting = true;
+         return backend;
+       }},
       {"preview-hard-shadows", [] { return std::make_unique<rigc::preview::PreviewBackend>(); },
        point_like_lights},
       {"preview-no-specular",

@@ -78,17 +78,19 @@ std::string PreviewBackend::options_key() const {
   std::string key = draft_surface ? "draft_surface" : "";
   if (supersample != 1) key += fmt::format("{}supersample={}", key.empty() ? "" : ";", supersample);
   if (!specular) key += key.empty() ? "no_specular" : ";no_specular";
+  if (per_pixel_lighting) key += key.empty() ? "per_pixel_lighting" : ";per_pixel_lighting";
   return key;
 }
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache, bool draft_surface,
-                                int supersample, bool specular) {
+                                int supersample, bool specular, bool per_pixel_lighting) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
   raster::FrameRequest request;
   request.draft_surface = draft_surface;
   request.specular = specular;
+  request.per_pixel_lighting = per_pixel_lighting;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
   request.canvas.width *= supersample;
@@ -129,7 +131,7 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
   *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface, supersample,
-                       specular);
+                       specular, per_pixel_lighting);
   return true;
 }
 

@@ -28,6 +28,9 @@ class PreviewBackend : public run::Backend {
   int supersample = 1;
   // False leaves the lights' specular lobe out (raster::FrameRequest::specular).
   bool specular = true;
+  // Lights summed for every pixel instead of once per 2 x 2 quad
+  // (raster::FrameRequest::per_pixel_lighting).
+  bool per_pixel_lighting = false;
   std::string options_key() const override;
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
@@ -41,7 +44,7 @@ run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache = nullptr,
                                 bool draft_surface = false, int supersample = 1,
-                                bool specular = true);
+                                bool specular = true, bool per_pixel_lighting = false);
 
 // The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
 // lights, shadows or motion blur.
