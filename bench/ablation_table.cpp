@@ -56,10 +56,16 @@ void point_like_lights(rigc::ir::Scene& scene) {
   for (rigc::ir::Light& light : scene.studio.lights) light.size_m = rigc::ir::Vec2::Zero();
 }
 
-std::unique_ptr<rigc::run::Backend> supersampled_preview(int side) {
-  auto backend = std::make_unique<rigc::preview::PreviewBackend>();
-  backend->supersample = side;
-  return backend;
+using MakeBackend = std::function<std::unique_ptr<rigc::run::Backend>()>;
+
+// A backend of type B with one of its options set by `set`.
+template <typename B>
+MakeBackend backend_with(std::function<void(B&)> set = nullptr) {
+  return [set] {
+    auto backend = std::make_unique<B>();
+    if (set) set(*backend);
+    return backend;
+  };
 }
 
 // 0.28 stop less light on the sensor (a shorter shutter: the scene is still).
@@ -68,39 +74,20 @@ void darker_by_cycles_gap(rigc::ir::Scene& scene) {
 }
 
 std::vector<Way> ways() {
+  using rigc::cycles::CyclesBackend;
+  using rigc::preview::PreviewBackend;
   return {
-      {"preview", [] { return std::make_unique<rigc::preview::PreviewBackend>(); }},
-      {"preview-point",
-       [] {
-         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
-         backend->draft_surface = true;
-         return backend;
-       }},
-      {"preview-2x2", [] { return supersampled_preview(2); }},
-      {"preview-4x4", [] { return supersampled_preview(4); }},
+      {"preview", backend_with<PreviewBackend>()},
+      {"preview-point", backend_with<PreviewBackend>([](auto& b) { b.draft_surface = true; })},
+      {"preview-2x2", backend_with<PreviewBackend>([](auto& b) { b.supersample = 2; })},
+      {"preview-4x4", backend_with<PreviewBackend>([](auto& b) { b.supersample = 4; })},
       {"preview-pixel-lighting",
-       [] {
-         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
-         backend->per_pixel_lighting = true;
-         return backend;
-       }},
-      {"preview-hard-shadows", [] { return std::make_unique<rigc::preview::PreviewBackend>(); },
-       point_like_lights},
-      {"preview-no-specular",
-       [] {
-         auto backend = std::make_unique<rigc::preview::PreviewBackend>();
-         backend->specular = false;
-         return backend;
-       }},
-      {"preview-darker", [] { return std::make_unique<rigc::preview::PreviewBackend>(); },
-       darker_by_cycles_gap},
-      {"cycles", [] { return std::make_unique<rigc::cycles::CyclesBackend>(); }},
-      {"cycles-direct",
-       [] {
-         auto backend = std::make_unique<rigc::cycles::CyclesBackend>();
-         backend->max_bounces = 0;
-         return backend;
-       }},
+       backend_with<PreviewBackend>([](auto& b) { b.per_pixel_lighting = true; })},
+      {"preview-hard-shadows", backend_with<PreviewBackend>(), point_like_lights},
+      {"preview-no-specular", backend_with<PreviewBackend>([](auto& b) { b.specular = false; })},
+      {"preview-darker", backend_with<PreviewBackend>(), darker_by_cycles_gap},
+      {"cycles", backend_with<CyclesBackend>()},
+      {"cycles-direct", backend_with<CyclesBackend>([](auto& b) { b.max_bounces = 0; })},
   };
 }
 
