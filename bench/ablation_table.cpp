@@ -41,12 +41,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using MakeBackend = std::function<std::unique_ptr<rigc::run::Backend>()>;
+
 struct Way {
   std::string name;
-  std::function<std::unique_ptr<rigc::run::Backend>()> make;
+  MakeBackend make;
   std::function<void(rigc::ir::Scene&)> edit = nullptr;  // of the scene it renders, if set
 
-  Way(std::string way_name, std::function<std::unique_ptr<rigc::run::Backend>()> make_backend,
+  Way(std::string way_name, MakeBackend make_backend,
       std::function<void(rigc::ir::Scene&)> edit_scene = nullptr)
       : name(std::move(way_name)), make(std::move(make_backend)), edit(std::move(edit_scene)) {}
 };
@@ -55,8 +57,6 @@ struct Way {
 void point_like_lights(rigc::ir::Scene& scene) {
   for (rigc::ir::Light& light : scene.studio.lights) light.size_m = rigc::ir::Vec2::Zero();
 }
-
-using MakeBackend = std::function<std::unique_ptr<rigc::run::Backend>()>;
 
 // A backend of type B with one of its options set by `set`.
 template <typename B>
@@ -78,13 +78,15 @@ std::vector<Way> ways() {
   using rigc::preview::PreviewBackend;
   return {
       {"preview", backend_with<PreviewBackend>()},
-      {"preview-point", backend_with<PreviewBackend>([](auto& b) { b.draft_surface = true; })},
-      {"preview-2x2", backend_with<PreviewBackend>([](auto& b) { b.supersample = 2; })},
-      {"preview-4x4", backend_with<PreviewBackend>([](auto& b) { b.supersample = 4; })},
+      {"preview-point",
+       backend_with<PreviewBackend>([](auto& b) { b.options.draft_surface = true; })},
+      {"preview-2x2", backend_with<PreviewBackend>([](auto& b) { b.options.supersample = 2; })},
+      {"preview-4x4", backend_with<PreviewBackend>([](auto& b) { b.options.supersample = 4; })},
       {"preview-pixel-lighting",
-       backend_with<PreviewBackend>([](auto& b) { b.per_pixel_lighting = true; })},
+       backend_with<PreviewBackend>([](auto& b) { b.options.per_pixel_lighting = true; })},
       {"preview-hard-shadows", backend_with<PreviewBackend>(), point_like_lights},
-      {"preview-no-specular", backend_with<PreviewBackend>([](auto& b) { b.specular = false; })},
+      {"preview-no-specular",
+       backend_with<PreviewBackend>([](auto& b) { b.options.specular = false; })},
       {"preview-darker", backend_with<PreviewBackend>(), darker_by_cycles_gap},
       {"cycles", backend_with<CyclesBackend>()},
       {"cycles-direct", backend_with<CyclesBackend>([](auto& b) { b.max_bounces = 0; })},

@@ -482,7 +482,8 @@ void Session::render_preview(const ir::Scene& scene,
     shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
     shadow_studio_ = studio;
   }
-  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get(), draft);
+  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get(),
+                                     {.draft_surface = draft});
 }
 
 std::optional<Frame> Session::frame(double scale, bool draft, std::string* error) {

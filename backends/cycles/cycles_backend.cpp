@@ -1,6 +1,7 @@
 #include "backends/cycles/cycles_backend.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <array>
 #include <cmath>
@@ -8,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
+#include <string>
+#include <vector>
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
@@ -199,11 +202,11 @@ std::string script_text(const json& data) {
 }  // namespace
 
 std::string CyclesBackend::options_key() const {
-  std::string key = albedo_only ? "albedo_only" : "";
-  if (max_bounces != kDefaultMaxBounces) {
-    key += fmt::format("{}max_bounces={}", key.empty() ? "" : ";", max_bounces);
-  }
-  return key;
+  std::vector<std::string> changed;
+  if (albedo_only) changed.push_back("albedo_only");
+  if (max_bounces != kDefaultMaxBounces)
+    changed.push_back(fmt::format("max_bounces={}", max_bounces));
+  return fmt::format("{}", fmt::join(changed, ";"));
 }
 
 bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studio,

@@ -1,10 +1,13 @@
 #include "backends/preview/preview_backend.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "dslr/lens.h"
 #include "raster/rasterizer.h"
@@ -74,23 +77,25 @@ dslr::LinearFrame box_downsample(const dslr::LinearFrame& fine, int factor,
 
 }  // namespace
 
-std::string PreviewBackend::options_key() const {
-  std::string key = draft_surface ? "draft_surface" : "";
-  if (supersample != 1) key += fmt::format("{}supersample={}", key.empty() ? "" : ";", supersample);
-  if (!specular) key += key.empty() ? "no_specular" : ";no_specular";
-  if (per_pixel_lighting) key += key.empty() ? "per_pixel_lighting" : ";per_pixel_lighting";
-  return key;
+std::string RenderOptions::key() const {
+  std::vector<std::string> changed;
+  if (draft_surface) changed.push_back("draft_surface");
+  if (supersample != 1) changed.push_back(fmt::format("supersample={}", supersample));
+  if (!specular) changed.push_back("no_specular");
+  if (per_pixel_lighting) changed.push_back("per_pixel_lighting");
+  return fmt::format("{}", fmt::join(changed, ";"));
 }
 
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
-                                raster::ShadowMapCache* shadow_cache, bool draft_surface,
-                                int supersample, bool specular, bool per_pixel_lighting) {
+                                raster::ShadowMapCache* shadow_cache,
+                                const RenderOptions& options) {
   const dslr::RenderGeometry geometry = dslr::render_geometry_for(scene.camera, scale);
+  const int supersample = options.supersample;
   raster::FrameRequest request;
-  request.draft_surface = draft_surface;
-  request.specular = specular;
-  request.per_pixel_lighting = per_pixel_lighting;
+  request.draft_surface = options.draft_surface;
+  request.specular = options.specular;
+  request.per_pixel_lighting = options.per_pixel_lighting;
   request.world_from_camera = shot.world_from_camera;
   request.canvas = geometry;
   request.canvas.width *= supersample;
@@ -130,8 +135,7 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
-  *out = render_linear(scene, studio, shot, settings.scale, nullptr, draft_surface, supersample,
-                       specular, per_pixel_lighting);
+  *out = render_linear(scene, studio, shot, settings.scale, nullptr, options);
   return true;
 }
 

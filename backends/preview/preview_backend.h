@@ -16,35 +16,41 @@ class ShadowMapCache;
 
 namespace rigc::preview {
 
-class PreviewBackend : public run::Backend {
- public:
-  std::string name() const override { return "preview"; }
-  // Point-samples textures and patterns as the studio's drafts do: for the benchmark that weighs
-  // what the surface filter does to a reconstruction (bench/ablation_table.cpp).
+// How the preview renders beyond the scene. The defaults are `rigc render`'s; the rest serve the
+// studio's drafts and the benchmark that weighs each difference from the references
+// (bench/ablation_table.cpp).
+struct RenderOptions {
+  // Textures and patterns point-sampled (raster::FrameRequest::draft_surface).
   bool draft_surface = false;
-  // Renders each pixel as supersample x supersample pixels averaged (shading, geometry and surface
-  // sampled that much finer): for the same benchmark, to weigh the preview's one shading point a
-  // pixel against a reference's many samples.
+  // Each pixel rendered as supersample x supersample pixels averaged (shading, geometry and
+  // surface sampled that much finer), as a reference's many samples a pixel are.
   int supersample = 1;
   // False leaves the lights' specular lobe out (raster::FrameRequest::specular).
   bool specular = true;
   // Lights summed for every pixel instead of once per 2 x 2 quad
   // (raster::FrameRequest::per_pixel_lighting).
   bool per_pixel_lighting = false;
-  std::string options_key() const override;
+
+  // The options that differ from the defaults, as text for the shot key ("" when none).
+  std::string key() const;
+};
+
+class PreviewBackend : public run::Backend {
+ public:
+  std::string name() const override { return "preview"; }
+  RenderOptions options;
+  std::string options_key() const override { return options.key(); }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
 };
 
 // One shot in linear light, with the rasterizer's stages in stage_ms. A `shadow_cache` keeps the
-// shadow maps of a frame without motion blur for the next (raster/shadow_map_cache.h); a
-// `draft_surface` point-samples textures and patterns (raster::FrameRequest::draft_surface).
+// shadow maps of a frame without motion blur for the next (raster/shadow_map_cache.h).
 run::RenderedShot render_linear(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale,
                                 raster::ShadowMapCache* shadow_cache = nullptr,
-                                bool draft_surface = false, int supersample = 1,
-                                bool specular = true, bool per_pixel_lighting = false);
+                                const RenderOptions& options = {});
 
 // The shot's unlit albedo (base colour x texture x pattern) as radiance, with its mask: no
 // lights, shadows or motion blur.

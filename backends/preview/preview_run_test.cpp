@@ -75,7 +75,7 @@ TEST(PreviewRun, PointSampledShotsAreNotTakenForFilteredOnes) {
   run::RunOptions options = small_run(dir.path());
   std::ostringstream log;
   PreviewBackend point_sampled;
-  point_sampled.draft_surface = true;
+  point_sampled.options.draft_surface = true;
   ASSERT_EQ(run::run_backend(scene, point_sampled, options, log), 0) << log.str();
   std::vector<run::ShotTiming> timings;
   ASSERT_EQ(run_preview(scene, options, log, &timings), 0) << log.str();

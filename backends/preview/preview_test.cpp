@@ -144,7 +144,7 @@ TEST(Preview, SupersampledFramesKeepTheirPlaceSizeAndBrightness) {
   const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const run::RenderedShot plain = render_linear(scene, studio, scene.shots[0], 0.1);
   const run::RenderedShot fine =
-      render_linear(scene, studio, scene.shots[0], 0.1, nullptr, false, 3);
+      render_linear(scene, studio, scene.shots[0], 0.1, nullptr, {.supersample = 3});
   const dslr::LinearFrame &a = plain.frame, &b = fine.frame;
   ASSERT_EQ(b.width, a.width);
   ASSERT_EQ(b.height, a.height);
@@ -174,7 +174,7 @@ TEST(Preview, LeavingSpecularOutOnlyTakesLightAway) {
   const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const auto lit = render_linear(scene, studio, scene.shots[0], 0.05).frame;
   const auto diffuse =
-      render_linear(scene, studio, scene.shots[0], 0.05, nullptr, false, 1, false).frame;
+      render_linear(scene, studio, scene.shots[0], 0.05, nullptr, {.specular = false}).frame;
   ASSERT_EQ(lit.rgb.size(), diffuse.rgb.size());
   double lit_sum = 0, diffuse_sum = 0;
   int brighter = 0, values = 0;
