@@ -54,6 +54,9 @@ class Backend {
   // The backend's own options that change its output, as text for the shot key ("" when none
   // differs from the default).
   virtual std::string options_key() const { return ""; }
+  // Raised whenever a correction changes what the backend renders from the same inputs; above 1
+  // it joins the shot key, so a run rendered before the correction renders again.
+  virtual int output_version() const { return 1; }
 
   // Checked before anything is written: e.g. that the external program is installed. False with
   // a one-line `error` naming what to install.

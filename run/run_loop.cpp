@@ -1,6 +1,7 @@
 #include "run/run_loop.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <string>
+#include <vector>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/image_io.h"
@@ -165,12 +168,16 @@ bool RunLoop::open_run_folder() {
 }
 
 std::string RunLoop::key_of(const ir::Shot& shot) const {
-  std::string extra = backend_.takes_samples() ? fmt::format("samples={}", settings_.samples) : "";
+  std::vector<std::string> extra;
+  if (backend_.takes_samples()) extra.push_back(fmt::format("samples={}", settings_.samples));
   if (const std::string options = backend_.options_key(); !options.empty()) {
-    extra += (extra.empty() ? "" : ";") + options;
+    extra.push_back(options);
+  }
+  if (const int version = backend_.output_version(); version > 1) {
+    extra.push_back(fmt::format("version={}", version));
   }
   return shot_key(scene_, content_hash_, shot, backend_.name(), settings_.scale, settings_.seed,
-                  extra);
+                  fmt::format("{}", fmt::join(extra, ";")));
 }
 
 // Instantiates the scene and lets the backend prepare (emit its scripts), once.

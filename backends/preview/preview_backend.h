@@ -40,6 +40,8 @@ class PreviewBackend : public run::Backend {
   std::string name() const override { return "preview"; }
   RenderOptions options;
   std::string options_key() const override { return options.key(); }
+  // 2: depth of field blurs by the circle of confusion in the image, not on the sensor.
+  int output_version() const override { return 2; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;

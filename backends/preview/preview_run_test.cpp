@@ -83,6 +83,27 @@ TEST(PreviewRun, PointSampledShotsAreNotTakenForFilteredOnes) {
   for (const auto& t : timings) EXPECT_FALSE(t.skipped);
 }
 
+// A corrected backend (its output version raised) renders a run's shots again instead of
+// taking the ones rendered before the correction as up to date.
+TEST(PreviewRun, ShotsRenderedBeforeACorrectionRenderAgain) {
+  struct CorrectedPreview : PreviewBackend {
+    int output_version() const override { return PreviewBackend::output_version() + 1; }
+  };
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(2, "180deg");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
+  std::vector<run::ShotTiming> timings;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0) << log.str();
+  for (const auto& t : timings) EXPECT_TRUE(t.skipped) << "unchanged: up to date";
+  CorrectedPreview corrected;
+  timings.clear();
+  ASSERT_EQ(run::run_backend(scene, corrected, options, log, &timings), 0) << log.str();
+  ASSERT_EQ(timings.size(), 2u);
+  for (const auto& t : timings) EXPECT_FALSE(t.skipped);
+}
+
 // A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
 // rerun after the scene lost shots, or changed its image format, removes what it no longer makes.
 TEST(PreviewRun, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
