@@ -174,7 +174,8 @@ int run_render(std::vector<std::string> args) {
       ->check(CLI::IsMember(backends::backend_names()))
       ->capture_default_str();
   app.add_option("--samples", samples,
-                 "samples per pixel for povray and cycles (0: the backend's default)")
+                 "samples per pixel (0: the backend's default; the preview's: 1, 4, 9, ... as "
+                 "a square grid, default 1)")
       ->check(non_negative_number());
   app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
   app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 or all")

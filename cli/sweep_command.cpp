@@ -46,7 +46,7 @@ void add_sweep_options(CLI::App& app, SweepArguments& a) {
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
   app.add_option("--samples", a.samples,
-                 "with --vary: the ray tracers' samples per pixel (0: each backend's default)")
+                 "with --vary: samples per pixel for every backend (0: each backend's default)")
       ->check(CLI::Range(0, 65536))
       ->capture_default_str();
   app.add_option("--measure", a.measure, "with --vary: coverage, eval or coverage,eval")

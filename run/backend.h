@@ -61,6 +61,11 @@ class Backend {
   // Checked before anything is written: e.g. that the external program is installed. False with
   // a one-line `error` naming what to install.
   virtual bool available(std::string* error) const;
+  // Checked with the settings before anything is written: settings valid for every backend that
+  // this one cannot honour. False with a one-line `error`.
+  virtual bool check_settings(const RenderSettings& /*settings*/, std::string* /*error*/) const {
+    return true;
+  }
   // Writes the scripts into `dir` (which may not exist yet). False with a one-line `error`.
   virtual bool emit(const ir::Scene& scene, const scene::StudioScene& studio,
                     const std::filesystem::path& dir, const RenderSettings& settings,

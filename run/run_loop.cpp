@@ -133,7 +133,8 @@ class RunLoop {
 
 int RunLoop::check_options() {
   std::string error;
-  if (!settings_.check(&error) || !output_camera(scene_.camera, settings_.scale, &error)) {
+  if (!settings_.check(&error) || !output_camera(scene_.camera, settings_.scale, &error) ||
+      !backend_.check_settings(settings_, &error)) {
     log_ << fmt::format("rigc: error: {}\n", error);
     return 1;
   }

@@ -12,6 +12,7 @@
 
 #include "backends/registry.h"
 #include "compiler/check.h"
+#include "run/backend.h"
 #include "sweep/scene_edit.h"
 
 namespace rigc::sweep {
@@ -129,6 +130,28 @@ void read_samples(const YAML::Node& node, const std::string& file, SweepSpec& sp
   spec.samples = *samples;
 }
 
+// The samples every backend of the sweep can take at its scale (the preview's are a square
+// grid no finer than the sensor), reported at the samples line.
+void check_samples_for_backends(const YAML::Node& node, const std::string& file,
+                                const SweepSpec& spec, DiagnosticEngine& diag) {
+  std::vector<std::string> names = {spec.backend};
+  for (const Axis& axis : spec.axes) {
+    if (!axis.is_backend()) continue;
+    names.clear();
+    for (const auto& value : axis.values) names.push_back(value.text);
+  }
+  run::RenderSettings settings;
+  settings.scale = spec.scale;
+  settings.samples = spec.samples;
+  for (const std::string& name : names) {
+    const backends::BackendEntry* entry = backends::find_backend(name);
+    std::string error;
+    if (entry && !entry->make()->check_settings(settings, &error)) {
+      diag.error(loc_of(node, file), fmt::format("samples: {} (backend {})", error, name));
+    }
+  }
+}
+
 void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& spec,
                     DiagnosticEngine& diag) {
   static const std::vector<std::string> kKeys = {"rigc-sweep", "name",  "scene",   "vary",   "zip",
@@ -158,7 +181,10 @@ void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& 
   }
   if (const YAML::Node n = root["zip"]) read_zip(n, file, spec, diag);
   if (const YAML::Node n = root["scale"]) read_scale(n, file, spec, diag);
-  if (const YAML::Node n = root["samples"]) read_samples(n, file, spec, diag);
+  if (const YAML::Node n = root["samples"]) {
+    read_samples(n, file, spec, diag);
+    if (spec.samples > 0) check_samples_for_backends(n, file, spec, diag);
+  }
   if (const YAML::Node n = root["measure"]) read_measure(n, file, spec, diag);
 }
 

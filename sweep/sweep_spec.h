@@ -31,7 +31,7 @@ struct SweepSpec {
   std::vector<std::vector<int>> zip_groups;  // axes (indices) paired value by value
   std::string backend = "preview";           // when the backend is no axis
   double scale = 0.25;
-  int samples = 0;  // the ray tracers' samples per pixel; 0 = each backend's default
+  int samples = 0;  // every backend's samples per pixel; 0 = each backend's default
   bool coverage = true, eval = false;
 };
 

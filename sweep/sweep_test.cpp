@@ -176,6 +176,32 @@ TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
   }
 }
 
+// The preview takes its samples as a square grid no finer than the sensor: a sweep that would
+// give it others is an error at the samples line, naming the backend, before anything runs.
+TEST(SweepFile, SamplesThePreviewCannotTakeAreRefusedAtTheirLine) {
+  const std::string head = "rigc-sweep: 1\nscene: " + source_path("scenes/paper-turntable.yaml") +
+                           "\nvary:\n  camera.exposure.aperture: [f/8]\n";
+  const auto diagnostics = [&](const std::string& rest) {
+    DiagnosticEngine diag;
+    capture(diag);
+    const bool parsed = parse_sweep_text(head + rest, "s.yaml", diag).has_value();
+    return std::make_pair(parsed, all_diagnostics(diag));
+  };
+  const auto [square_ok, square] = diagnostics("backend: [preview, cycles]\nsamples: 32\n");
+  EXPECT_FALSE(square_ok);
+  EXPECT_NE(square.find("s.yaml:6:10: samples: the preview takes a square number of samples per "
+                        "pixel (1, 4, 9, 16, ...), not 32 (backend preview)"),
+            std::string::npos)
+      << square;
+  const auto [fine_ok, fine] = diagnostics("scale: 0.5\nsamples: 16\n");
+  EXPECT_FALSE(fine_ok);
+  EXPECT_NE(fine.find("s.yaml:6:10: samples: 16 samples per pixel at scale 0.5 would render the "
+                      "preview larger than the sensor"),
+            std::string::npos)
+      << fine;
+  EXPECT_TRUE(diagnostics("backend: cycles\nscale: 0.5\nsamples: 32\n").first);
+}
+
 TEST(SweepFile, FolderNamesAreSanitised) {
   EXPECT_EQ(folder_name("../../etc/passwd"), "..-..-etc-passwd");
   EXPECT_EQ(folder_name(".."), "_..");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -42,6 +43,13 @@ dslr::LinearFrame render_motion_blurred(const ir::Scene& scene, const scene::Stu
   for (size_t i = 0; i < sum.size(); ++i) frame.rgb[i] = static_cast<float>(sum[i] / subframes);
   frame.tile_ranges = {};  // they described the middle sub-frame alone
   return frame;
+}
+
+// The side of the square sample grid of `samples` a pixel, rounded down.
+int grid_side(int samples) {
+  int side = static_cast<int>(std::sqrt(static_cast<double>(samples)));
+  while ((side + 1) * (side + 1) <= samples) ++side;
+  return std::max(side, 1);
 }
 
 // The frame `factor` times smaller on each side: radiance averaged, the nearest depth kept (the
@@ -131,11 +139,33 @@ dslr::LinearFrame render_albedo(const ir::Scene& scene, const scene::StudioScene
   return raster::render_frame(scene, studio, request);
 }
 
+bool PreviewBackend::check_settings(const run::RenderSettings& settings, std::string* error) const {
+  if (settings.samples == 0) return true;
+  const int grid = grid_side(settings.samples);
+  if (grid * grid != settings.samples) {
+    *error = fmt::format(
+        "the preview takes a square number of samples per pixel (1, 4, 9, 16, ...), not {}",
+        settings.samples);
+    return false;
+  }
+  if (grid > 1 && grid * settings.scale > 1.0) {
+    const int most = static_cast<int>(std::floor(1.0 / settings.scale + 1e-9));
+    *error = fmt::format(
+        "{} samples per pixel at scale {} would render the preview larger than the sensor; at "
+        "this scale it takes at most {} ({} x {})",
+        settings.samples, settings.scale, most * most, most, most);
+    return false;
+  }
+  return true;
+}
+
 bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& studio,
                             const ir::Shot& shot, const run::RenderSettings& settings,
                             const run::ShotFiles& /*files*/, run::RenderedShot* out,
                             std::string* /*error*/) {
-  *out = render_linear(scene, studio, shot, settings.scale, nullptr, options);
+  RenderOptions shot_options = options;
+  if (settings.samples > 0) shot_options.supersample = grid_side(settings.samples);
+  *out = render_linear(scene, studio, shot, settings.scale, nullptr, shot_options);
   return true;
 }
 

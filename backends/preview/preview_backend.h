@@ -23,7 +23,8 @@ struct RenderOptions {
   // Textures and patterns point-sampled (raster::FrameRequest::draft_surface).
   bool draft_surface = false;
   // Each pixel rendered as supersample x supersample pixels averaged (shading, geometry and
-  // surface sampled that much finer), as a reference's many samples a pixel are.
+  // surface sampled that much finer), as a reference's many samples a pixel are. A run's
+  // RenderSettings::samples, when not 0, set it (PreviewBackend::takes_samples).
   int supersample = 1;
   // False leaves the lights' specular lobe out (raster::FrameRequest::specular).
   bool specular = true;
@@ -40,6 +41,11 @@ class PreviewBackend : public run::Backend {
   std::string name() const override { return "preview"; }
   RenderOptions options;
   std::string options_key() const override { return options.key(); }
+  // RenderSettings::samples: n x n a pixel (RenderOptions::supersample), 0 for one. The grid
+  // must be square, and the finer canvas no larger than the sensor (memory stays within the
+  // full-resolution render's).
+  bool takes_samples() const override { return true; }
+  bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
   // 2: depth of field blurs by the circle of confusion in the image, not on the sensor.
   int output_version() const override { return 2; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,

@@ -104,6 +104,53 @@ TEST(PreviewRun, ShotsRenderedBeforeACorrectionRenderAgain) {
   for (const auto& t : timings) EXPECT_FALSE(t.skipped);
 }
 
+// A run's samples per pixel reach the preview as a square grid of finer pixels (the frame
+// RenderOptions::supersample renders); they join the shot key, and grids that are not square or
+// would render larger than the sensor are refused before anything is written.
+TEST(PreviewRun, SamplesAreASquareGridWithinTheSensor) {
+  ir::Scene scene = turntable_ball(2, "180deg");
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  PreviewBackend backend;
+  run::RenderSettings settings;
+  settings.scale = 0.05;
+  settings.samples = 4;
+  run::RenderedShot by_samples;
+  std::string error;
+  ASSERT_TRUE(backend.render(scene, studio, scene.shots[1], settings, {}, &by_samples, &error));
+  const run::RenderedShot by_option =
+      render_linear(scene, studio, scene.shots[1], 0.05, nullptr, {.supersample = 2});
+  EXPECT_EQ(by_samples.frame.rgb, by_option.frame.rgb);
+  const run::RenderedShot single = render_linear(scene, studio, scene.shots[1], 0.05);
+  EXPECT_NE(by_samples.frame.rgb, single.frame.rgb);
+
+  testing::TempDir dir;
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  options.settings.samples = 4;
+  ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
+  std::vector<run::ShotTiming> timings;
+  options.settings.samples = 0;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0) << log.str();
+  for (const auto& t : timings) EXPECT_FALSE(t.skipped) << "one sample is another image";
+
+  const auto refused = [&](int samples, double scale) {
+    testing::TempDir other;
+    run::RunOptions o = small_run(other.path());
+    o.settings.samples = samples;
+    o.settings.scale = scale;
+    std::ostringstream message;
+    EXPECT_EQ(run_preview(scene, o, message), 1) << samples << " at " << scale;
+    EXPECT_FALSE(fs::exists(other.path() / "manifest.json"));
+    return message.str();
+  };
+  EXPECT_NE(refused(5, 0.05).find("a square number of samples per pixel (1, 4, 9, 16, ...), "
+                                  "not 5"),
+            std::string::npos);
+  EXPECT_NE(refused(9, 0.5).find("larger than the sensor; at this scale it takes at most 4 (2 x "
+                                 "2)"),
+            std::string::npos);
+}
+
 // A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
 // rerun after the scene lost shots, or changed its image format, removes what it no longer makes.
 TEST(PreviewRun, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
