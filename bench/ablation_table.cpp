@@ -137,7 +137,8 @@ double render(const rigc::ir::Scene& scene, const Way& way, const Args& args, co
   rigc::run::RunOptions options;
   options.output_dir = dir;
   options.settings.scale = args.scale;
-  options.settings.samples = args.samples;
+  // --samples are the reference's: the preview's ways set their own sample grid.
+  options.settings.samples = way.name.starts_with("preview") ? 0 : args.samples;
   std::ofstream log(dir.string() + "-render.log");
   rigc::ir::Scene edited = scene;
   if (way.edit) way.edit(edited);
