@@ -144,10 +144,7 @@ double render(const rigc::ir::Scene& scene, const Way& way, const Args& args, co
   if (way.edit) way.edit(edited);
   const int code = rigc::run::run_backend(edited, *way.make(), options, log);
   if (code != 0) return -1;
-  const auto manifest = rigc::run::Manifest::load(dir / "manifest.json");
-  double ms = 0;
-  for (const auto& [name, shot] : manifest.shots()) ms += shot.render_ms;
-  return ms / 1000;
+  return rigc::run::Manifest::load(dir / "manifest.json").render_seconds();
 }
 
 void print_eval_row(const std::string& name, double render_s, int run, const Args& args,

@@ -85,6 +85,12 @@ const ShotRecord* Manifest::find(const std::string& name) const {
   return it == shots_.end() ? nullptr : &it->second;
 }
 
+double Manifest::render_seconds() const {
+  double ms = 0;
+  for (const auto& [name, shot] : shots_) ms += shot.render_ms;
+  return ms / 1000;
+}
+
 bool Manifest::is_done(const std::string& name, const std::string& key,
                        const fs::path& run_dir) const {
   const ShotRecord* record = find(name);

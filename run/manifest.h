@@ -55,6 +55,8 @@ class Manifest {
   const std::string& rigc_version() const { return rigc_version_; }
   const std::map<std::string, ShotRecord>& shots() const { return shots_; }
   const ShotRecord* find(const std::string& name) const;
+  // The seconds every recorded shot took to render, summed.
+  double render_seconds() const;
 
   nlohmann::json to_json() const;
   // Atomic write; false with a one-line `error`.

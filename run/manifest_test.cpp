@@ -48,6 +48,12 @@ TEST(BackendManifest, SaveLoadAndIsDone) {
   EXPECT_EQ(loaded.find("shot_000")->render_ms, 812.5);
   EXPECT_EQ(loaded.find("shot_000")->stage_ms.at("develop"), 312.25);
   EXPECT_EQ(loaded.find("shot_000")->files.size(), 2u);
+  ShotRecord second = sample_record("def");
+  second.name = "shot_001";
+  second.render_ms = 187.5;
+  Manifest two = loaded;
+  two.record(second);
+  EXPECT_DOUBLE_EQ(two.render_seconds(), 1.0);
   EXPECT_TRUE(loaded.is_done("shot_000", "abc", run.path()));
   EXPECT_FALSE(loaded.is_done("shot_000", "abd", run.path()));  // changed key
   EXPECT_FALSE(loaded.is_done("shot_001", "abc", run.path()));  // no entry

@@ -37,14 +37,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Sum of the manifest's per-shot render times: the images' cost even when a rerun reused them.
-double manifest_render_seconds(const fs::path& run_dir) {
-  const auto manifest = run::Manifest::load(run_dir / "manifest.json");
-  double ms = 0;
-  for (const auto& [name, shot] : manifest.shots()) ms += shot.render_ms;
-  return ms / 1000;
-}
-
 void measure_coverage(const ir::Scene& scene, const fs::path& dir, nlohmann::json& result) {
   const scene::StudioScene studio = scene::prepare_studio_scene(scene);
   const auto start = Clock::now();
@@ -113,7 +105,8 @@ nlohmann::json run_stages(const nlohmann::json& variant, const fs::path& dir, st
   const auto start = Clock::now();
   const int render_status = run::run_backend(*scene, *entry->make(), options, log);
   result["render_wall_s"] = seconds_since(start);
-  result["render_s"] = manifest_render_seconds(dir);
+  // The images' cost even when a rerun reused them.
+  result["render_s"] = run::Manifest::load(dir / "manifest.json").render_seconds();
   if (render_status != 0) {
     result["reason"] = fmt::format("render: exit {} (see the log)", render_status);
     return result;
