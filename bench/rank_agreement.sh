@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Issue #34's rank agreement (measured, not asserted): does the preview rank capture
-# configurations by reconstruction std in the order Cycles does? Runs the sweep
-# bench/rank_agreement/six_configurations.yaml (the paper scene, six configurations, preview and
-# Cycles at 16 samples, eval), then two of them with Cycles at 64 samples
-# (two_at_64_samples.yaml) to show that 16 samples do not change Cycles' own order.
+# configurations by reconstruction std in the order Cycles does? Runs the sweeps
+# bench/rank_agreement/six_configurations_{preview,cycles}.yaml (the paper scene, six
+# configurations, the preview and Cycles at 16 samples, eval), then two of them with Cycles at 64
+# samples (two_at_64_samples.yaml) to show that 16 samples do not change Cycles' own order.
 #
 # COLMAP is not deterministic (one scene's std moves by 2-4 % between evaluations, as much as
 # some configurations differ), so each variant is evaluated EVALS times in all (the sweep's eval
@@ -38,9 +38,10 @@ evaluate_again() {
 # Per variant: each evaluation's std, points and F-score and their means; then Spearman's rho
 # between the backends' rankings of the configurations by each mean.
 summarise() {
-  python3 - "$1" <<'PY'
+  python3 - "$@" <<'PY'
 import glob, json, os, sys
-from statistics import mean
+from itertools import combinations
+from statistics import mean, stdev
 
 def ranks(values):
     order = sorted(range(len(values)), key=lambda i: values[i])
@@ -63,49 +64,77 @@ def spearman(a, b):
     vb = sum((y - mb) ** 2 for y in rb) ** 0.5
     return cov / (va * vb) if va and vb else float("nan")
 
-sweep = json.load(open(os.path.join(sys.argv[1], "sweep.json")))
-rows = {}
-print("variant\tevaluations: std (mm) / points / F\tmean std\tmean points\tmean F")
-for v in sweep["variants"]:
-    folder = os.path.join(sys.argv[1], v["name"])
-    evals = []
-    for path in sorted(glob.glob(os.path.join(folder, "eval*", "eval.json"))):
-        e = json.load(open(path))
-        evals.append((e["signed_distance_mm"]["std"], e["reconstruction"]["points"],
-                      e["fscore"]["fscore"]))
-    if not evals:
-        print(f'{v["name"]}\tno evaluation')
-        continue
-    m = tuple(mean(e[i] for e in evals) for i in range(3))
-    rows[v["name"]] = m
-    each = ", ".join(f"{s:.4f} / {p} / {f:.3f}" for s, p, f in evals)
-    print(f'{v["name"]}\t{each}\t{m[0]:.4f}\t{m[1]:.0f}\t{m[2]:.3f}')
-
-# Configurations: the variant names without their backend part.
+# Per configuration and backend: the evaluations' (std, points, F-score). A configuration is a
+# variant's name without its backend part; the backend is the variant's.
 configs = {}
-for name, m in rows.items():
-    config, _, backend = name.rpartition("_backend-")
-    if config:
-        configs.setdefault(config, {})[backend] = m
+print("variant\tevaluations: std (mm) / points / F\tmean std\tmean points\tmean F")
+for folder in sys.argv[1:]:
+    sweep = json.load(open(os.path.join(folder, "sweep.json")))
+    for v in sweep["variants"]:
+        evals = []
+        for path in sorted(glob.glob(os.path.join(folder, v["name"], "eval*", "eval.json"))):
+            e = json.load(open(path))
+            evals.append((e["signed_distance_mm"]["std"], e["reconstruction"]["points"],
+                          e["fscore"]["fscore"]))
+        if not evals:
+            print(f'{v["name"]} ({v["backend"]})\tno evaluation')
+            continue
+        m = tuple(mean(e[i] for e in evals) for i in range(3))
+        config = v["name"].split("_backend-")[0]
+        configs.setdefault(config, {})[v["backend"]] = evals
+        each = ", ".join(f"{s:.4f} / {p} / {f:.3f}" for s, p, f in evals)
+        print(f'{config} ({v["backend"]})\t{each}\t{m[0]:.4f}\t{m[1]:.0f}\t{m[2]:.3f}')
+
 paired = {c: b for c, b in configs.items() if "preview" in b and "cycles" in b}
-if len(paired) >= 2:
-    names = sorted(paired)
+names = sorted(paired)
+if len(names) >= 2:
     for i, measure in enumerate(["std", "points", "F-score"]):
-        a = [paired[c]["preview"][i] for c in names]
-        b = [paired[c]["cycles"][i] for c in names]
+        a = [mean(e[i] for e in paired[c]["preview"]) for c in names]
+        b = [mean(e[i] for e in paired[c]["cycles"]) for c in names]
         print(f"Spearman rho, preview vs cycles, mean {measure} over {len(names)} configurations: "
               f"{spearman(a, b):+.3f}")
+    # The pairs of configurations whose std Cycles tells apart (means further apart than twice
+    # the standard error of their difference, from the spread of the evaluations), and how many
+    # of them the preview orders the same way.
+    def std_stats(evals):
+        values = [e[0] for e in evals]
+        return mean(values), (stdev(values) ** 2 / len(values) if len(values) > 1 else 0.0)
+    resolved = agreeing = 0
+    for x, y in combinations(names, 2):
+        (cx, vx), (cy, vy) = std_stats(paired[x]["cycles"]), std_stats(paired[y]["cycles"])
+        if len(paired[x]["cycles"]) < 2 or abs(cx - cy) <= 2 * (vx + vy) ** 0.5:
+            continue
+        resolved += 1
+        px, py = std_stats(paired[x]["preview"])[0], std_stats(paired[y]["preview"])[0]
+        same = (px - py) * (cx - cy) > 0
+        agreeing += same
+        print(f"  {x} vs {y}: cycles {cx:.4f} vs {cy:.4f}, preview {px:.4f} vs {py:.4f}"
+              f"{'' if same else ' (opposite)'}")
+    print(f"pairs of configurations Cycles orders by std beyond its evaluations' spread: "
+          f"{resolved} of {len(names) * (len(names) - 1) // 2}; the preview orders {agreeing} of "
+          f"them the same way")
 PY
+}
+
+# Runs a sweep file into `dir` and evaluates its variants until each has `evals` evaluations.
+run_sweep() {
+  "$rigc" sweep "bench/rank_agreement/$1" -o "$2" || true
+  evaluate_again "$2"
 }
 
 for w in $which; do
   case $w in
-    six) sweep=bench/rank_agreement/six_configurations.yaml dir=$out/six ;;
-    64) sweep=bench/rank_agreement/two_at_64_samples.yaml dir=$out/cycles-64 ;;
+    six)
+      run_sweep six_configurations_preview.yaml "$out/six-preview"
+      run_sweep six_configurations_cycles.yaml "$out/six-cycles"
+      echo "== six configurations, preview and Cycles at 16 samples, $evals evaluations a variant"
+      summarise "$out/six-preview" "$out/six-cycles"
+      ;;
+    64)
+      run_sweep two_at_64_samples.yaml "$out/cycles-64"
+      echo "== two configurations, Cycles at 64 samples, $evals evaluations a variant"
+      summarise "$out/cycles-64"
+      ;;
     *) echo "rank_agreement.sh: unknown part $w (six, 64)" >&2; exit 1 ;;
   esac
-  "$rigc" sweep "$sweep" -o "$dir" || true
-  evaluate_again "$dir"
-  echo "== $sweep, $evals evaluations a variant"
-  summarise "$dir"
 done
