@@ -13,8 +13,8 @@ struct LoadedModel {
   ir::Mesh mesh;  // triangle_material indexes `materials`
   std::vector<ir::Material> materials;
   std::vector<ir::Texture> textures;  // Material::base_color_texture indexes this
-  // Linear RGB per vertex of `mesh` (PLY scans), empty if none. The materials then have the
-  // area-weighted mean vertex colour as base_color, which every renderer uses.
+  // Linear RGB per vertex of `mesh` (PLY scans), empty if none: the base colour where the scene
+  // keeps it (ir::Mesh::colors). The materials have their area-weighted mean as base_color.
   std::vector<Eigen::Vector3f> vertex_colors;
   std::vector<std::string> warnings;  // what loaded but not as the file meant (one line each)
 };

@@ -260,6 +260,34 @@ TEST(Frontend, UntexturedObjectGetsACaptureWarning) {
   EXPECT_NE(compiled.diagnostics.find("warning: the object has no texture"), std::string::npos);
 }
 
+// A scan's vertex colours are its base colour in the IR (red on the cube's top, blue below):
+// they count as a texture, the scene's own colour replaces them, and the IR JSON carries them.
+TEST(Frontend, VertexColoursReachTheIrUnlessTheSceneGivesAColour) {
+  std::string text = kMinimalScene;
+  text.replace(
+      text.find("primitive: sphere"), 17,
+      "mesh: " + rigc::testing::source_path("tests/meshes/cube_quads_big_endian_colors.ply"));
+  text.erase(text.find("  surface: {pattern: speckle}\n"), 30);
+  Compiled coloured = compile_text(text);
+  ASSERT_TRUE(coloured.scene) << coloured.diagnostics;
+  EXPECT_EQ(coloured.diagnostics.find("no texture"), std::string::npos) << coloured.diagnostics;
+  const ir::Mesh& mesh = coloured.scene->object.mesh;
+  ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    EXPECT_EQ(mesh.colors[i],
+              mesh.positions[i].z() > 0 ? Eigen::Vector3f(1, 0, 0) : Eigen::Vector3f(0, 0, 1));
+  }
+  const nlohmann::json ir = ir_to_json(*coloured.scene);
+  EXPECT_EQ(ir["object"]["mesh"]["has_vertex_colors"], true);
+  EXPECT_EQ(ir["object"]["mesh"]["vertex_colors"].size(), 3 * mesh.positions.size());
+
+  text.insert(text.find("camera:"), "  surface: {color: [0.5, 0.5, 0.5], pattern: none}\n");
+  Compiled painted = compile_text(text);
+  ASSERT_TRUE(painted.scene) << painted.diagnostics;
+  EXPECT_TRUE(painted.scene->object.mesh.colors.empty());
+  EXPECT_NE(painted.diagnostics.find("no texture"), std::string::npos) << painted.diagnostics;
+}
+
 TEST(Frontend, ManualFocusAndEffectsReachTheIr) {
   std::string text = kMinimalScene;
   text.insert(text.find("shots:"),

@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -28,6 +29,21 @@ Mat4 translation(const Vec3& t) {
   Mat4 m = Mat4::Identity();
   m.block<3, 1>(0, 3) = t;
   return m;
+}
+
+// Whether a mesh's vertex colours vary enough to be a texture SfM can match (a luminance spread
+// of 0.02 in linear light, about 8 sRGB codes in mid tones), not one paint colour.
+bool vertex_colors_vary(const ir::Mesh& mesh) {
+  if (mesh.colors.size() < 2) return false;
+  double sum = 0, sum_squares = 0;
+  for (const Eigen::Vector3f& c : mesh.colors) {
+    const double y = 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
+    sum += y;
+    sum_squares += y * y;
+  }
+  const double n = static_cast<double>(mesh.colors.size());
+  const double variance = std::max(sum_squares / n - (sum / n) * (sum / n), 0.0);
+  return std::sqrt(variance) >= 0.02;
 }
 
 Mat4 rotation(const Eigen::Matrix3d& r) {
@@ -161,6 +177,7 @@ bool Lowering::load_mesh(Eigen::Matrix3d* up) {
   }
   out.source = object.mesh_path_resolved;
   out.mesh = std::move(model->mesh);
+  out.mesh.colors = std::move(model->vertex_colors);
   scene_.materials = std::move(model->materials);
   scene_.textures = std::move(model->textures);
   std::string ext = fs::path(object.mesh_path_resolved).extension().string();
@@ -177,16 +194,21 @@ bool Lowering::load_mesh(Eigen::Matrix3d* up) {
   return true;
 }
 
-// The scene's surface settings over every material (a texture wins over the pattern).
+// The scene's surface settings over every material (a texture wins over the pattern). A mesh's
+// vertex colours stay its base colour unless the scene gives one or a material has an image
+// texture: then every material keeps the mean vertex colour it loaded with.
 void Lowering::apply_surface() {
   const spec::ObjectSpec& object = spec_.object;
+  bool textured = false;
   for (auto& material : scene_.materials) {
     material.loc = object.loc;
     if (object.surface_color) material.base_color = *object.surface_color;
     if (object.roughness) material.roughness = *object.roughness;
     if (object.metallic) material.metallic = *object.metallic;
     if (material.base_color_texture < 0) material.pattern = object.pattern;
+    textured |= material.base_color_texture >= 0;
   }
+  if (object.surface_color || textured) scene_.object.mesh.colors.clear();
   if (scene_.materials.empty()) scene_.materials.push_back(ir::Material{});
 }
 
@@ -260,7 +282,7 @@ void Lowering::warn_about_object() {
                   fmt::format("the object ({:.0f} cm across) overhangs the {:.0f} cm turntable",
                               radius * 200, scene_.studio.turntable.diameter_m * 100));
   }
-  bool textured = false;
+  bool textured = vertex_colors_vary(out.mesh);
   for (const auto& m : scene_.materials) {
     textured |= m.base_color_texture >= 0 || m.pattern.kind != ir::PatternKind::kNone;
   }

@@ -61,6 +61,9 @@ struct Mesh {
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;  // unit length
   std::vector<Eigen::Vector2f> uvs;      // empty if the mesh has none; v = 0 at the image top
+  // Linear RGB per vertex, empty if none: where present it is the base colour, interpolated over
+  // each triangle, in place of its material's (docs/surface-functions.md).
+  std::vector<Eigen::Vector3f> colors;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::int32_t> triangle_material;  // one per triangle, index into Scene::materials
 };

@@ -78,7 +78,8 @@ const char* format_name(ir::ImageFormat format) {
 json mesh_json(const ir::Mesh& mesh, bool include_geometry) {
   json out{{"vertex_count", mesh.positions.size()},
            {"triangle_count", mesh.triangles.size()},
-           {"has_uvs", !mesh.uvs.empty()}};
+           {"has_uvs", !mesh.uvs.empty()},
+           {"has_vertex_colors", !mesh.colors.empty()}};
   if (!include_geometry) return out;
   std::vector<float> positions, normals, uvs;
   positions.reserve(mesh.positions.size() * 3);
@@ -87,12 +88,16 @@ json mesh_json(const ir::Mesh& mesh, bool include_geometry) {
   for (const auto& n : mesh.normals) normals.insert(normals.end(), {n.x(), n.y(), n.z()});
   uvs.reserve(mesh.uvs.size() * 2);
   for (const auto& uv : mesh.uvs) uvs.insert(uvs.end(), {uv.x(), uv.y()});
+  std::vector<float> colors;
+  colors.reserve(mesh.colors.size() * 3);
+  for (const auto& c : mesh.colors) colors.insert(colors.end(), {c.x(), c.y(), c.z()});
   std::vector<std::uint32_t> indices;
   indices.reserve(mesh.triangles.size() * 3);
   for (const auto& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
   out["positions"] = positions;
   out["normals"] = normals;
   out["uvs"] = uvs;
+  out["vertex_colors"] = colors;
   out["triangles"] = indices;
   out["triangle_material"] = mesh.triangle_material;
   return out;

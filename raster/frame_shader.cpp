@@ -123,11 +123,15 @@ AlbedoSample FrameShader::albedo_sample_at(const ScreenTriangle& s, float px, fl
   const scene::ShadedMaterial& material = studio_.materials[source.material()];
   const bool textured =
       material.texture >= 0 && material.texture < static_cast<int>(studio_.textures.size());
+  // Vertex colours vary linearly over a triangle: their value at the pixel's centre is their
+  // box-filtered mean over the pixel.
+  const bool vertex_colored = is_object && !source.g.colors.empty();
   AlbedoSample out;
   out.color = material.base_color;
   out.patterned = is_object && scene::has_pattern(material.pattern);
-  if (!textured && !out.patterned) return out;
+  if (!textured && !out.patterned && !vertex_colored) return out;
   const Vector3f b = source_bary_at(s, px, py);
+  if (vertex_colored) out.color = source.at(source.g.colors, b);
   if (textured) {
     const scene::MipTexture& texture = studio_.textures[material.texture];
     auto uv_at = [&](float qx, float qy) {

@@ -118,6 +118,13 @@ std::array<std::uint8_t, 3> albedo(const ir::Scene& scene, std::size_t t, const 
   if (m < 0 || m >= static_cast<int>(scene.materials.size())) return {204, 204, 204};
   const ir::Material& material = scene.materials[m];
   ir::Vec3 linear = material.base_color;
+  if (!mesh.colors.empty()) {
+    const auto& tri = mesh.triangles[t];
+    linear = (mesh.colors[tri[0]] * static_cast<float>(1 - b1 - b2) +
+              mesh.colors[tri[1]] * static_cast<float>(b1) +
+              mesh.colors[tri[2]] * static_cast<float>(b2))
+                 .cast<double>();
+  }
   const int tex = material.base_color_texture;
   if (tex >= 0 && tex < static_cast<int>(scene.textures.size()) && !mesh.uvs.empty()) {
     const ir::Texture& texture = scene.textures[tex];

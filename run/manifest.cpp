@@ -144,6 +144,8 @@ std::string scene_content_hash(const ir::Scene& scene) {
   add(mesh.positions.data(), mesh.positions.size() * sizeof(Eigen::Vector3f));
   add(mesh.normals.data(), mesh.normals.size() * sizeof(Eigen::Vector3f));
   add(mesh.uvs.data(), mesh.uvs.size() * sizeof(Eigen::Vector2f));
+  // Only when present, so that the keys of runs of meshes without colours stay as they were.
+  if (!mesh.colors.empty()) add(mesh.colors.data(), mesh.colors.size() * sizeof(Eigen::Vector3f));
   add(mesh.triangles.data(), mesh.triangles.size() * sizeof(mesh.triangles[0]));
   add(mesh.triangle_material.data(), mesh.triangle_material.size() * sizeof(std::int32_t));
   const std::uint64_t texture_count = scene.textures.size();

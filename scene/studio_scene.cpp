@@ -451,6 +451,7 @@ void add_object(const ir::Scene& scene, StudioScene& out) {
     object.normals[i] = (normal_matrix * mesh.normals[i]).normalized();
     if (!mesh.uvs.empty()) object.uvs[i] = mesh.uvs[i];
   }
+  object.colors = mesh.colors;
   object.triangles = mesh.triangles;
   object.triangle_material = mesh.triangle_material;
   if (object.triangle_material.size() != object.triangles.size()) {

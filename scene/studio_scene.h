@@ -38,6 +38,9 @@ struct Geometry {
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;
   std::vector<Eigen::Vector2f> uvs;  // one per vertex (zeros where the source had none)
+  // Linear RGB per vertex in place of the material's base colour (ir::Mesh::colors); empty if
+  // none.
+  std::vector<Eigen::Vector3f> colors;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::int32_t> triangle_material;  // index into StudioScene::materials
   std::vector<Eigen::Vector3f> face_normals;    // unit, from the winding; filled by prepare

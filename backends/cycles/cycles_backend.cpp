@@ -115,8 +115,9 @@ bool write_linear_texture(const fs::path& path, const ir::Texture& texture, std:
   return dslr::write_pixels(path, spec, pixels.data(), error);
 }
 
+// `vertex_colors`: the mesh's vertex colours are the base colour.
 json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material, int index,
-                   bool is_object) {
+                   bool is_object, bool vertex_colors) {
   std::string name = index < static_cast<int>(scene.materials.size())
                          ? scene.materials[index].name
                          : fmt::format("rigc_studio_{}", index);
@@ -126,7 +127,8 @@ json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material
                {"metallic", material.metallic},
                {"texture",
                 material.texture >= 0 ? json(texture_file_name(material.texture)) : json(nullptr)},
-               {"pattern", nullptr}};
+               {"pattern", nullptr},
+               {"vertex_colors", vertex_colors}};
   const ir::SurfacePattern& pattern = material.pattern;
   if (is_object && pattern.kind != ir::PatternKind::kNone && pattern.contrast > 0) {
     const char* kind = pattern.kind == ir::PatternKind::kChecker   ? "checker"
@@ -147,8 +149,9 @@ json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material
   return spec;
 }
 
-// Appends the mesh the way Blender's foreach_set wants it: per-vertex positions and normals,
-// per-loop vertex indices and UVs (v flipped: Blender's v = 0 is the image bottom).
+// Appends the mesh the way Blender's foreach_set wants it: per-vertex positions, normals and
+// RGBA colours (if any), per-loop vertex indices and UVs (v flipped: Blender's v = 0 is the image
+// bottom).
 json append_geometry(std::string& bytes, const scene::Geometry& g, int material_offset,
                      int material_count) {
   auto append = [&](const void* data, size_t size) {
@@ -181,6 +184,11 @@ json append_geometry(std::string& bytes, const scene::Geometry& g, int material_
     ints.push_back(std::clamp(m, material_offset, material_offset + material_count - 1));
   }
   spec["materials"] = append(ints.data(), ints.size() * sizeof(std::int32_t));
+  if (!g.colors.empty()) {
+    floats.clear();
+    for (const auto& c : g.colors) floats.insert(floats.end(), {c.x(), c.y(), c.z(), 1.0f});
+    spec["vertex_colors"] = append(floats.data(), floats.size() * sizeof(float));
+  }
   return spec;
 }
 
@@ -249,7 +257,9 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
 
   json materials = json::array();
   for (int m = 0; m < total_materials; ++m) {
-    materials.push_back(material_json(scene, studio.materials[m], m, m < object_materials));
+    const bool is_object = m < object_materials;
+    materials.push_back(material_json(scene, studio.materials[m], m, is_object,
+                                      is_object && !studio.object.colors.empty()));
   }
   data["materials"] = materials;
   // scene/speckle.h's constants, for the script's speckle node group.

@@ -71,6 +71,29 @@ TEST(CyclesEmit, MaxBouncesReachTheScriptAndTheShotKey) {
   EXPECT_EQ(direct.options_key(), "max_bounces=0");
 }
 
+// Vertex colours reach Blender as a colour attribute of the object's mesh that its materials
+// read in place of their base colour.
+TEST(CyclesEmit, VertexColoursReachTheScript) {
+  TempDir dir;
+  ir::Scene scene = hostile_scene(dir);
+  for (std::size_t i = 0; i < scene.object.mesh.positions.size(); ++i) {
+    scene.object.mesh.colors.push_back({0.2f, 0.4f, 0.6f});
+  }
+  std::string error;
+  ASSERT_TRUE(emit(scene, dir.path() / "cycles", 0.02, &error)) << error;
+  const std::string script = read_text((dir.path() / "cycles" / "scene.py").string());
+  EXPECT_NE(script.find(R"(\"vertex_colors\":true)"), std::string::npos);
+  EXPECT_NE(script.find(R"(\"vertex_colors\":false)"), std::string::npos) << "the studio's";
+  EXPECT_NE(script.find(R"(attribute.attribute_name = "RigcColor")"), std::string::npos);
+  // Four floats a vertex more in the geometry than without the colours.
+  ir::Scene plain = scene;
+  plain.object.mesh.colors.clear();
+  ASSERT_TRUE(emit(plain, dir.path() / "plain", 0.02, &error)) << error;
+  EXPECT_EQ(fs::file_size(dir.path() / "cycles" / "geometry.bin") -
+                fs::file_size(dir.path() / "plain" / "geometry.bin"),
+            4 * sizeof(float) * scene.object.mesh.positions.size());
+}
+
 TEST(CyclesRun, MissingExecutableNamesThePackage) {
   TempDir dir;
   const ir::Scene scene = hostile_scene(dir);

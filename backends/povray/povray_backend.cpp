@@ -4,12 +4,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <ostream>
 #include <regex>
 #include <set>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
@@ -56,6 +61,10 @@ std::string pov_matrix(const ir::Mat4& m) {
 std::string material_identifier(int index) {
   return fmt::format("RigcMaterial{}", index);
 }
+// The macro that makes material `index`'s texture with a vertex's colour.
+std::string vertex_texture_macro(int index) {
+  return fmt::format("RigcVertexTexture{}", index);
+}
 std::string texture_file_name(int material) {
   return fmt::format("material_{}.png", material);
 }
@@ -84,17 +93,19 @@ bool write_baked_texture(const fs::path& path, const ir::Texture& texture,
   return dslr::write_pixels(path, spec, pixels.data(), error);
 }
 
-std::string pigment_text(const scene::ShadedMaterial& material, int index, bool is_object) {
-  const Eigen::Vector3f base = material.base_color;
+// The material's pigment. `base` is its base colour as POV-Ray text: a vector, or the name of a
+// macro's colour parameter for vertex colours.
+std::string pigment_text(const scene::ShadedMaterial& material, int index, bool is_object,
+                         const std::string& base) {
   if (material.texture >= 0) {
     return fmt::format("uv_mapping image_map {{ png {} gamma 1.0 interpolate 2 }}",
                        *external::pov_string_literal(texture_file_name(index)));
   }
   const ir::SurfacePattern& pattern = material.pattern;
   if (!is_object || pattern.kind == ir::PatternKind::kNone || pattern.contrast <= 0) {
-    return "rgb " + vec(base);
+    return "rgb " + base;
   }
-  const Eigen::Vector3f dark = base * static_cast<float>(1 - pattern.contrast);
+  const std::string dark = fmt::format("({}) * {}", base, number_text(1 - pattern.contrast));
   const std::string scale = number_text(pattern.scale_m);
   switch (pattern.kind) {
     case ir::PatternKind::kSpeckle:
@@ -102,7 +113,7 @@ std::string pigment_text(const scene::ShadedMaterial& material, int index, bool 
       return fmt::format(
           "function {{ min(rigc_speckle(x, y, z, {0}), 0.99999) }}\n"
           "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
-          number_text(scene::speckle::seed_offset(pattern.seed)), vec(base), vec(dark), scale);
+          number_text(scene::speckle::seed_offset(pattern.seed)), base, dark, scale);
     case ir::PatternKind::kNoise: {
       // scene/speckle.h's noise, one seed offset per octave.
       std::string seeds;
@@ -112,14 +123,14 @@ std::string pigment_text(const scene::ShadedMaterial& material, int index, bool 
       return fmt::format(
           "function {{ min(rigc_noise(x, y, z{0}), 0.99999) }}\n"
           "      color_map {{ [0 rgb {1}] [1 rgb {2}] }} scale {3}",
-          seeds, vec(base), vec(dark), scale);
+          seeds, base, dark, scale);
     }
     case ir::PatternKind::kChecker:
-      return fmt::format("checker rgb {}, rgb {} scale {}", vec(base), vec(dark), scale);
+      return fmt::format("checker rgb {}, rgb {} scale {}", base, dark, scale);
     case ir::PatternKind::kNone:
       break;
   }
-  return "rgb " + vec(base);
+  return "rgb " + base;
 }
 
 // scene/speckle.h's pattern as POV-Ray functions: a function has no local variables, so each
@@ -221,6 +232,80 @@ std::string finish_text(const scene::ShadedMaterial& material) {
                      metallic > 0.5 ? " metallic" : "");
 }
 
+// A material's texture for the mask, the albedo and the lit passes, with its base colour as
+// POV-Ray text (see pigment_text).
+std::string texture_text(const scene::ShadedMaterial& material, int index, bool is_object,
+                         const std::string& base) {
+  return fmt::format(
+      "#if (RIGC_MASK)\n"
+      "  texture {{ pigment {{ rgb {0} }} finish {{ ambient 1 diffuse 0 }} }}\n"
+      "#elseif (RIGC_ALBEDO)\n"
+      "  texture {{ pigment {{ {1} }} finish {{ ambient 1 diffuse 0 }} }}\n"
+      "#else\n  texture {{\n    pigment {{ {1} }}\n    {2}\n  }}\n#end\n",
+      is_object ? 1 : 0, pigment_text(material, index, is_object, base), finish_text(material));
+}
+
+// Triangle t's material, counted from the mesh's first.
+int face_material(const scene::Geometry& g, int t, int material_offset, int material_count) {
+  return std::clamp(g.triangle_material[t] - material_offset, 0, std::max(0, material_count - 1));
+}
+
+// The texture list of a mesh's materials and its faces, one texture each.
+void append_material_faces(fmt::memory_buffer& out, const scene::Geometry& g,
+                           const std::vector<int>& triangles, int material_offset,
+                           int material_count) {
+  fmt::format_to(std::back_inserter(out), " }}\n  texture_list {{ {}", material_count);
+  for (int m = 0; m < material_count; ++m) {
+    fmt::format_to(std::back_inserter(out), ",\n    texture {{ {} }}",
+                   material_identifier(material_offset + m));
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  face_indices {{ {}", triangles.size());
+  for (int t : triangles) {
+    const auto& tri = g.triangles[t];
+    fmt::format_to(std::back_inserter(out), ",\n    <{}, {}, {}>, {}", tri[0], tri[1], tri[2],
+                   face_material(g, t, material_offset, material_count));
+  }
+}
+
+// The texture list of a vertex-coloured mesh, a texture per material and vertex colour (each
+// made by the material's vertex texture macro), and its faces with a texture per corner, which
+// POV-Ray interpolates.
+void append_vertex_colored_faces(fmt::memory_buffer& out, const scene::Geometry& g,
+                                 const std::vector<int>& triangles, int material_offset,
+                                 int material_count) {
+  std::map<std::tuple<int, float, float, float>, int> texture_index;
+  std::vector<std::array<int, 3>> corners;
+  corners.reserve(triangles.size());
+  for (int t : triangles) {
+    const int material = face_material(g, t, material_offset, material_count);
+    std::array<int, 3> corner{};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f& c = g.colors[g.triangles[t][k]];
+      const auto [it, added] = texture_index.try_emplace({material, c.x(), c.y(), c.z()},
+                                                         static_cast<int>(texture_index.size()));
+      corner[k] = it->second;
+    }
+    corners.push_back(corner);
+  }
+  std::vector<std::string> textures(texture_index.size());
+  for (const auto& [key, index] : texture_index) {
+    const auto& [material, red, green, blue] = key;
+    textures[index] =
+        fmt::format("{}(<{:.7g}, {:.7g}, {:.7g}>)",
+                    vertex_texture_macro(material_offset + material), red, green, blue);
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  texture_list {{ {}", textures.size());
+  for (const std::string& texture : textures) {
+    fmt::format_to(std::back_inserter(out), ",\n    {}", texture);
+  }
+  fmt::format_to(std::back_inserter(out), " }}\n  face_indices {{ {}", triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    const auto& tri = g.triangles[triangles[i]];
+    fmt::format_to(std::back_inserter(out), ",\n    <{}, {}, {}>, {}, {}, {}", tri[0], tri[1],
+                   tri[2], corners[i][0], corners[i][1], corners[i][2]);
+  }
+}
+
 void append_mesh2(fmt::memory_buffer& out, const std::string& name, const scene::Geometry& g,
                   const std::vector<int>& triangles, int material_offset, int material_count) {
   fmt::format_to(std::back_inserter(out), "#declare {} = mesh2 {{\n  vertex_vectors {{ {}", name,
@@ -237,18 +322,10 @@ void append_mesh2(fmt::memory_buffer& out, const std::string& name, const scene:
   for (const auto& uv : g.uvs) {
     fmt::format_to(std::back_inserter(out), ",\n    <{:.7g}, {:.7g}>", uv.x(), 1 - uv.y());
   }
-  fmt::format_to(std::back_inserter(out), " }}\n  texture_list {{ {}", material_count);
-  for (int m = 0; m < material_count; ++m) {
-    fmt::format_to(std::back_inserter(out), ",\n    texture {{ {} }}",
-                   material_identifier(material_offset + m));
-  }
-  fmt::format_to(std::back_inserter(out), " }}\n  face_indices {{ {}", triangles.size());
-  for (int t : triangles) {
-    const auto& tri = g.triangles[t];
-    const int material =
-        std::clamp(g.triangle_material[t] - material_offset, 0, std::max(0, material_count - 1));
-    fmt::format_to(std::back_inserter(out), ",\n    <{}, {}, {}>, {}", tri[0], tri[1], tri[2],
-                   material);
+  if (g.colors.empty()) {
+    append_material_faces(out, g, triangles, material_offset, material_count);
+  } else {
+    append_vertex_colored_faces(out, g, triangles, material_offset, material_count);
   }
   fmt::format_to(std::back_inserter(out), " }}\n}}\n");
 }
@@ -455,14 +532,14 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
         return false;
       }
     }
-    fmt::format_to(out,
-                   "#declare {0} =\n#if (RIGC_MASK)\n"
-                   "  texture {{ pigment {{ rgb {1} }} finish {{ ambient 1 diffuse 0 }} }}\n"
-                   "#elseif (RIGC_ALBEDO)\n"
-                   "  texture {{ pigment {{ {2} }} finish {{ ambient 1 diffuse 0 }} }}\n"
-                   "#else\n  texture {{\n    pigment {{ {2} }}\n    {3}\n  }}\n#end\n",
-                   material_identifier(m), is_object ? 1 : 0, pigment_text(material, m, is_object),
-                   finish_text(material));
+    fmt::format_to(out, "#declare {} =\n{}", material_identifier(m),
+                   texture_text(material, m, is_object, vec(material.base_color)));
+    // With vertex colours each vertex has the texture with its colour, which POV-Ray
+    // interpolates over the triangle (face_indices with three textures).
+    if (is_object && !studio.object.colors.empty()) {
+      fmt::format_to(out, "#macro {}(RigcColor)\n{}#end\n", vertex_texture_macro(m),
+                     texture_text(material, m, is_object, "RigcColor"));
+    }
   }
   inc.push_back('\n');
   std::vector<int> object_triangles(studio.object.triangles.size());

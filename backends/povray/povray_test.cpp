@@ -81,6 +81,27 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   EXPECT_NE(pov.find("focal_point"), std::string::npos);
 }
 
+// Vertex colours become a texture per colour, made by the material's macro, and each face names
+// the textures of its three corners, which POV-Ray interpolates.
+TEST(PovrayEmit, VertexColoursBecomeInterpolatedVertexTextures) {
+  ir::Scene scene = paper_scene();
+  ir::Mesh& mesh = scene.object.mesh;
+  const Eigen::Vector3f palette[3] = {{0.8f, 0.1f, 0.1f}, {0.1f, 0.8f, 0.1f}, {0.1f, 0.1f, 0.8f}};
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) mesh.colors.push_back(palette[i % 3]);
+  TempDir dir;
+  std::string error;
+  ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
+  const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
+  EXPECT_NE(inc.find("#macro RigcVertexTexture0(RigcColor)"), std::string::npos);
+  const auto object = inc.find("#declare RigcObject = mesh2 {");
+  ASSERT_NE(object, std::string::npos);
+  EXPECT_NE(inc.find("texture_list { 3,\n    RigcVertexTexture0(<0.8, 0.1, 0.1>)", object),
+            std::string::npos);
+  const auto& t = mesh.triangles[0];
+  EXPECT_NE(inc.find(fmt::format("<{}, {}, {}>, 0, ", t[0], t[1], t[2]), object), std::string::npos)
+      << "the first face names a texture per corner";
+}
+
 TEST(PovrayEmit, AnEmitWithFewerShotsRemovesOnlyTheFilesOfTheShotsItNoLongerHas) {
   ir::Scene scene = paper_scene();
   ASSERT_EQ(scene.shots.size(), 18u);

@@ -189,6 +189,45 @@ TEST(Preview, LeavingSpecularOutOnlyTakesLightAway) {
   EXPECT_LT(diffuse_sum, 0.99 * lit_sum) << diffuse_sum << " " << lit_sum;
 }
 
+// Vertex colours are the ball's base colour, interpolated: red over its upper half, blue below,
+// in the unlit albedo, where the material's own colour would be grey.
+TEST(Preview, VertexColoursColourTheObject) {
+  ir::Scene scene = turntable_ball(2, "180deg");
+  ir::Mesh& mesh = scene.object.mesh;
+  float mid = 0;
+  for (const auto& p : mesh.positions) mid += p.z() / static_cast<float>(mesh.positions.size());
+  for (const auto& p : mesh.positions) {
+    mesh.colors.push_back(p.z() > mid ? Eigen::Vector3f(0.8f, 0.05f, 0.05f)
+                                      : Eigen::Vector3f(0.05f, 0.05f, 0.8f));
+  }
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  const dslr::LinearFrame albedo = render_albedo(scene, studio, scene.shots[0], 0.05);
+  int top = -1, bottom = -1;
+  for (int y = 0; y < albedo.height; ++y) {
+    for (int x = 0; x < albedo.width; ++x) {
+      if (albedo.mask[static_cast<std::size_t>(y) * albedo.width + x] == 0) continue;
+      if (top < 0) top = y;
+      bottom = y;
+    }
+  }
+  ASSERT_GT(bottom - top, 8) << "the ball is in the frame";
+  auto mean_row = [&](int y) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (int x = 0; x < albedo.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * albedo.width + x;
+      if (albedo.mask[i] == 0) continue;
+      sum += Eigen::Vector3d(albedo.rgb[3 * i], albedo.rgb[3 * i + 1], albedo.rgb[3 * i + 2]);
+      ++n;
+    }
+    return Eigen::Vector3d(sum / std::max(n, 1));
+  };
+  const Eigen::Vector3d upper = mean_row(top + 2), lower = mean_row(bottom - 2);
+  EXPECT_GT(upper.x(), 5 * upper.z()) << upper.transpose();
+  EXPECT_GT(lower.z(), 5 * lower.x()) << lower.transpose();
+  EXPECT_LT(upper.y(), 0.1 * upper.x()) << "no grey of the material's own colour";
+}
+
 TEST(Preview, MotionBlurLengthMatchesTheTurntableSpeed) {
   auto extent = [](const std::string& speed) {
     ir::Scene scene = compile(ball_scene("}",
