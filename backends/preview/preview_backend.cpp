@@ -48,7 +48,7 @@ dslr::LinearFrame render_motion_blurred(const ir::Scene& scene, const scene::Stu
 // The side of the square sample grid of `samples` a pixel, rounded down.
 int grid_side(int samples) {
   int side = static_cast<int>(std::sqrt(static_cast<double>(samples)));
-  while ((side + 1) * (side + 1) <= samples) ++side;
+  while (static_cast<long long>(side + 1) * (side + 1) <= samples) ++side;
   return std::max(side, 1);
 }
 
@@ -149,7 +149,7 @@ bool PreviewBackend::check_settings(const run::RenderSettings& settings, std::st
     return false;
   }
   if (grid > 1 && grid * settings.scale > 1.0) {
-    const int most = static_cast<int>(std::floor(1.0 / settings.scale + 1e-9));
+    const int most = std::max(1, static_cast<int>(std::floor(1.0 / settings.scale + 1e-9)));
     *error = fmt::format(
         "{} samples per pixel at scale {} would render the preview larger than the sensor; at "
         "this scale it takes at most {} ({} x {})",

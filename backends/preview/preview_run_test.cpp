@@ -149,6 +149,10 @@ TEST(PreviewRun, SamplesAreASquareGridWithinTheSensor) {
   EXPECT_NE(refused(9, 0.5).find("larger than the sensor; at this scale it takes at most 4 (2 x "
                                  "2)"),
             std::string::npos);
+  EXPECT_NE(refused(4, 2.0).find("at most 1 (1 x 1)"), std::string::npos);
+  EXPECT_NE(refused(2147395600, 0.01).find("2147395600 samples per pixel at scale 0.01"),
+            std::string::npos)
+      << "46340 x 46340, the largest square an int holds";
 }
 
 // A run folder holds one scene's shots (`rigc eval` runs COLMAP on every image in images/): a
