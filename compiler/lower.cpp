@@ -37,7 +37,7 @@ bool vertex_colors_vary(const ir::Mesh& mesh) {
   if (mesh.colors.size() < 2) return false;
   double sum = 0, sum_squares = 0;
   for (const Eigen::Vector3f& c : mesh.colors) {
-    const double y = 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
+    const double y = luminance(c.cast<double>());
     sum += y;
     sum_squares += y * y;
   }
