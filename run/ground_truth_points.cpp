@@ -117,21 +117,18 @@ std::array<std::uint8_t, 3> albedo(const ir::Scene& scene, std::size_t t, const 
   const int m = t < mesh.triangle_material.size() ? mesh.triangle_material[t] : 0;
   if (m < 0 || m >= static_cast<int>(scene.materials.size())) return {204, 204, 204};
   const ir::Material& material = scene.materials[m];
+  // A per-vertex attribute at the point.
+  const auto& tri = mesh.triangles[t];
+  const auto at_point = [&](const auto& values) {
+    return values[tri[0]] * static_cast<float>(1 - b1 - b2) +
+           values[tri[1]] * static_cast<float>(b1) + values[tri[2]] * static_cast<float>(b2);
+  };
   ir::Vec3 linear = material.base_color;
-  if (!mesh.colors.empty()) {
-    const auto& tri = mesh.triangles[t];
-    linear = (mesh.colors[tri[0]] * static_cast<float>(1 - b1 - b2) +
-              mesh.colors[tri[1]] * static_cast<float>(b1) +
-              mesh.colors[tri[2]] * static_cast<float>(b2))
-                 .cast<double>();
-  }
+  if (!mesh.colors.empty()) linear = Eigen::Vector3f(at_point(mesh.colors)).cast<double>();
   const int tex = material.base_color_texture;
   if (tex >= 0 && tex < static_cast<int>(scene.textures.size()) && !mesh.uvs.empty()) {
     const ir::Texture& texture = scene.textures[tex];
-    const auto& tri = mesh.triangles[t];
-    const Eigen::Vector2f uv = mesh.uvs[tri[0]] * static_cast<float>(1 - b1 - b2) +
-                               mesh.uvs[tri[1]] * static_cast<float>(b1) +
-                               mesh.uvs[tri[2]] * static_cast<float>(b2);
+    const Eigen::Vector2f uv = at_point(mesh.uvs);
     auto wrap = [](double x, int n) {
       const int i = static_cast<int>(std::floor((x - std::floor(x)) * n));
       return std::clamp(i, 0, n - 1);
