@@ -45,6 +45,22 @@ TEST(GroundTruthPoints, LieOnTheSurfaceAndProjectWhereTheirTracksSay) {
   EXPECT_EQ(listed, observations);
 }
 
+// The points take the mesh's vertex colours (here one colour, unlike the statue's grey) in place
+// of the material's base colour.
+TEST(GroundTruthPoints, TakeTheVertexColours) {
+  rigc::testing::TempDir dir;
+  const auto r = make_statue_run(dir.path(), 500);
+  ASSERT_TRUE(r);
+  ir::Scene scene = r->scene;
+  for (auto& material : scene.materials) material.pattern.kind = ir::PatternKind::kNone;
+  scene.object.mesh.colors.assign(scene.object.mesh.positions.size(), {0.5f, 0.1f, 0.02f});
+  const GroundTruthPoints points = sample_ground_truth_points(scene, r->shots, r->camera, 500);
+  ASSERT_GT(points.points.size(), 100u);
+  for (const auto& p : points.points) {
+    EXPECT_EQ(p.rgb, (std::array<std::uint8_t, 3>{188, 89, 39}));  // sRGB of the linear colour
+  }
+}
+
 // Every observation is a point its camera sees unoccluded: a ray from the camera centre hits the
 // surface first at the point (Embree, through eval's Surface).
 TEST(GroundTruthPoints, ObservationsAreNotHiddenByTheObject) {
