@@ -98,38 +98,6 @@ struct CumulativeTotals {
   }
 };
 
-// Mean albedo luminance of each face: material colour (or the face's mean vertex colour),
-// texture average, pattern average.
-std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene& studio) {
-  const scene::Geometry& object = studio.object;
-  std::vector<float> material_albedo, material_factor;
-  for (size_t m = 0; m < scene.materials.size(); ++m) {
-    const scene::ShadedMaterial& material = studio.materials[m];
-    Vector3f color = material.base_color;
-    if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size()) &&
-        !studio.textures[material.texture].levels.empty()) {
-      color = color.cwiseProduct(studio.textures[material.texture].levels.back().texels[0]);
-    }
-    // A footprint far larger than the pattern gives the pattern's mean.
-    const float pattern_mean = scene::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
-    material_factor.push_back(pattern_mean * (1 - material.metallic));
-    material_albedo.push_back(
-        static_cast<float>(luminance(color.cast<double>()) * material_factor.back()));
-  }
-  std::vector<float> albedo(object.triangles.size(), 0.5f);
-  for (size_t f = 0; f < albedo.size(); ++f) {
-    const int m = object.triangle_material[f];
-    if (m < 0 || m >= static_cast<int>(material_albedo.size())) continue;
-    albedo[f] = material_albedo[m];
-    if (!object.colors.empty()) {
-      const auto& t = object.triangles[f];
-      const Vector3f mean = (object.colors[t[0]] + object.colors[t[1]] + object.colors[t[2]]) / 3;
-      albedo[f] = static_cast<float>(luminance(mean.cast<double>()) * material_factor[m]);
-    }
-  }
-  return albedo;
-}
-
 // One shot as the analysis needs it: the camera and the turntable in the object frame, and what
 // the camera sees (from a visibility buffer at the reduced canvas).
 struct ShotView {
@@ -162,6 +130,36 @@ struct ViewFaults {
 };
 
 }  // namespace
+
+std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene& studio) {
+  const scene::Geometry& object = studio.object;
+  std::vector<float> material_albedo, material_factor;
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const scene::ShadedMaterial& material = studio.materials[m];
+    Vector3f color = material.base_color;
+    if (material.texture >= 0 && material.texture < static_cast<int>(studio.textures.size()) &&
+        !studio.textures[material.texture].levels.empty()) {
+      color = color.cwiseProduct(studio.textures[material.texture].levels.back().texels[0]);
+    }
+    // A footprint far larger than the pattern gives the pattern's mean.
+    const float pattern_mean = scene::pattern_factor(material.pattern, Vector3f::Zero(), 1e6f);
+    material_factor.push_back(pattern_mean * (1 - material.metallic));
+    material_albedo.push_back(
+        static_cast<float>(luminance(color.cast<double>()) * material_factor.back()));
+  }
+  std::vector<float> albedo(object.triangles.size(), 0.5f);
+  for (size_t f = 0; f < albedo.size(); ++f) {
+    const int m = object.triangle_material[f];
+    if (m < 0 || m >= static_cast<int>(material_albedo.size())) continue;
+    albedo[f] = material_albedo[m];
+    if (!object.colors.empty()) {
+      const auto& t = object.triangles[f];
+      const Vector3f mean = (object.colors[t[0]] + object.colors[t[1]] + object.colors[t[2]]) / 3;
+      albedo[f] = static_cast<float>(luminance(mean.cast<double>()) * material_factor[m]);
+    }
+  }
+  return albedo;
+}
 
 // The whole analysis: per shot, per face visibility, usability and triangulation; the per-face
 // state persists across shots (view counts, usable views by shot). Shots are added in order.

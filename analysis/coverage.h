@@ -79,6 +79,10 @@ struct CoverageOptions {
 CoverageResult analyse_coverage(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const CoverageOptions& options = {});
 
+// Each face's mean albedo luminance, as the exposure check sees it: the material's colour (or
+// the mean of the face's vertex colours) times its texture's and pattern's averages.
+std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene& studio);
+
 class CoverageAnalysis;
 
 // The analysis kept open, so that shots can be added one at a time (the studio's captures): after

@@ -175,6 +175,43 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
 
 // A distortion the compiler takes (no fold-over) but that draws the frame's edge from beyond
 // the rendered canvas is pointed out at the distortion's line; a usual one is not.
+// A scan's vertex colours are the albedo the exposure check sees, face by face: the cube's red
+// top and blue bottom, not one mean colour for the whole cube.
+TEST(Coverage, VertexColoursAreTheFacesAlbedo) {
+  const std::string cube =
+      "  mesh: " + rigc::testing::source_path("tests/meshes/cube_quads_big_endian_colors.ply") +
+      "\n  fit: {height: 20cm}";
+  std::string text = scene_text(cube, kGoodExposure, kGoodShots);
+  const std::string speckle = "surface: {pattern: speckle, scale: 3mm}";
+  text.replace(text.find(speckle), speckle.size(), "surface: {pattern: none}");
+  DiagnosticEngine diag;
+  const auto scene = compile_scene_text(text, "test.yaml", ".", diag);
+  ASSERT_TRUE(scene);
+  const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
+  const std::vector<float> albedo = face_albedo(*scene, studio);
+  const ir::Mesh& mesh = scene->object.mesh;
+  ASSERT_EQ(albedo.size(), mesh.triangles.size());
+  int top = 0, bottom = 0;
+  for (std::size_t f = 0; f < albedo.size(); ++f) {
+    const auto& corners = mesh.triangles[f];
+    const bool all_top = mesh.positions[corners[0]].z() > 0 && mesh.positions[corners[1]].z() > 0 &&
+                         mesh.positions[corners[2]].z() > 0;
+    const bool all_bottom = mesh.positions[corners[0]].z() < 0 &&
+                            mesh.positions[corners[1]].z() < 0 &&
+                            mesh.positions[corners[2]].z() < 0;
+    if (all_top) {
+      EXPECT_NEAR(albedo[f], 0.2126, 1e-3) << "face " << f;
+    }
+    if (all_bottom) {
+      EXPECT_NEAR(albedo[f], 0.0722, 1e-3) << "face " << f;
+    }
+    top += all_top;
+    bottom += all_bottom;
+  }
+  EXPECT_EQ(top, 2);
+  EXPECT_EQ(bottom, 2);
+}
+
 TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
   const auto with_lens = [](const std::string& distortion) {
     std::string text = scene_text(kStatue, kGoodExposure, kGoodShots);
