@@ -532,13 +532,14 @@ bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
         return false;
       }
     }
-    fmt::format_to(out, "#declare {} =\n{}", material_identifier(m),
-                   texture_text(material, m, is_object, vec(material.base_color)));
     // With vertex colours each vertex has the texture with its colour, which POV-Ray
     // interpolates over the triangle (face_indices with three textures).
     if (is_object && !studio.object.colors.empty()) {
       fmt::format_to(out, "#macro {}(RigcColor)\n{}#end\n", vertex_texture_macro(m),
                      texture_text(material, m, is_object, "RigcColor"));
+    } else {
+      fmt::format_to(out, "#declare {} =\n{}", material_identifier(m),
+                     texture_text(material, m, is_object, vec(material.base_color)));
     }
   }
   inc.push_back('\n');

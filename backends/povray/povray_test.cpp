@@ -93,6 +93,9 @@ TEST(PovrayEmit, VertexColoursBecomeInterpolatedVertexTextures) {
   ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
   const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
   EXPECT_NE(inc.find("#macro RigcVertexTexture0(RigcColor)"), std::string::npos);
+  EXPECT_EQ(inc.find("#declare RigcMaterial0 ="), std::string::npos)
+      << "the object's material is the macro alone";
+  EXPECT_NE(inc.find("#declare RigcMaterial1 ="), std::string::npos) << "the studio's stay";
   const auto object = inc.find("#declare RigcObject = mesh2 {");
   ASSERT_NE(object, std::string::npos);
   EXPECT_NE(inc.find("texture_list { 3,\n    RigcVertexTexture0(<0.8, 0.1, 0.1>)", object),
