@@ -51,6 +51,9 @@ class Backend {
   virtual bool emits_scripts() const { return false; }
   // Whether RenderSettings::samples changes its output (then it is part of the shot key).
   virtual bool takes_samples() const { return false; }
+  // The samples a pixel that RenderSettings::samples = 0 stands for, when one count says it (0
+  // when the default is no count): asking for the default by number keeps the shot keys.
+  virtual int default_samples() const { return 0; }
   // The backend's own options that change its output, as text for the shot key ("" when none
   // differs from the default).
   virtual std::string options_key() const { return ""; }

@@ -100,6 +100,10 @@ class RunLoop {
  private:
   int check_options();
   bool open_run_folder();
+  // The samples a pixel the run renders with: the settings', or the backend's default for 0.
+  int samples() const {
+    return settings_.samples > 0 ? settings_.samples : backend_.default_samples();
+  }
   std::string key_of(const ir::Shot& shot) const;
   bool prepare_backend();
   bool render_and_queue(const ir::Shot& shot, const std::string& key);
@@ -170,7 +174,7 @@ bool RunLoop::open_run_folder() {
 
 std::string RunLoop::key_of(const ir::Shot& shot) const {
   std::vector<std::string> extra;
-  if (backend_.takes_samples()) extra.push_back(fmt::format("samples={}", settings_.samples));
+  if (backend_.takes_samples()) extra.push_back(fmt::format("samples={}", samples()));
   if (const std::string options = backend_.options_key(); !options.empty()) {
     extra.push_back(options);
   }
@@ -205,7 +209,7 @@ int RunLoop::run() {
                            {"object_sha256", object_geometry_hash(scene_)},
                            {"scale", settings_.scale},
                            {"seed", settings_.seed}};
-  if (backend_.takes_samples()) inputs["samples"] = settings_.samples;
+  if (backend_.takes_samples()) inputs["samples"] = samples();
   manifest_.set_inputs(std::move(inputs));
 
   for (int index : shots_) {

@@ -28,7 +28,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr double kPi = std::numbers::pi;
-constexpr int kDefaultSamples = 64;
 
 constexpr const char* kScriptTemplate =
 #include "backends/cycles/cycles_script.py.inc"
@@ -234,7 +233,7 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
   data["source_file"] = scene.source_file;
   data["width"] = canvas.width;
   data["height"] = canvas.height;
-  data["samples"] = samples > 0 ? samples : kDefaultSamples;
+  data["samples"] = samples > 0 ? samples : CyclesBackend::kDefaultSamples;
   data["shutter_s"] = camera.shutter_s;
   data["ambient_radiance"] = scene.studio.ambient_lx / external::kCandelaPerBlenderUnit / kPi;
   // The sensor width that gives the canvas's fx at the true focal length, so that Cycles' pupil

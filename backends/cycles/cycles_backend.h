@@ -32,6 +32,8 @@ class CyclesBackend : public external::ExternalBackend {
   static constexpr int kDefaultMaxBounces = 8;
   int max_bounces = kDefaultMaxBounces;
   std::string options_key() const override;
+  static constexpr int kDefaultSamples = 64;
+  int default_samples() const override { return kDefaultSamples; }
   // 2: area lights given their full power on Blender before 4.0.
   int output_version() const override { return 2; }
   // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is

@@ -45,6 +45,7 @@ class PreviewBackend : public run::Backend {
   // must be square, and the finer canvas no larger than the sensor (memory stays within the
   // full-resolution render's).
   bool takes_samples() const override { return true; }
+  int default_samples() const override { return 1; }
   bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
   // 2: depth of field blurs by the circle of confusion in the image, not on the sensor.
   int output_version() const override { return 2; }

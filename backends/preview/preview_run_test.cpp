@@ -104,6 +104,21 @@ TEST(PreviewRun, ShotsRenderedBeforeACorrectionRenderAgain) {
   for (const auto& t : timings) EXPECT_FALSE(t.skipped);
 }
 
+// Asking for the default samples by number is the default: the shots stay up to date.
+TEST(PreviewRun, TheDefaultSamplesByNumberAreTheDefault) {
+  testing::TempDir dir;
+  ir::Scene scene = turntable_ball(2, "180deg");
+  run::RunOptions options = small_run(dir.path());
+  std::ostringstream log;
+  ASSERT_EQ(run_preview(scene, options, log), 0) << log.str();
+  options.settings.samples = PreviewBackend().default_samples();
+  ASSERT_EQ(options.settings.samples, 1);
+  std::vector<run::ShotTiming> timings;
+  ASSERT_EQ(run_preview(scene, options, log, &timings), 0) << log.str();
+  ASSERT_EQ(timings.size(), 2u);
+  for (const auto& t : timings) EXPECT_TRUE(t.skipped);
+}
+
 // A run's samples per pixel reach the preview as a square grid of finer pixels (the frame
 // RenderOptions::supersample renders); they join the shot key, and grids that are not square or
 // would render larger than the sensor are refused before anything is written.
