@@ -148,9 +148,14 @@ double mean_signal(const ir::Camera& camera, const Rendered& r, const ir::Shot& 
   return sum / std::max(1.0, count);
 }
 
-// `reference_gap_stops`: how far the two ray tracers' exposures may part (Cycles adds the light
-// the studio reflects onto the object; POV-Ray and the preview leave it out).
-void expect_agreement(ir::Scene scene, int shot_index, double scale, double reference_gap_stops) {
+// Masks agree, and each reference's exposure of the object against the preview's. POV-Ray
+// shades with the preview's model (within kPovrayStops). Cycles stands above both, by less than
+// `cycles_gap_stops`: Blender 3's Principled BSDF keeps its whole diffuse under the specular
+// layer, where the preview and POV-Ray take (1 - F) out of it, and Cycles adds the light the
+// studio reflects onto the object. Below the preview, Cycles' lights would be short of power
+// (Blender 3's area lights needed 4/π more, 0.35 stop).
+void expect_agreement(ir::Scene scene, int shot_index, double scale, double cycles_gap_stops) {
+  constexpr double kPovrayStops = 0.05;
   RIGC_REQUIRE_TOOL(renderers_installed(), "povray or blender");
   // Sharp images (DOF has its own test) and no sensor noise: this compares the renderers.
   scene.camera.effects.depth_of_field = false;
@@ -172,7 +177,6 @@ void expect_agreement(ir::Scene scene, int shot_index, double scale, double refe
   const std::vector<std::uint8_t> common = eroded_common_mask(all);
   const double preview_mean = mean_object_luminance(all[0].frame, common);
   ASSERT_GT(preview_mean, 0);
-  std::vector<double> reference_means;
   for (size_t i = 1; i < all.size(); ++i) {
     const MaskStats stats = mask_stats(all[i].frame);
     const double iou = mask_iou(all[0].frame, all[i].frame);
@@ -186,12 +190,13 @@ void expect_agreement(ir::Scene scene, int shot_index, double scale, double refe
     EXPECT_GE(iou, 0.97) << all[i].backend;
     EXPECT_NEAR(stats.x, reference.x, 1.0) << all[i].backend;
     EXPECT_NEAR(stats.y, reference.y, 1.0) << all[i].backend;
-    EXPECT_LT(std::abs(stops), 1.0 / 3) << all[i].backend;
-    reference_means.push_back(mean);
+    if (all[i].backend == "povray") {
+      EXPECT_LT(std::abs(stops), kPovrayStops);
+    } else {
+      EXPECT_GT(stops, 0) << all[i].backend;
+      EXPECT_LT(stops, cycles_gap_stops) << all[i].backend;
+    }
   }
-  // Both ray tracers take the lights' power to the same light (Cycles' area lights in Blender 3
-  // needed 4/π more power for it).
-  EXPECT_LT(std::abs(std::log2(reference_means[1] / reference_means[0])), reference_gap_stops);
   // +1 stop of shutter is +1 stop of signal for every backend (nothing clips here).
   for (const auto& r : all) {
     ir::Camera camera = scene.camera;
@@ -208,16 +213,18 @@ void expect_agreement(ir::Scene scene, int shot_index, double scale, double refe
 
 TEST(ReferenceAgreement, PaperSceneMasksAndExposure) {
   const ir::Scene scene = compile_file("scenes/paper-turntable.yaml");
-  // 5472 px wide: 192 px. A dark studio (black turntable, green screen): little light comes back.
-  expect_agreement(scene, 2, 192.0 / scene.camera.width_px, 0.05);
+  // 5472 px wide: 192 px. A dark studio (black turntable, green screen): little light comes back,
+  // and Cycles stands 0.07 stop above the preview.
+  expect_agreement(scene, 2, 192.0 / scene.camera.width_px, 0.12);
 }
 
 TEST(ReferenceAgreement, TexturedSceneMasksAndExposure) {
   RIGC_REQUIRE_TOOL(fs::exists("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf"),
                     "assimp-testmodels");
   const ir::Scene scene = compile_file("scenes/orbit-textured.yaml");
-  // A grey turntable and backdrop: Cycles' box gets 0.16 stop more light back from them.
-  expect_agreement(scene, 3, 192.0 / scene.camera.width_px, 0.25);
+  // A grey turntable and backdrop: Cycles' box gets 0.16 stop more light back from them (0.26
+  // above the preview in all).
+  expect_agreement(scene, 3, 192.0 / scene.camera.width_px, 0.32);
 }
 
 // Mean absolute difference of two renders over `mask`, all channels, relative to the mean of b.

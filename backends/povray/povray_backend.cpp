@@ -218,14 +218,16 @@ std::string noise_functions_text() {
 }
 
 // The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) scaled by
-// 1 - F0 as the preview's (1 - Fresnel), and a normalised Blinn-Phong highlight of the same
-// peak as its GGX lobe.
+// 1 - F0 as the preview's (1 - Fresnel), and a Blinn-Phong highlight of the GGX lobe's width
+// (exponent 2/α² - 2) and peak. POV adds specular · (n·h)^exponent · light colour, with no n·l;
+// the GGX lobe's radiance with light and view along the normal is F0 · D(1) / 4 · E, D(1) =
+// 1/(π α²), so specular = F0 / (4 α²).
 std::string finish_text(const scene::ShadedMaterial& material) {
   const double metallic = material.metallic;
   const double f0 = 0.04 * (1 - metallic) + metallic;
   const double alpha = std::max(static_cast<double>(material.roughness) * material.roughness, 0.05);
   const double exponent = std::max(2 / (alpha * alpha) - 2, 1.0);
-  const double specular = f0 * (exponent + 8) / 8;
+  const double specular = f0 / (4 * alpha * alpha);
   return fmt::format("finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
                      number_text(1 - metallic), number_text((1 - f0) * (1 - metallic)),
                      number_text(specular), number_text(1 / exponent),

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "backends/external/process.h"
+#include "backends/external/script_text.h"
 #include "backends/povray/povray_backend.h"
 #include "compiler/frontend.h"
 #include "run/run_loop.h"
@@ -79,6 +80,24 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   const std::string pov = read_text((dir.path() / "pov" / "shot_000.pov").string());
   EXPECT_NE(pov.find("aperture"), std::string::npos);  // f-number mapped to focal blur
   EXPECT_NE(pov.find("focal_point"), std::string::npos);
+}
+
+// The object's highlight peaks as the preview's GGX lobe does with light and view along the
+// normal: F0 · D(1) / 4 · E, D(1) = 1 / (π α²), α = roughness², so POV's specular (which adds
+// specular · E/π at the peak) is F0 / (4 α²); its width is the lobe's (exponent 2/α² - 2).
+TEST(PovrayEmit, HighlightPeaksAsThePreviewsGgxLobe) {
+  const ir::Scene scene = paper_scene();
+  TempDir dir;
+  std::string error;
+  ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
+  const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
+  const double roughness = static_cast<float>(scene.materials[0].roughness);  // as shaded
+  const double alpha = roughness * roughness;
+  ASSERT_GT(alpha, 0.05);  // above POV's clamp
+  const std::string finish =
+      fmt::format("specular {} roughness {}", external::number_text(0.04 / (4 * alpha * alpha)),
+                  external::number_text(1 / (2 / (alpha * alpha) - 2)));
+  EXPECT_NE(inc.find(finish), std::string::npos) << finish;
 }
 
 // Vertex colours become a texture per colour, made by the material's macro, and each face names
