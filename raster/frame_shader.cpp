@@ -218,7 +218,7 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
     float fresnel = 0;
     const float specular =
         ggx_specular(n_dot_l, n_dot_v, std::max(sp.n.dot(h), 0.0f), std::max(sp.v.dot(h), 0.0f),
-                     material.roughness, f0, &fresnel);
+                     material.roughness, f0, sample.half_vector_spread2, &fresnel);
     const Vector3f arriving = sample.illuminance * (n_dot_l * visibility);
     diffuse += arriving * ((1 - fresnel) / kPi);
     if (request_.specular) specular_sum += arriving * specular;

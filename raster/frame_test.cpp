@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <set>
 #include <sstream>
@@ -14,6 +15,7 @@
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/optics.h"
+#include "raster/lighting.h"
 #include "raster/rasterizer.h"
 #include "run/colmap_text.h"
 #include "run/manifest.h"
@@ -419,6 +421,36 @@ TEST(Raster, SoftboxLightsABoxFaceDownToItsFoot) {
 // smallest filter (1.5 texels), the filter's outer taps must still count: with them counted as
 // lit, a lit wedge opened between the box's foot and its shadow (0.913 of the point light's
 // shadowed pixels then, 0.992 now).
+// A panel's size: it lights a point on its axis as a Lambertian disc of its area does, 1 / (1 +
+// R²/D²) of its centre's light, and widens the highlight it makes by half its angular radius.
+TEST(Raster, AnAreaLightsSizeDimsItsLightAndWidensItsHighlight) {
+  ir::Light panel;
+  panel.type = ir::LightType::kArea;
+  panel.position = {0, 0, 2};
+  panel.direction = {0, 0, -1};
+  panel.power_w = 80;
+  panel.size_m = {0.5, 0.5};
+  const FrameLight light(panel, Vector3f::Ones());
+  LightSample sample;
+  ASSERT_TRUE(sample_light(light, Vector3f::Zero(), &sample));
+  const double radius2 = 0.25 / std::numbers::pi, distance2 = 4;
+  EXPECT_NEAR(sample.illuminance.x(),
+              light.scaled_color.x() / distance2 / (1 + radius2 / distance2),
+              1e-3 * sample.illuminance.x());
+  EXPECT_NEAR(sample.half_vector_spread2, radius2 / (4 * distance2), 1e-7);
+
+  // The peak of the GGX lobe is 1 / (π a²), a² = α² + spread²: a glossy highlight loses most of
+  // its peak, a rough one little.
+  for (const float roughness : {0.3f, 0.8f}) {
+    const float alpha2 = std::pow(roughness, 4.0f);
+    float fresnel = 0;
+    const float point = ggx_specular(1, 1, 1, 1, roughness, 0.04f, 0, &fresnel);
+    const float wide =
+        ggx_specular(1, 1, 1, 1, roughness, 0.04f, sample.half_vector_spread2, &fresnel);
+    EXPECT_NEAR(wide / point, alpha2 / (alpha2 + sample.half_vector_spread2), 1e-4) << roughness;
+  }
+}
+
 TEST(Raster, SmallAreaLightShadowsLikeAPointLight) {
   auto shadowed_pixels = [](const std::string& light) {
     const dslr::LinearFrame frame = box_frame(light, 0.25, 684);  // a 0.25-scale render's map

@@ -22,6 +22,8 @@ struct FrameLight {
   // spot: colour x intensity (cd).
   Vector3f scaled_color = Vector3f::Zero();
   float spot_outer_cos = -1, spot_inner_cos = -1;
+  // Area: the squared radius of the disc of the panel's area (its size, for the highlight).
+  float disc_radius2 = 0;
 
   explicit FrameLight(const ir::Light& light, const Vector3f& color)
       : type(light.type),
@@ -35,6 +37,7 @@ struct FrameLight {
       case ir::LightType::kArea:
         // A one-sided Lambertian emitter of power P has intensity P/π along its normal.
         scaled_color = color * (kLumensPerWatt * watts / kPi);
+        disc_radius2 = static_cast<float>(light.size_m.x() * light.size_m.y()) / kPi;
         break;
       case ir::LightType::kPoint:
       case ir::LightType::kSpot: {
@@ -53,6 +56,9 @@ struct FrameLight {
 struct LightSample {
   Vector3f to_light;
   Vector3f illuminance;  // per channel, lux
+  // The square of half the light's angular radius from the point: how far the half vector
+  // spreads over the light, added to the highlight's α² (ggx_specular).
+  float half_vector_spread2 = 0;
 };
 
 // Always inlined: left to itself GCC keeps it a call from the lighting loop, which runs about a
@@ -69,7 +75,10 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
   out->to_light = d / std::sqrt(dist2);
   float falloff = 1 / dist2;
   if (light.type == ir::LightType::kArea) {
-    falloff *= std::max(0.0f, -light.direction.dot(out->to_light));
+    // The panel's cosine, and its size: a Lambertian disc of radius R seen on axis from D gives
+    // 1 / (1 + R²/D²) of what its centre alone would.
+    falloff *=
+        std::max(0.0f, -light.direction.dot(out->to_light)) / (1 + light.disc_radius2 / dist2);
   } else if (light.type == ir::LightType::kSpot) {
     const float cos_axis = light.direction.dot(-out->to_light);
     const float t = std::clamp((cos_axis - light.spot_outer_cos) /
@@ -78,14 +87,18 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
     falloff *= t * t * (3 - 2 * t);
   }
   out->illuminance = light.scaled_color * falloff;
+  out->half_vector_spread2 = light.disc_radius2 / (4 * dist2);
   return falloff > 0;
 }
 
 // GGX microfacet specular (Smith-Schlick visibility), times π so that it sits beside albedo/π·π.
+// A light of some size widens the lobe it is seen in: `spread2` is added to α² (a convolution of
+// two narrow lobes adds their variances), which lowers a glossy highlight's peak as integrating
+// over the light does.
 inline float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h,
-                          float roughness, float f0, float* fresnel_out) {
+                          float roughness, float f0, float spread2, float* fresnel_out) {
   const float alpha = std::max(roughness * roughness, 0.002f);
-  const float a2 = alpha * alpha;
+  const float a2 = alpha * alpha + spread2;
   const float denom = n_dot_h * n_dot_h * (a2 - 1) + 1;
   const float d = a2 / (kPi * denom * denom);
   const float k = alpha / 2;
