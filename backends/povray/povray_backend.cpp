@@ -365,14 +365,18 @@ std::string light_text(const ir::Light& light) {
       across.normalize();
       const Eigen::Vector3d along = dir.cross(across).normalized();
       const int cells = 5;
+      // POV's grid spans its axes end to end; (cells - 1) / cells of the panel puts its points at
+      // the centres of the panel's cells, so that they average the panel uniformly.
+      const double span = (cells - 1.0) / cells;
       // A Lambertian panel of power P: intensity P/π·cos θ, one-sided (the spotlight's cos).
+      // area_illumination: light and highlights from every cell, not the panel's centre.
       return fmt::format(
           "light_source {{ {}, rgb {} {} spotlight point_at {} radius 90 falloff 90 tightness 1\n"
-          "  area_light {}, {}, {}, {} adaptive 1 }}\n",
+          "  area_light {}, {}, {}, {} adaptive 1 area_illumination on }}\n",
           vec(light.position), vec(Eigen::Vector3d(color * light.power_w / kPi * to_colour)), fade,
           vec(Eigen::Vector3d(light.position + dir)),
-          vec(Eigen::Vector3d(across * std::max(light.size_m.x(), 1e-4))),
-          vec(Eigen::Vector3d(along * std::max(light.size_m.y(), 1e-4))), cells, cells);
+          vec(Eigen::Vector3d(across * (span * std::max(light.size_m.x(), 1e-4)))),
+          vec(Eigen::Vector3d(along * (span * std::max(light.size_m.y(), 1e-4)))), cells, cells);
     }
   }
   return "";

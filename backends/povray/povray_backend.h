@@ -33,8 +33,9 @@ class PovrayBackend : public external::ExternalBackend {
   // lights) instead of the lit image: for the albedo agreement test.
   bool albedo_only = false;
   std::string options_key() const override { return albedo_only ? "albedo_only" : ""; }
-  // 2: the highlight's peak that of the preview's GGX lobe.
-  int output_version() const override { return 2; }
+  // 2: the highlight's peak that of the preview's GGX lobe; 3: area lights light from their
+  // whole panel.
+  int output_version() const override { return 3; }
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
   // samples (0: defaults).

@@ -98,6 +98,8 @@ TEST(PovrayEmit, HighlightPeaksAsThePreviewsGgxLobe) {
       fmt::format("specular {} roughness {}", external::number_text(0.04 / (4 * alpha * alpha)),
                   external::number_text(1 / (2 / (alpha * alpha) - 2)));
   EXPECT_NE(inc.find(finish), std::string::npos) << finish;
+  // The highlight of an area light comes from its whole panel, as Cycles' does.
+  EXPECT_NE(inc.find("area_illumination on"), std::string::npos);
 }
 
 // Vertex colours become a texture per colour, made by the material's macro, and each face names
