@@ -68,17 +68,18 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
   if (light.type == ir::LightType::kDirectional) {
     out->to_light = -light.direction;
     out->illuminance = light.scaled_color;
+    out->half_vector_spread2 = 0;
     return true;
   }
   const Vector3f d = light.position - p;
   const float dist2 = std::max(d.squaredNorm(), 1e-6f);
   out->to_light = d / std::sqrt(dist2);
+  const float size2 = light.disc_radius2 / dist2;  // (R/D)²: 0 but for area lights
   float falloff = 1 / dist2;
   if (light.type == ir::LightType::kArea) {
     // The panel's cosine, and its size: a Lambertian disc of radius R seen on axis from D gives
     // 1 / (1 + R²/D²) of what its centre alone would.
-    falloff *=
-        std::max(0.0f, -light.direction.dot(out->to_light)) / (1 + light.disc_radius2 / dist2);
+    falloff *= std::max(0.0f, -light.direction.dot(out->to_light)) / (1 + size2);
   } else if (light.type == ir::LightType::kSpot) {
     const float cos_axis = light.direction.dot(-out->to_light);
     const float t = std::clamp((cos_axis - light.spot_outer_cos) /
@@ -87,7 +88,7 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
     falloff *= t * t * (3 - 2 * t);
   }
   out->illuminance = light.scaled_color * falloff;
-  out->half_vector_spread2 = light.disc_radius2 / (4 * dist2);
+  out->half_vector_spread2 = size2 / 4;
   return falloff > 0;
 }
 
