@@ -150,9 +150,9 @@ double mean_signal(const ir::Camera& camera, const Rendered& r, const ir::Shot& 
 
 // Masks agree, and each reference's exposure of the object against the preview's. POV-Ray
 // shades with the preview's model (within kPovrayStops). Cycles stands above both, by less than
-// `cycles_gap_stops`: Blender 3's Principled BSDF keeps its whole diffuse under the specular
-// layer, where the preview and POV-Ray take (1 - F) out of it, and Cycles adds the light the
-// studio reflects onto the object. Below the preview, Cycles' lights would be short of power
+// `cycles_gap_stops`: Blender 3's Principled BSDF has Burley's diffuse, brighter than Lambert's
+// where rough surfaces are seen or lit at grazing angles, and Cycles adds the light the studio
+// reflects onto the object. Below the preview, Cycles' lights would be short of power
 // (Blender 3's area lights needed 4/π more, 0.35 stop).
 void expect_agreement(ir::Scene scene, int shot_index, double scale, double cycles_gap_stops) {
   constexpr double kPovrayStops = 0.05;

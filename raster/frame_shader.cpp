@@ -215,16 +215,17 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
         shadow_maps_[l].visibility(sp.p, sp.geometric, std::max(geo_dot_l, 0.0f));
     if (visibility <= 0) continue;
     const Vector3f h = unit(sample.to_light + sp.v);
-    float fresnel = 0;
     const float specular =
         ggx_specular(n_dot_l, n_dot_v, std::max(sp.n.dot(h), 0.0f), std::max(sp.v.dot(h), 0.0f),
-                     material.roughness, f0, sample.half_vector_spread2, &fresnel);
+                     material.roughness, f0, sample.half_vector_spread2);
     const Vector3f arriving = sample.illuminance * (n_dot_l * visibility);
-    diffuse += arriving * ((1 - fresnel) / kPi);
+    diffuse += arriving / kPi;
     if (request_.specular) specular_sum += arriving * specular;
   }
-  // brdf = albedo·(1 - metallic)·(1 - F)/π + spec_colour·specular, where the specular colour
-  // is white for dielectrics and blends towards the albedo with the metallic factor.
+  // brdf = albedo·(1 - metallic)/π + spec_colour·specular, where the specular colour is white
+  // for dielectrics and blends towards the albedo with the metallic factor. The diffuse keeps
+  // its whole weight under the highlight, as in the Principled BSDF of the Cycles reference
+  // (docs/fidelity.md).
   return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
 }
 

@@ -97,7 +97,7 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
 // two narrow lobes adds their variances), which lowers a glossy highlight's peak as integrating
 // over the light does.
 inline float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h,
-                          float roughness, float f0, float spread2, float* fresnel_out) {
+                          float roughness, float f0, float spread2) {
   const float alpha = std::max(roughness * roughness, 0.002f);
   const float a2 = alpha * alpha + spread2;
   const float denom = n_dot_h * n_dot_h * (a2 - 1) + 1;
@@ -106,7 +106,6 @@ inline float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_d
   const float vis = 1 / ((n_dot_l * (1 - k) + k) * (n_dot_v * (1 - k) + k));
   const float fresnel =
       f0 + (1 - f0) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h) * (1 - v_dot_h);
-  *fresnel_out = fresnel;
   return d * vis * fresnel / 4;
 }
 

@@ -217,8 +217,8 @@ std::string noise_functions_text() {
   return text;
 }
 
-// The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) scaled by
-// 1 - F0 as the preview's (1 - Fresnel), and a Blinn-Phong highlight of the GGX lobe's width
+// The preview's shading in POV's terms: Lambert (the 1/π is in the light colours) with the whole
+// diffuse weight under the highlight, and a Blinn-Phong highlight of the GGX lobe's width
 // (exponent 2/α² - 2) and peak. POV adds specular · (n·h)^exponent · light colour, with no n·l;
 // the GGX lobe's radiance with light and view along the normal is F0 · D(1) / 4 · E, D(1) =
 // 1/(π α²), so specular = F0 / (4 α²).
@@ -229,9 +229,8 @@ std::string finish_text(const scene::ShadedMaterial& material) {
   const double exponent = std::max(2 / (alpha * alpha) - 2, 1.0);
   const double specular = f0 / (4 * alpha * alpha);
   return fmt::format("finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
-                     number_text(1 - metallic), number_text((1 - f0) * (1 - metallic)),
-                     number_text(specular), number_text(1 / exponent),
-                     metallic > 0.5 ? " metallic" : "");
+                     number_text(1 - metallic), number_text(1 - metallic), number_text(specular),
+                     number_text(1 / exponent), metallic > 0.5 ? " metallic" : "");
 }
 
 // A material's texture for the mask, the albedo and the lit passes, with its base colour as

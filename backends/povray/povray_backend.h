@@ -35,7 +35,7 @@ class PovrayBackend : public external::ExternalBackend {
   std::string options_key() const override { return albedo_only ? "albedo_only" : ""; }
   // 2: the highlight's peak that of the preview's GGX lobe; 3: area lights light from their
   // whole panel.
-  int output_version() const override { return 3; }
+  int output_version() const override { return 4; }
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
   // samples (0: defaults).
