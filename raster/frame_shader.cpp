@@ -219,13 +219,15 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
         ggx_specular(n_dot_l, n_dot_v, std::max(sp.n.dot(h), 0.0f), std::max(sp.v.dot(h), 0.0f),
                      material.roughness, f0, sample.half_vector_spread2);
     const Vector3f arriving = sample.illuminance * (n_dot_l * visibility);
-    diffuse += arriving / kPi;
+    const float burley =
+        burley_diffuse(n_dot_l, n_dot_v, sample.to_light.dot(sp.v), material.roughness);
+    diffuse += arriving * (burley / kPi);
     if (request_.specular) specular_sum += arriving * specular;
   }
-  // brdf = albedo·(1 - metallic)/π + spec_colour·specular, where the specular colour is white
-  // for dielectrics and blends towards the albedo with the metallic factor. The diffuse keeps
-  // its whole weight under the highlight, as in the Principled BSDF of the Cycles reference
-  // (docs/fidelity.md).
+  // brdf = albedo·(1 - metallic)·burley/π + spec_colour·specular, where the specular colour is
+  // white for dielectrics and blends towards the albedo with the metallic factor. The diffuse
+  // keeps its whole weight under the highlight, as in the Principled BSDF of the Cycles
+  // reference (docs/fidelity.md); the ambient room light stays Lambertian.
   return {diffuse * (1 - metallic) + specular_sum * metallic, specular_sum * (1 - metallic)};
 }
 

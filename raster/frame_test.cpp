@@ -423,6 +423,21 @@ TEST(Raster, SoftboxLightsABoxFaceDownToItsFoot) {
 // shadowed pixels then, 0.992 now).
 // A panel's size: it lights a point on its axis as a Lambertian disc of its area does, 1 / (1 +
 // R²/D²) of its centre's light, and widens the highlight it makes by half its angular radius.
+// Burley's diffuse (Blender 3's Principled): Lambert's where light and view are along the
+// normal; at grazing light and view, 1/4 of it for a smooth surface, and for a rough one the
+// retro-reflection 2 (1 + 1 + 1) on top when light and view coincide.
+TEST(Raster, DiffuseIsBurleysAsInPrincipled) {
+  for (const float roughness : {0.0f, 0.5f, 1.0f}) {
+    EXPECT_FLOAT_EQ(burley_diffuse(1, 1, 1, roughness), 1) << roughness;
+  }
+  EXPECT_FLOAT_EQ(burley_diffuse(0, 0, 1, 0), 0.25f);
+  EXPECT_FLOAT_EQ(burley_diffuse(0, 0, 1, 1), 6.25f);
+  // Light and view 60° either side of the normal (l·v = -0.5), roughness 0.8.
+  const float f = 0.5f * 0.5f * 0.5f * 0.5f * 0.5f, retro = 0.8f * 0.5f;
+  EXPECT_FLOAT_EQ(burley_diffuse(0.5f, 0.5f, -0.5f, 0.8f),
+                  (1 - f / 2) * (1 - f / 2) + retro * (2 * f + f * f * (retro - 1)));
+}
+
 TEST(Raster, AnAreaLightsSizeDimsItsLightAndWidensItsHighlight) {
   ir::Light panel;
   panel.type = ir::LightType::kArea;

@@ -109,4 +109,17 @@ inline float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_d
   return d * vis * fresnel / 4;
 }
 
+// Burley's diffuse relative to Lambert's, as Blender 3's Principled BSDF has it: darker where
+// light or view graze the surface, plus a retro-reflection that grows with roughness and peaks
+// with light and view together (1 + l·v = 2 (l·h)²).
+inline float burley_diffuse(float n_dot_l, float n_dot_v, float l_dot_v, float roughness) {
+  auto schlick = [](float cosine) {
+    const float m = std::clamp(1 - cosine, 0.0f, 1.0f);
+    return m * m * m * m * m;
+  };
+  const float fl = schlick(n_dot_l), fv = schlick(n_dot_v);
+  const float retro = roughness * (1 + l_dot_v);
+  return (1 - 0.5f * fv) * (1 - 0.5f * fl) + retro * (fl + fv + fl * fv * (retro - 1));
+}
+
 }  // namespace rigc::raster

@@ -49,7 +49,7 @@ class PreviewBackend : public run::Backend {
   bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
   // 2: depth of field blurs by the circle of confusion in the image, not on the sensor; 3: an
   // area light's size widens the highlights it makes.
-  int output_version() const override { return 4; }
+  int output_version() const override { return 5; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
