@@ -416,13 +416,6 @@ TEST(Raster, SoftboxLightsABoxFaceDownToItsFoot) {
   EXPECT_NEAR(soft / small, 1.0, 0.02);
 }
 
-// A 1 cm area light casts the hard shadow a point light in its place casts, right up to the
-// contact with the box. Where the cone from a point to such a light is narrower than the
-// smallest filter (1.5 texels), the filter's outer taps must still count: with them counted as
-// lit, a lit wedge opened between the box's foot and its shadow (0.913 of the point light's
-// shadowed pixels then, 0.992 now).
-// A panel's size: it lights a point on its axis as a Lambertian disc of its area does, 1 / (1 +
-// R²/D²) of its centre's light, and widens the highlight it makes by half its angular radius.
 // Burley's diffuse (Blender 3's Principled): Lambert's where light and view are along the
 // normal; at grazing light and view, 1/4 of it for a smooth surface, and for a rough one the
 // retro-reflection 2 (1 + 1 + 1) on top when light and view coincide.
@@ -438,6 +431,8 @@ TEST(Raster, DiffuseIsBurleysAsInPrincipled) {
                   (1 - f / 2) * (1 - f / 2) + retro * (2 * f + f * f * (retro - 1)));
 }
 
+// A panel's size: it lights a point on its axis as a Lambertian disc of its area does, 1 / (1 +
+// R²/D²) of its centre's light, and widens the highlight it makes by half its angular radius.
 TEST(Raster, AnAreaLightsSizeDimsItsLightAndWidensItsHighlight) {
   ir::Light panel;
   panel.type = ir::LightType::kArea;
@@ -464,6 +459,11 @@ TEST(Raster, AnAreaLightsSizeDimsItsLightAndWidensItsHighlight) {
   }
 }
 
+// A 1 cm area light casts the hard shadow a point light in its place casts, right up to the
+// contact with the box. Where the cone from a point to such a light is narrower than the
+// smallest filter (1.5 texels), the filter's outer taps must still count: with them counted as
+// lit, a lit wedge opened between the box's foot and its shadow (0.913 of the point light's
+// shadowed pixels then, 0.992 now).
 TEST(Raster, SmallAreaLightShadowsLikeAPointLight) {
   auto shadowed_pixels = [](const std::string& light) {
     const dslr::LinearFrame frame = box_frame(light, 0.25, 684);  // a 0.25-scale render's map
