@@ -161,6 +161,23 @@ std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene&
   return albedo;
 }
 
+namespace {
+
+// Each face's material roughness (0.5 where a face has no material).
+std::vector<float> face_roughness(const scene::StudioScene& studio) {
+  const scene::Geometry& object = studio.object;
+  std::vector<float> roughness(object.triangles.size(), 0.5f);
+  for (size_t f = 0; f < roughness.size(); ++f) {
+    const int m = object.triangle_material[f];
+    if (m >= 0 && m < static_cast<int>(studio.materials.size())) {
+      roughness[f] = studio.materials[m].roughness;
+    }
+  }
+  return roughness;
+}
+
+}  // namespace
+
 // The whole analysis: per shot, per face visibility, usability and triangulation; the per-face
 // state persists across shots (view counts, usable views by shot). Shots are added in order.
 class CoverageAnalysis {
@@ -211,6 +228,7 @@ class CoverageAnalysis {
   CoverageResult result_;
   std::vector<Vector3d> center_, normal_;  // object frame
   std::vector<float> albedo_;
+  std::vector<float> roughness_;  // of each face's material
   // usable_by_shot_[s][f]: face f has a usable view in shot s (for triangulation pairs).
   std::vector<std::vector<std::uint8_t>> usable_by_shot_;
   std::vector<std::uint8_t> seen_previous_, seen_now_;
@@ -274,6 +292,7 @@ CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioSc
   if (!options.check(&error)) throw std::invalid_argument(error);
   measure_faces();
   albedo_ = face_albedo(scene_, studio_);
+  roughness_ = face_roughness(studio_);
   if (visibility_cache_) geometry_key_ = geometry_key(studio_, canvas_);
 }
 
@@ -483,16 +502,19 @@ double CoverageAnalysis::footprint_px(const ShotView& view, size_t f) const {
   return std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 2;
 }
 
-// The sensor signal of a diffuse face: albedo x illuminance / pi x exposure (see
-// docs/camera-model.md).
+// The sensor signal of a face's diffuse reflection: albedo x illuminance / pi x exposure, each
+// light's illuminance shaped by the preview's diffuse lobe (see docs/camera-model.md).
 double CoverageAnalysis::face_signal(const ShotView& view, size_t f) const {
-  const Vector3f world_center =
-      (view.world_rotation * center_[f] + view.world_translation).cast<float>();
+  const Vector3d center = view.world_rotation * center_[f] + view.world_translation;
+  const Vector3d eye = view.world_rotation * view.eye + view.world_translation;
+  const Vector3f world_center = center.cast<float>();
   const Vector3f world_normal = (view.world_rotation * normal_[f]).cast<float>();
+  const Vector3f to_eye = (eye - center).normalized().cast<float>();
   double illuminance = scene_.studio.ambient_lx;
   for (const auto& light : scene_.studio.lights) {
-    illuminance +=
-        luminance(raster::light_illuminance(light, world_center, world_normal).cast<double>());
+    const Vector3f reflected =
+        raster::diffuse_illuminance(light, world_center, world_normal, to_eye, roughness_[f]);
+    illuminance += luminance(reflected.cast<double>());
   }
   return albedo_[f] * illuminance / std::numbers::pi * exposure_;
 }

@@ -431,6 +431,30 @@ TEST(Raster, DiffuseIsBurleysAsInPrincipled) {
                   (1 - f / 2) * (1 - f / 2) + retro * (2 * f + f * f * (retro - 1)));
 }
 
+// The diffuse reflection coverage estimates is the preview's: Lambert's illuminance with light
+// and view along the normal, Burley's lobe elsewhere (a rough surface seen and lit from the same
+// grazing side reflects more than a Lambertian one would).
+TEST(Raster, DiffuseIlluminanceIsShapedByBurleysLobe) {
+  ir::Light lamp;
+  lamp.type = ir::LightType::kPoint;
+  lamp.position = {0, 0, 2};
+  lamp.power_w = 10;
+  const Vector3f up = Vector3f::UnitZ();
+  const float head_on = diffuse_illuminance(lamp, Vector3f::Zero(), up, up, 0.8f).x();
+  EXPECT_NEAR(head_on, kLumensPerWatt * 10 / (4 * std::numbers::pi_v<float> * 4), 1e-3f * head_on);
+  // The surface tilted 80° away from both the lamp and the eye above it.
+  const Vector3f tilted(std::sin(80 * std::numbers::pi_v<float> / 180), 0,
+                        std::cos(80 * std::numbers::pi_v<float> / 180));
+  const float cos_tilt = tilted.z();
+  const float rough = diffuse_illuminance(lamp, Vector3f::Zero(), tilted, up, 1.0f).x();
+  const float smooth = diffuse_illuminance(lamp, Vector3f::Zero(), tilted, up, 0.0f).x();
+  EXPECT_NEAR(rough, head_on * cos_tilt * burley_diffuse(cos_tilt, cos_tilt, 1, 1.0f),
+              1e-3f * rough);
+  EXPECT_GT(rough, head_on * cos_tilt * 1.5f);
+  EXPECT_LT(smooth, head_on * cos_tilt);
+  EXPECT_EQ(diffuse_illuminance(lamp, Vector3f::Zero(), -up, up, 0.8f).x(), 0);
+}
+
 // A panel's size: it lights a point on its axis as a Lambertian disc of its area does, 1 / (1 +
 // R²/D²) of its centre's light, and widens the highlight it makes by half its angular radius.
 TEST(Raster, AnAreaLightsSizeDimsItsLightAndWidensItsHighlight) {

@@ -70,13 +70,18 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const scene::StudioScene&
   return frame;
 }
 
-Eigen::Vector3f light_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
-                                  const Eigen::Vector3f& normal) {
+Eigen::Vector3f diffuse_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
+                                    const Eigen::Vector3f& normal, const Eigen::Vector3f& to_eye,
+                                    float roughness) {
   LightSample sample;
   if (!sample_light(FrameLight(light, light.color.cast<float>()), point, &sample)) {
     return Vector3f::Zero();
   }
-  return sample.illuminance * std::max(0.0f, normal.dot(sample.to_light));
+  const float n_dot_l = normal.dot(sample.to_light);
+  if (n_dot_l <= 0) return Vector3f::Zero();
+  const float n_dot_v = std::max(normal.dot(to_eye), 1e-3f);
+  return sample.illuminance *
+         (n_dot_l * burley_diffuse(n_dot_l, n_dot_v, sample.to_light.dot(to_eye), roughness));
 }
 
 VisibilityBuffer render_visibility(const ir::Scene& scene, const scene::StudioScene& studio,

@@ -51,10 +51,13 @@ dslr::LinearFrame render_frame(const ir::Scene& scene, const scene::StudioScene&
                                const FrameRequest& request, RasterTimings* timings = nullptr,
                                ShadowMapCache* shadow_cache = nullptr);
 
-// Illuminance (lux, per linear RGB channel) that a light casts on a surface point with normal n,
-// shadows ignored: the same radiometry the renderer shades with.
-Eigen::Vector3f light_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
-                                  const Eigen::Vector3f& normal);
+// A light's diffuse reflection at a surface point, as the illuminance (lux, per linear RGB
+// channel) a Lambertian surface would need to give it: the illuminance on the surface with
+// normal n, shaped by Burley's lobe for a view towards `to_eye` and the surface's roughness;
+// shadows ignored. The same radiometry the renderer shades with.
+Eigen::Vector3f diffuse_illuminance(const ir::Light& light, const Eigen::Vector3f& point,
+                                    const Eigen::Vector3f& normal, const Eigen::Vector3f& to_eye,
+                                    float roughness);
 
 // Visibility only, one sample per pixel centre: the nearest object triangle (-1 where the studio
 // or nothing is seen) and the camera-space depth of whatever is nearest. For coverage analysis.
