@@ -34,7 +34,7 @@ class PovrayBackend : public external::ExternalBackend {
   bool albedo_only = false;
   std::string options_key() const override { return albedo_only ? "albedo_only" : ""; }
   // 2: the highlight's peak that of the preview's GGX lobe; 3: area lights light from their
-  // whole panel.
+  // whole panel; 4: the whole diffuse under the highlight.
   int output_version() const override { return 4; }
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
