@@ -161,23 +161,6 @@ std::vector<float> face_albedo(const ir::Scene& scene, const scene::StudioScene&
   return albedo;
 }
 
-namespace {
-
-// Each face's material roughness (0.5 where a face has no material).
-std::vector<float> face_roughness(const scene::StudioScene& studio) {
-  const scene::Geometry& object = studio.object;
-  std::vector<float> roughness(object.triangles.size(), 0.5f);
-  for (size_t f = 0; f < roughness.size(); ++f) {
-    const int m = object.triangle_material[f];
-    if (m >= 0 && m < static_cast<int>(studio.materials.size())) {
-      roughness[f] = studio.materials[m].roughness;
-    }
-  }
-  return roughness;
-}
-
-}  // namespace
-
 // The whole analysis: per shot, per face visibility, usability and triangulation; the per-face
 // state persists across shots (view counts, usable views by shot). Shots are added in order.
 class CoverageAnalysis {
@@ -228,7 +211,6 @@ class CoverageAnalysis {
   CoverageResult result_;
   std::vector<Vector3d> center_, normal_;  // object frame
   std::vector<float> albedo_;
-  std::vector<float> roughness_;  // of each face's material
   // usable_by_shot_[s][f]: face f has a usable view in shot s (for triangulation pairs).
   std::vector<std::vector<std::uint8_t>> usable_by_shot_;
   std::vector<std::uint8_t> seen_previous_, seen_now_;
@@ -292,7 +274,6 @@ CoverageAnalysis::CoverageAnalysis(const ir::Scene& scene, const scene::StudioSc
   if (!options.check(&error)) throw std::invalid_argument(error);
   measure_faces();
   albedo_ = face_albedo(scene_, studio_);
-  roughness_ = face_roughness(studio_);
   if (visibility_cache_) geometry_key_ = geometry_key(studio_, canvas_);
 }
 
@@ -510,10 +491,14 @@ double CoverageAnalysis::face_signal(const ShotView& view, size_t f) const {
   const Vector3f world_center = center.cast<float>();
   const Vector3f world_normal = (view.world_rotation * normal_[f]).cast<float>();
   const Vector3f to_eye = (eye - center).normalized().cast<float>();
+  const int m = mesh_.triangle_material[f];
+  const float roughness = m >= 0 && m < static_cast<int>(studio_.materials.size())
+                              ? studio_.materials[m].roughness
+                              : 0.5f;
   double illuminance = scene_.studio.ambient_lx;
   for (const auto& light : scene_.studio.lights) {
     const Vector3f reflected =
-        raster::diffuse_illuminance(light, world_center, world_normal, to_eye, roughness_[f]);
+        raster::diffuse_illuminance(light, world_center, world_normal, to_eye, roughness);
     illuminance += luminance(reflected.cast<double>());
   }
   return albedo_[f] * illuminance / std::numbers::pi * exposure_;
