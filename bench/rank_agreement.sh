@@ -99,6 +99,15 @@ if len(names) >= 2:
                  [draw.choice(paired[c]["cycles"])[0] for c in names]) for _ in range(2000))
     print(f"  rho of std from single evaluations drawn at random: 5 % {draws[100]:+.3f}, "
           f"median {draws[1000]:+.3f}, 95 % {draws[1900]:+.3f}")
+    # The most any predictor could reach when COLMAP's spread decides: each backend's rho of std
+    # against itself, two different evaluations drawn per configuration (2000 draws, seeded).
+    for backend in ("cycles", "preview"):
+        if any(len(paired[c][backend]) < 2 for c in names):
+            continue
+        pairs = [[draw.sample(paired[c][backend], 2) for c in names] for _ in range(2000)]
+        selfs = sorted(spearman([p[0][0] for p in ps], [p[1][0] for p in ps]) for ps in pairs)
+        print(f"  rho of {backend}'s std against its own other evaluation: 5 % {selfs[100]:+.3f}, "
+              f"median {selfs[1000]:+.3f}, 95 % {selfs[1900]:+.3f}")
     # The pairs of configurations whose std Cycles tells apart (means further apart than twice
     # the standard error of their difference, from the spread of the evaluations), and how many
     # of them the preview orders the same way.
