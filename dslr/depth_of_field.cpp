@@ -210,6 +210,72 @@ static_assert(kLanes == 8, "a group of pixels is one simd::F32x8");
 using Floats = simd::F32x8;
 using simd::load8;
 
+// The gather's radius for a thin-lens disc of radius r: the one whose taps spread a uniform region
+// with the disc's second moment, r²/2. The taps' coverage ramps spread a disc's edge over a
+// pixel (the box the canvas's pixels already are), so the thin-lens radius itself blurs a disc of
+// a pixel or two too much (1.6x the moment at 1 px), and a disc under a pixel reaches no
+// neighbour at all; the paper scene's discs at f/5.6 are of those sizes.
+class MatchedRadius {
+ public:
+  MatchedRadius() {
+    const TapSet& set = tap_set();
+    auto moment = [&set](double radius) {
+      double weight = 0, weighted = 0;
+      for (std::size_t t = 0; t < set.distance.size(); ++t) {
+        const double d = set.distance[t];
+        const double w = set.area[t] * std::clamp((radius - d) * set.inv_soft[t] + 0.5, 0.0, 1.0);
+        weight += w;
+        weighted += w * d * d;
+      }
+      return weighted / weight;
+    };
+    for (int k = 0; k <= kTableEnd * kPerPixel; ++k) {
+      const double r = static_cast<double>(k) / kPerPixel;
+      if (r < kSharpBelow) {
+        table_.push_back(0.5f);
+        continue;
+      }
+      double low = 0.5, high = r + 1;  // the moment grows with the radius from 0 at half a pixel
+      for (int step = 0; step < 32; ++step) {
+        const double mid = 0.5 * (low + high);
+        (moment(mid) < 0.5 * r * r ? low : high) = mid;
+      }
+      table_.push_back(static_cast<float>(0.5 * (low + high)));
+    }
+    tail_sq_ = kTableEnd * kTableEnd - table_.back() * table_.back();
+  }
+
+  float operator()(float r) const {
+    if (r < kSharpBelow) return 0.5f;
+    if (!(r < kTableEnd)) return std::sqrt(r * r - tail_sq_);
+    const float at = r * kPerPixel;
+    const int k = static_cast<int>(at);
+    return table_[k] + (at - static_cast<float>(k)) * (table_[k + 1] - table_[k]);
+  }
+  Floats operator()(Floats r) const {
+    if (!simd::any(r < kTableEnd)) return simd::sqrt(r * r - tail_sq_);
+    if (!simd::any(r >= kSharpBelow)) return Floats{} + 0.5f;
+    Floats out;
+    for (int k = 0; k < kLanes; ++k) out[k] = (*this)(r[k]);
+    return out;
+  }
+
+ private:
+  static constexpr int kPerPixel = 32;
+  // Discs under half a pixel across stay sharp (their spread, under an eighth of a pixel, is not
+  // worth gathering the in-focus regions for).
+  static constexpr float kSharpBelow = 0.25f;
+  // Beyond it the ramps add a constant (about a pixel's box): sqrt(r² - tail_sq_).
+  static constexpr float kTableEnd = 8;
+  std::vector<float> table_;  // [k]: the radius for r = k / kPerPixel
+  float tail_sq_ = 0;
+};
+
+const MatchedRadius& matched_radius() {
+  static const MatchedRadius matched;
+  return matched;
+}
+
 inline Floats clamp01(Floats v) {
   const Floats zero = {}, one = zero + 1;
   v = v < zero ? zero : v;
@@ -361,11 +427,13 @@ struct LevelInput {
 
 // The thin-lens radius in canvas pixels, factored as K·|1 - S1/z| (K: the radius at infinity)
 // so the per-pixel cost is one division; z = +inf gives K. Less the blur the coarse levels above
-// add, at least half a pixel and at most kMaxCocRadiusPx. For one depth (float) or eight
-// (Floats), with the same operations: the plane fill runs it eight at a time. Loops copy it into
-// a local, so that their float stores need not reload its members.
+// add, at full resolution as the taps' radius (MatchedRadius), at least half a pixel and at most
+// kMaxCocRadiusPx. For one depth (float) or eight (Floats), with the same operations: the plane
+// fill runs it eight at a time. Loops copy it into a local, so that their float stores need not
+// reload its members.
 struct BlurRadius {
   float radius_at_infinity = 0, focus = 0, removed_radius_sq = 0;
+  const MatchedRadius* matched = &matched_radius();
 
   template <typename T>
   T operator()(T z) const {
@@ -380,6 +448,7 @@ struct BlurRadius {
     } else {
       root = simd::sqrt(square);
     }
+    if (matched != nullptr) root = (*matched)(root);
     return root < half ? half : (largest < root ? largest : root);
   }
 };
@@ -573,6 +642,8 @@ DepthOfFieldLevel::DepthOfFieldLevel(const LevelInput& in)
       in.canvas.fx / f);
   radius_at_.focus = static_cast<float>(in.focus_distance_m);
   for (int k = 0; k < in.level; ++k) radius_at_.removed_radius_sq += std::ldexp(1.0f, -2 * k);
+  // The coarse levels' discs are 2 px and more, and what they take off was set with the ramps in.
+  if (in.level > 0) radius_at_.matched = nullptr;
 }
 
 void DepthOfFieldLevel::run() {

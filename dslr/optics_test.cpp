@@ -126,6 +126,48 @@ TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
   expect_disc_blur(20.0, 0.5, 80);   // ~87 px: gathered three levels down, at an eighth
 }
 
+// The 1-D variance of the line spread of a vertical step edge blurred by apply_depth_of_field
+// on a small canvas at one depth, the edge between columns width/2 - 1 and width/2.
+double edge_spread_variance(const ir::Camera& camera, double depth_m) {
+  const Intrinsics canvas{64, 16, 1000, 1000, 32, 8};
+  LinearFrame frame = flat_frame(canvas, 0, static_cast<float>(depth_m));
+  for (int y = 0; y < canvas.height; ++y) {
+    for (int x = canvas.width / 2; x < canvas.width; ++x) {
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * (static_cast<std::size_t>(y) * canvas.width + x) + c] = 1;
+    }
+  }
+  std::vector<float> out;
+  apply_depth_of_field(camera, kFocus, canvas, frame.rgb, frame.depth_m, out);
+  const int row = canvas.height / 2;
+  double weight = 0, first = 0, second = 0;
+  for (int x = 1; x < canvas.width; ++x) {
+    const std::size_t at = 3 * (static_cast<std::size_t>(row) * canvas.width + x) + 1;
+    const double spread = out[at] - out[at - 3];  // between x - 1 and x: at x - 0.5
+    weight += spread;
+    first += spread * (x - 0.5);
+    second += spread * (x - 0.5) * (x - 0.5);
+  }
+  const double mean = first / weight;
+  return second / weight - mean * mean;
+}
+
+TEST(DslrDepthOfField, DiscsOfAPixelOrTwoSpreadAnEdgeAsTheThinLensDoes) {
+  // The paper scene's discs at f/5.6 at a quarter scale: a disc of radius r spreads an edge
+  // with variance r²/4 (the canvas pixels' own box is the render's, not the blur's).
+  ir::Camera camera = canon_6d();
+  camera.aperture_f_number = 2.8;
+  const double f = camera.focal_length_m, fx = 1000;
+  for (double r = 0.5; r <= 4.0; r += 0.125) {
+    // coc_in_image_m = (f/N)·f·(z - S1)/(z·S1) = 2r·f/fx, for z behind the focus.
+    const double coc = 2 * r * f / fx;
+    const double depth = 1 / (1 / kFocus - coc / (f / camera.aperture_f_number * f));
+    ASSERT_NEAR(0.5 * coc_in_image_m(f, camera.aperture_f_number, kFocus, depth) * fx / f, r, 1e-9);
+    const double variance = edge_spread_variance(camera, depth);
+    EXPECT_NEAR(variance, r * r / 4, 0.04 * r * r / 4) << "disc radius " << r << " px";
+  }
+}
+
 TEST(DslrDepthOfField, SharpForegroundKeepsItsValuesNextToABlurredBackground) {
   ir::Camera camera = canon_6d();
   camera.aperture_f_number = 2.8;

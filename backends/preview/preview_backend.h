@@ -49,8 +49,8 @@ class PreviewBackend : public run::Backend {
   bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
   // 2: depth of field blurs by the circle of confusion in the image, not on the sensor; 3: an
   // area light's size widens the highlights it makes; 4: the whole diffuse under the highlight;
-  // 5: Burley's diffuse lobe.
-  int output_version() const override { return 5; }
+  // 5: Burley's diffuse lobe; 6: depth of field no longer widens small discs by a pixel's box.
+  int output_version() const override { return 6; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
