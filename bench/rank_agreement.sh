@@ -117,7 +117,8 @@ if len(names) >= 2:
     resolved = agreeing = 0
     for x, y in combinations(names, 2):
         (cx, vx), (cy, vy) = std_stats(paired[x]["cycles"]), std_stats(paired[y]["cycles"])
-        if len(paired[x]["cycles"]) < 2 or abs(cx - cy) <= 2 * (vx + vy) ** 0.5:
+        if min(len(paired[x]["cycles"]), len(paired[y]["cycles"])) < 2 or \
+                abs(cx - cy) <= 2 * (vx + vy) ** 0.5:
             continue
         resolved += 1
         px, py = std_stats(paired[x]["preview"])[0], std_stats(paired[y]["preview"])[0]
