@@ -11,7 +11,7 @@
 #
 # Usage: bench/rank_agreement.sh [OUT_DIR] [EVALS]
 #   defaults: out/rank-agreement, 3. RIGC: the rigc binary (default ./build/rigc).
-# The Cycles sweep renders 120 shots at 0.25 scale, about 3.3 minutes each on two cores (6.5
+# The Cycles sweep renders 120 shots at 0.25 scale, about 2.4 minutes each on two quiet cores (5
 # hours); it resumes where it stopped, so it can be run in parts.
 set -euo pipefail
 cd "$(dirname "$0")/.."
