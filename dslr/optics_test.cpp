@@ -53,18 +53,23 @@ struct EdgeScene {
   LinearFrame frame;
 };
 
+// Sets every channel of the frame's columns from width/2 on to `value`.
+void brighten_right_half(LinearFrame& frame, float value) {
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = frame.width / 2; x < frame.width; ++x) {
+      for (int c = 0; c < 3; ++c)
+        frame.rgb[3 * (static_cast<std::size_t>(y) * frame.width + x) + c] = value;
+    }
+  }
+}
+
 // Dark on the left, bright from column width/2 on, every pixel at depth_m.
 EdgeScene step_edge(double f_number, double depth_m, double scale) {
   EdgeScene s{canon_6d(), scale, {}};
   s.camera.aperture_f_number = f_number;
   s.camera.effects.depth_of_field = true;
   s.frame = flat_frame(sensor_intrinsics(s.camera, scale), 100, static_cast<float>(depth_m));
-  for (int y = 0; y < s.frame.height; ++y) {
-    for (int x = s.frame.width / 2; x < s.frame.width; ++x) {
-      for (int c = 0; c < 3; ++c)
-        s.frame.rgb[3 * (static_cast<std::size_t>(y) * s.frame.width + x) + c] = 1000;
-    }
-  }
+  brighten_right_half(s.frame, 1000);
   return s;
 }
 
@@ -131,12 +136,7 @@ TEST(DslrDepthOfField, BlurWidthMatchesTheCircleOfConfusion) {
 double edge_spread_variance(const ir::Camera& camera, double depth_m) {
   const Intrinsics canvas{64, 16, 1000, 1000, 32, 8};
   LinearFrame frame = flat_frame(canvas, 0, static_cast<float>(depth_m));
-  for (int y = 0; y < canvas.height; ++y) {
-    for (int x = canvas.width / 2; x < canvas.width; ++x) {
-      for (int c = 0; c < 3; ++c)
-        frame.rgb[3 * (static_cast<std::size_t>(y) * canvas.width + x) + c] = 1;
-    }
-  }
+  brighten_right_half(frame, 1);
   std::vector<float> out;
   apply_depth_of_field(camera, kFocus, canvas, frame.rgb, frame.depth_m, out);
   const int row = canvas.height / 2;
