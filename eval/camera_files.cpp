@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "run/camera_csv.h"
 
 namespace rigc::eval {
 
@@ -105,6 +108,70 @@ std::optional<fs::path> bundler_list(const fs::path& out_path) {
     if (fs::is_regular_file(candidate)) return candidate;
   }
   return std::nullopt;
+}
+
+// The rotation nearest to `m` (a file's matrix written with few digits), or nullopt when `m` is
+// further than `tolerance` from any rotation (entry-wise on m^T m - I) or a reflection.
+std::optional<Eigen::Matrix3d> nearest_rotation(const Eigen::Matrix3d& m, double tolerance) {
+  if (!m.allFinite() || m.determinant() <= 0 ||
+      (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > tolerance) {
+    return std::nullopt;
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return Eigen::Matrix3d(svd.matrixU() * svd.matrixV().transpose());
+}
+
+constexpr double kRotationTolerance = 1e-3;
+
+// The lines of a text file that hold something: comments ('#') and blank lines skipped, each
+// with its line number.
+std::vector<std::pair<int, std::string>> content_lines(std::istream& in) {
+  std::vector<std::pair<int, std::string>> lines;
+  int number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    lines.emplace_back(number, line);
+  }
+  return lines;
+}
+
+// One line of a Middlebury _par.txt: name, K (9), R (9), t (3).
+bool read_par_line(const std::string& line, run::ColmapImage* image, run::ColmapCamera* camera,
+                   std::string* why) {
+  std::istringstream words(line);
+  std::string name;
+  double v[21];
+  words >> name;
+  for (double& x : v) words >> x;
+  if (!words ||
+      !std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) {
+    *why = "expected an image name and 21 numbers (K, R, t)";
+    return false;
+  }
+  std::string extra;
+  if (words >> extra) {
+    *why = "more than an image name and 21 numbers (K, R, t)";
+    return false;
+  }
+  if (v[6] != 0 || v[7] != 0 || !(v[8] > 0) || !(v[0] > 0) || !(v[4] > 0)) {
+    *why = "K is not a camera matrix (positive focal lengths, last row 0 0 k33 with k33 > 0)";
+    return false;
+  }
+  Eigen::Matrix3d r;
+  r << v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16], v[17];
+  const auto rotation = nearest_rotation(r, kRotationTolerance);
+  if (!rotation) {
+    *why = "R is not a rotation";
+    return false;
+  }
+  image->name = file_name_of(name);
+  image->camera_from_world = pose_from(*rotation, ir::Vec3(v[18], v[19], v[20]));
+  // Skew (k12) is left out: COLMAP's models have none.
+  camera->model = "PINHOLE";
+  camera->params = {v[0] / v[8], v[4] / v[8], v[2] / v[8], v[5] / v[8]};
+  return true;
 }
 
 }  // namespace
@@ -258,6 +325,93 @@ std::optional<std::vector<run::ColmapImage>> read_meshroom_sfm(const fs::path& p
   return images;
 }
 
+std::optional<CameraFile> read_middlebury_par(const fs::path& path, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return bad_file(path, "cannot open", error), std::nullopt;
+  const auto lines = content_lines(in);
+  long count = -1;
+  if (lines.empty() || !(std::istringstream(lines.front().second) >> count) || count < 1) {
+    return bad_file(path, "does not start with the number of images (not a Middlebury _par.txt)",
+                    error),
+           std::nullopt;
+  }
+  if (static_cast<long>(lines.size()) - 1 != count) {
+    return bad_file(
+               path,
+               fmt::format("says {} images but has {} lines of cameras", count, lines.size() - 1),
+               error),
+           std::nullopt;
+  }
+  CameraFile file;
+  file.format = "Middlebury";
+  file.path = path;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    run::ColmapImage image;
+    run::ColmapCamera camera;
+    std::string why;
+    if (!read_par_line(lines[i].second, &image, &camera, &why)) {
+      return bad_file(path, fmt::format("line {}: {}", lines[i].first, why), error), std::nullopt;
+    }
+    image.image_id = image.camera_id = camera.camera_id = static_cast<int>(i);
+    image.line = lines[i].first;
+    file.images.push_back(std::move(image));
+    file.cameras.push_back(std::move(camera));
+  }
+  return file;
+}
+
+std::optional<std::vector<run::ColmapImage>> read_rigc_camera_csv(const fs::path& path,
+                                                                  std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return bad_file(path, "cannot open", error), std::nullopt;
+  const auto lines = content_lines(in);
+  if (lines.empty() || lines.front().second.rfind("label,x,y,z,omega,phi,kappa", 0) != 0) {
+    return bad_file(path, "has no header 'label,x,y,z,omega,phi,kappa' (not RigC's cameras.csv)",
+                    error),
+           std::nullopt;
+  }
+  std::vector<run::ColmapImage> images;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::string text = lines[i].second;
+    const auto comma = text.find(',');
+    std::replace(text.begin(), text.end(), ',', ' ');
+    std::istringstream words(comma == std::string::npos ? std::string() : text.substr(comma + 1));
+    double v[6];
+    for (double& x : v) words >> x;
+    if (comma == 0 || !words ||
+        !std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) {
+      return bad_file(path,
+                      fmt::format("line {}: expected a name and six numbers (x, y, z, omega, "
+                                  "phi, kappa)",
+                                  lines[i].first),
+                      error),
+             std::nullopt;
+    }
+    const ir::Vec3 angles = ir::Vec3(v[3], v[4], v[5]) * (M_PI / 180);
+    const Eigen::Matrix3d r = run::rotation_from_omega_phi_kappa(angles);
+    run::ColmapImage image;
+    image.image_id = static_cast<int>(i);
+    image.camera_id = 1;
+    image.name = file_name_of(lines[i].second.substr(0, comma));
+    image.camera_from_world = pose_from(r, -r * ir::Vec3(v[0], v[1], v[2]));
+    image.line = lines[i].first;
+    images.push_back(std::move(image));
+  }
+  return images;
+}
+
+KnownCameras known_cameras(const CameraFile& file) {
+  std::map<int, const run::ColmapCamera*> by_id;
+  for (const auto& c : file.cameras) by_id[c.camera_id] = &c;
+  KnownCameras known;
+  for (const auto& im : file.images) {
+    KnownCamera& k = known[im.name];
+    k.camera_from_world = im.camera_from_world;
+    if (const auto it = by_id.find(im.camera_id); it != by_id.end()) k.intrinsics = *it->second;
+  }
+  return known;
+}
+
 std::optional<CameraFile> read_camera_file(const fs::path& path, std::string* error) {
   CameraFile file;
   file.path = path;
@@ -306,12 +460,18 @@ std::optional<CameraFile> read_camera_file(const fs::path& path, std::string* er
     }
     file.list = *list;
     images = read_bundler(path, *list, error);
+  } else if (ext == ".txt") {
+    return read_middlebury_par(path, error);
+  } else if (ext == ".csv") {
+    file.format = "RigC cameras.csv";
+    images = read_rigc_camera_csv(path, error);
   } else if (ext == ".sfm" || ext == ".json") {
     file.format = "Meshroom SfMData";
     images = read_meshroom_sfm(path, error);
   } else {
     *error = fmt::format(
-        "{}: unknown camera file (a COLMAP model folder, a Bundler .out, a Meshroom .sfm/.json)",
+        "{}: unknown camera file (a COLMAP model folder, a Bundler .out, a Meshroom .sfm/.json, a "
+        "Middlebury _par.txt or RigC's cameras.csv)",
         path.string());
     return std::nullopt;
   }

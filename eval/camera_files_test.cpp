@@ -1,6 +1,7 @@
 #include "eval/camera_files.h"
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -70,6 +71,74 @@ TEST(CameraFiles, BrokenFilesAreNamed) {
   EXPECT_NE(error.find("ends early"), std::string::npos) << error;
   EXPECT_FALSE(read_camera_file(dir.file("c.xyz"), &error));
   EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+}
+
+TEST(CameraFiles, RigcCameraCsvGivesTheRunsPoses) {
+  rigc::testing::TempDir dir;
+  const auto r = test_inputs::make_statue_run(dir.path(), 100);
+  ASSERT_TRUE(r);
+  std::string error;
+  const auto file = read_camera_file(r->dir / "cameras.csv", &error);
+  ASSERT_TRUE(file) << error;
+  EXPECT_EQ(file->format, "RigC cameras.csv");
+  ASSERT_EQ(file->images.size(), r->shots.size());
+  for (std::size_t i = 0; i < r->shots.size(); ++i) {
+    const ir::Shot& shot = r->scene.shots[r->shots[i]];
+    EXPECT_EQ(file->images[i].name, run::image_file_name(r->scene.camera, shot));
+    // The file holds nine significant digits.
+    EXPECT_LT((file->images[i].camera_from_world - run::camera_from_object(shot)).norm(), 1e-6);
+  }
+}
+
+// The real temple's calibration (tests/real/README.md): every camera sees the object's bounding
+// box centre inside its 640 x 480 photo, in front of it.
+TEST(CameraFiles, MiddleburyParFileGivesPosesAndIntrinsics) {
+  std::string error;
+  const auto file = read_camera_file(
+      std::string(RIGC_SOURCE_DIR) + "/tests/real/templeSparseRing/templeSR_par.txt", &error);
+  ASSERT_TRUE(file) << error;
+  EXPECT_EQ(file->format, "Middlebury");
+  ASSERT_EQ(file->images.size(), 16u);
+  ASSERT_EQ(file->cameras.size(), 16u);
+  EXPECT_EQ(file->images[0].name, "templeSR0001.png");
+  EXPECT_EQ(file->cameras[0].model, "PINHOLE");
+  EXPECT_THAT(file->cameras[0].params, ::testing::ElementsAre(1520.4, 1525.9, 302.32, 246.87));
+  const ir::Vec3 centre =
+      (ir::Vec3(-0.073568, 0.021728, -0.012445) + ir::Vec3(0.028855, 0.181892, 0.062736)) / 2;
+  const KnownCameras known = known_cameras(*file);
+  ASSERT_EQ(known.size(), 16u);
+  for (const auto& [name, camera] : known) {
+    const ir::Vec3 x = camera.camera_from_world.topLeftCorner<3, 3>() * centre +
+                       camera.camera_from_world.topRightCorner<3, 1>();
+    ASSERT_GT(x.z(), 0.3) << name;
+    const auto& k = camera.intrinsics->params;
+    const double u = k[0] * x.x() / x.z() + k[2], v = k[1] * x.y() / x.z() + k[3];
+    EXPECT_GT(u, 200) << name;
+    EXPECT_LT(u, 440) << name;
+    EXPECT_GT(v, 120) << name;
+    EXPECT_LT(v, 360) << name;
+  }
+}
+
+TEST(CameraFiles, BrokenParAndCsvFilesAreNamedWithTheirLine) {
+  rigc::testing::TempDir dir;
+  std::string error;
+  const std::string k = "1500 0 320 0 1500 240 0 0 1";
+  rigc::testing::write_text(dir.file("a_par.txt"), "2\nx.png " + k + " 1 0 0 0 1 0 0 0 1 0 0 1\n");
+  EXPECT_FALSE(read_camera_file(dir.file("a_par.txt"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("says 2 images but has 1 lines"));
+  rigc::testing::write_text(dir.file("b_par.txt"), "1\nx.png " + k + " 1 0 0 0 1 0 0 0 2 0 0 1\n");
+  EXPECT_FALSE(read_camera_file(dir.file("b_par.txt"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("b_par.txt: line 2: R is not a rotation"));
+  rigc::testing::write_text(dir.file("c_par.txt"), "1\nx.png " + k + " 1 0 0 0 1 0\n");
+  EXPECT_FALSE(read_camera_file(dir.file("c_par.txt"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("line 2: expected an image name and 21 numbers"));
+  rigc::testing::write_text(dir.file("d.csv"), "label,x,y,z,omega,phi,kappa\nx.jpg,1,2,3,4,5\n");
+  EXPECT_FALSE(read_camera_file(dir.file("d.csv"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("d.csv: line 2: expected a name and six numbers"));
+  rigc::testing::write_text(dir.file("e.csv"), "name,a,b\n");
+  EXPECT_FALSE(read_camera_file(dir.file("e.csv"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("not RigC's cameras.csv"));
 }
 
 // COLMAP's binary model (written by COLMAP itself from the text one) reads as the text one.
