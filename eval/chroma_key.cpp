@@ -129,6 +129,80 @@ std::optional<Chroma> backdrop_at_borders(const KeyImage& image, const std::opti
   return key;
 }
 
+namespace {
+
+// Rec. 709 luminance of a pixel, linear.
+double luminance_of(const KeyImage& image, std::size_t i) {
+  const ir::Vec3 rgb = linear_pixel(image.srgb, i);
+  return 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
+}
+
+// Otsu's threshold over 256 bins of `values` in [0, 1]: the bin edge with the largest variance
+// between the two classes.
+double otsu_threshold(const std::vector<double>& values) {
+  constexpr int kBins = 256;
+  std::vector<double> histogram(kBins, 0);
+  for (double v : values) histogram[std::clamp(static_cast<int>(v * kBins), 0, kBins - 1)] += 1;
+  double total = 0, weighted = 0;
+  for (int b = 0; b < kBins; ++b) {
+    total += histogram[b];
+    weighted += b * histogram[b];
+  }
+  double below = 0, below_weighted = 0, best = -1;
+  int best_bin = kBins / 2;
+  for (int b = 0; b < kBins - 1; ++b) {
+    below += histogram[b];
+    below_weighted += b * histogram[b];
+    const double above = total - below;
+    if (below == 0 || above == 0) continue;
+    const double mean_below = below_weighted / below;
+    const double mean_above = (weighted - below_weighted) / above;
+    const double between = below * above * (mean_below - mean_above) * (mean_below - mean_above);
+    if (between > best) {
+      best = between;
+      best_bin = b;
+    }
+  }
+  return (best_bin + 1.0) / kBins;
+}
+
+}  // namespace
+
+std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& image) {
+  const int band = std::max(1, std::min(image.width, image.height) / 50);
+  std::size_t border = 0, dark = 0, bright = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (!(x < band || y < band || x >= image.width - band || y >= image.height - band)) continue;
+      const double l = luminance_of(image, static_cast<std::size_t>(y) * image.width + x);
+      ++border;
+      dark += l < 0.05;
+      bright += l > 0.8;
+    }
+  }
+  if (border == 0) return std::nullopt;
+  if (10 * dark >= 9 * border) return BrightBackdrop::kDark;
+  if (10 * bright >= 9 * border) return BrightBackdrop::kBright;
+  return std::nullopt;
+}
+
+std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop backdrop) {
+  // Otsu on the square root of luminance: a lit object against black velvet spans the brighter
+  // half of a perceptual scale, which splits better than the linear one.
+  std::vector<double> lightness(image.pixels());
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    lightness[i] = std::sqrt(std::max(0.0, luminance_of(image, i)));
+  }
+  const double threshold = otsu_threshold(lightness);
+  std::vector<std::uint8_t> mask(image.pixels(), 0);
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    const bool object =
+        backdrop == BrightBackdrop::kDark ? lightness[i] >= threshold : lightness[i] < threshold;
+    mask[i] = object ? 255 : 0;
+  }
+  return mask;
+}
+
 std::vector<std::uint8_t> key_backdrop(const KeyImage& image, const Chroma& key, double tolerance) {
   std::vector<std::uint8_t> mask(image.pixels(), 255);
   for (std::size_t i = 0; i < image.pixels(); ++i) {

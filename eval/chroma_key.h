@@ -49,6 +49,18 @@ std::optional<Chroma> backdrop_at_borders(const KeyImage& image, const std::opti
 // too dark to tell), 0 where it is.
 std::vector<std::uint8_t> key_backdrop(const KeyImage& image, const Chroma& key, double tolerance);
 
+// A backdrop keyed by brightness, not colour: black velvet or a light tent, where chromaticity
+// says nothing (too dark) or the object may share its white.
+enum class BrightBackdrop { kDark, kBright };
+
+// kDark when nine border pixels in ten are darker than a twentieth of full scale (linear), kBright
+// when they are brighter than four fifths; nullopt otherwise.
+std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& image);
+
+// 255 where a pixel's luminance is on the object's side of the threshold that best splits the
+// image's histogram in two (Otsu's), 0 where it is the backdrop's.
+std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop backdrop);
+
 // What stays still across photos of one size taken from one place: per pixel, the median colour
 // and the share of the photos that show it there.
 struct StillBackground {

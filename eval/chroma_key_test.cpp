@@ -136,3 +136,51 @@ TEST(ChromaKey, CleaningDropsSpecksFillsHolesAndGrows) {
 
 }  // namespace
 }  // namespace rigc::eval
+
+namespace rigc::eval {
+namespace {
+
+// A 100 x 80 picture on black velvet (sRGB 8, a dark grey fold at 30 on the left) with a lit,
+// shaded plaster block at columns 40..69, rows 20..59 (sRGB 120 to 230), or the same in a
+// light tent (sRGB 245) with a mid-grey block.
+KeyImage velvet_picture(bool dark) {
+  KeyImage im;
+  im.width = 100;
+  im.height = 80;
+  im.srgb.resize(im.pixels() * 3);
+  for (int y = 0; y < im.height; ++y) {
+    for (int x = 0; x < im.width; ++x) {
+      std::uint8_t* p = &im.srgb[3 * (static_cast<std::size_t>(y) * im.width + x)];
+      std::uint8_t v = dark ? (x < 12 ? 30 : 8) : 245;
+      if (x >= 40 && x < 70 && y >= 20 && y < 60) {
+        v = static_cast<std::uint8_t>(dark ? 120 + 110 * (x - 40) / 30 : 90 + 60 * (x - 40) / 30);
+      }
+      p[0] = p[1] = v;
+      p[2] = static_cast<std::uint8_t>(v * 9 / 10);
+    }
+  }
+  return im;
+}
+
+TEST(ChromaKey, BlackVelvetAndALightTentAreKeyedByBrightness) {
+  for (const bool dark : {true, false}) {
+    const KeyImage im = velvet_picture(dark);
+    const auto backdrop = backdrop_brightness_at_borders(im);
+    ASSERT_TRUE(backdrop.has_value()) << dark;
+    EXPECT_EQ(*backdrop, dark ? BrightBackdrop::kDark : BrightBackdrop::kBright);
+    const auto mask = key_brightness(im, *backdrop);
+    int wrong = 0;
+    for (int y = 0; y < im.height; ++y) {
+      for (int x = 0; x < im.width; ++x) {
+        const bool object = x >= 40 && x < 70 && y >= 20 && y < 60;
+        wrong += (mask[static_cast<std::size_t>(y) * im.width + x] == 255) != object;
+      }
+    }
+    EXPECT_EQ(wrong, 0) << (dark ? "velvet" : "light tent");
+  }
+  EXPECT_FALSE(backdrop_brightness_at_borders(turntable_picture(1)).has_value())
+      << "a green screen is no brightness backdrop";
+}
+
+}  // namespace
+}  // namespace rigc::eval

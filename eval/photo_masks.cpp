@@ -57,6 +57,12 @@ std::map<std::pair<int, int>, StillBackground> still_backgrounds(
 // One photo's keyed mask (empty when no key applies), and its line of the report.
 std::vector<std::uint8_t> key_one(const KeyImage& picture, const std::optional<Chroma>& hint,
                                   const StillBackground* still, double tolerance, json& entry) {
+  // Black velvet or a light tent: keyed by brightness (a green screen is neither).
+  if (const auto brightness = hint ? std::nullopt : backdrop_brightness_at_borders(picture)) {
+    entry["backdrop"] = *brightness == BrightBackdrop::kDark ? "dark" : "bright";
+    return clean_object_mask(key_brightness(picture, *brightness), picture.width, picture.height,
+                             kGrowPx);
+  }
   const auto key = backdrop_at_borders(picture, hint, tolerance);
   if (!key && !still) return {};
   std::vector<std::uint8_t> mask(picture.pixels(), 255);
@@ -83,8 +89,10 @@ bool key_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::path
   std::optional<Chroma> hint;
   if (o.backdrop_color) hint = chroma_of_linear(*o.backdrop_color);
   const auto still = still_backgrounds(pictures);
-  report["method"] = hint ? "chroma key on the scene's green screen, and the still background"
-                          : "chroma key on the colour at the borders, and the still background";
+  report["method"] =
+      hint ? "chroma key on the scene's green screen, and the still background"
+           : "chroma key on the colour at the borders, and the still background (a brightness "
+             "key where the borders are black or white)";
   report["tolerance"] = o.tolerance;
   json& by_photo = report["photos"];
   for (std::size_t k = 0; k < pictures.size(); ++k) {
