@@ -31,6 +31,10 @@ void add_photo_options(CLI::App& app, eval::EvalOptions& o) {
   app.add_option("--camera", o.camera,
                  "photos: the camera, BODY,FOCAL (e.g. canon-6d,50mm), for photos without EXIF "
                  "(it overrides their EXIF)");
+  app.add_option("--reference-cameras", o.reference_cameras,
+                 "photos: calibrated cameras to measure the registration against (Middlebury "
+                 "_par.txt, COLMAP model folder, Bundler .out with its list, Meshroom .sfm, "
+                 "RigC's cameras.csv): rotation, centre and focal errors, relative-pose AUC");
   app.add_flag("--allow-partial", o.allow_partial,
                "exit 0 even when fewer than half of the images register");
 }
@@ -87,7 +91,8 @@ int run_eval_command(std::vector<std::string> args) {
   EvalOptions o;
   app.add_option("run", o.run_dir, "run folder (images/, sparse/, manifest.json)");
   app.add_option("--photos", o.photos_dir,
-                 "a folder of real photos instead (no ground-truth poses: global registration)");
+                 "a folder of real photos instead (no ground-truth poses: global registration; "
+                 "without --ground-truth or --scene, registration only)");
   app.add_option("--ground-truth", o.ground_truth,
                  "ground-truth mesh (glTF, OBJ, PLY, STL; in its own frame; default: the run's "
                  "scene object in the object frame)");

@@ -304,6 +304,7 @@ class ColmapPipeline {
     fs::create_directories(work_ / "sparse", ec);
     fs::create_directories(logs_, ec);
     if (!prepare_images() || !probe()) return r_;
+    r_.images_dir = images_dir_;
     std::vector<Step> steps = extraction_steps();
     if (steps.empty()) return r_;
     std::optional<Argv> match = matcher_args();
@@ -331,6 +332,7 @@ class ColmapPipeline {
     r_.ok = true;
     r_.reused = true;
     r_.model_txt = txt_;
+    r_.images_dir = in_.images.wider_than_eight_bit.empty() ? images_dir_ : work_ / "images_8bit";
     const json previous =
         json::parse(std::ifstream(in_.out / "eval.json", std::ios::binary), nullptr, false);
     if (!previous.is_discarded() && previous.contains("colmap") && previous["colmap"].is_object()) {

@@ -89,6 +89,7 @@ struct ColmapRun {
   nlohmann::json steps = nlohmann::json::array();  // name, seconds, cpu_seconds, exit_code, log
   double seconds = 0;
   std::filesystem::path model_txt;                     // the largest model, as text
+  std::filesystem::path images_dir;                    // the images COLMAP read
   nlohmann::json prior;                                // the intrinsics COLMAP started from
   nlohmann::json matching = nlohmann::json::object();  // matcher, pairs and how they were chosen
   bool reused = false;  // --reuse-colmap found a model: the times are the earlier run's

@@ -15,6 +15,7 @@
 #include "eval/measure.h"
 #include "eval/photos.h"
 #include "eval/reconstruction.h"
+#include "eval/reference_check.h"
 #include "eval/report.h"
 
 namespace rigc::eval {
@@ -55,8 +56,8 @@ bool EvalOptions::check(std::string* error) const {
     return refuse(fmt::format(
         "the key tolerance is {}; it must be in (0, 1] (a chromaticity distance)", key_tolerance));
   }
-  if (photos_dir.empty() && (!masks_dir.empty() || !camera.empty())) {
-    return refuse("--masks and --camera are for photos (--photos DIR)");
+  if (photos_dir.empty() && (!masks_dir.empty() || !camera.empty() || !reference_cameras.empty())) {
+    return refuse("--masks, --camera and --reference-cameras are for photos (--photos DIR)");
   }
   if (!(std::isfinite(color_range_mm) && color_range_mm >= 0)) {
     return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
@@ -94,6 +95,18 @@ bool too_few_registered(const EvalOptions& o, const EvalInputs& in, std::size_t 
   return true;
 }
 
+// Photos without a ground-truth mesh: the registration (and the reference cameras) is the
+// result.
+int finish_without_mesh(const EvalOptions& o, const EvalInputs& in, const ColmapRun& colmap,
+                        EvalReport& report, EvalTimes& times, Clock::time_point t_start,
+                        std::ostream& log, std::size_t registered) {
+  times.total = seconds_since(t_start);
+  report.add_timing(colmap, times);
+  if (!report.write()) return 2;
+  if (!o.quiet) report.print_written();
+  return too_few_registered(o, in, registered, log) ? 2 : 0;
+}
+
 }  // namespace
 
 int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
@@ -129,6 +142,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   });
   if (!colmap.ok && photos && mapped) {
     report.sections()["unregistered"] = report_unregistered(*in, &*photos, {}, masked, log);
+    check_against_reference(o, *in, colmap, nullptr, report, log);
   }
   if (!colmap.ok) {
     return report.fail("reconstruction", colmap.failure, colmap.exit_code ? colmap.exit_code : 2);
@@ -145,6 +159,10 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   for (const auto& image : model->images) registered.insert(image.name);
   report.sections()["unregistered"] =
       report_unregistered(*in, photos ? &*photos : nullptr, registered, masked, log);
+  check_against_reference(o, *in, colmap, &*model, report, log);
+  if (!in->has_mesh()) {
+    return finish_without_mesh(o, *in, colmap, report, times, t_start, log, registered.size());
+  }
   if (model->points.size() < 3) {
     return report.fail("reconstruction", "the reconstruction has fewer than 3 points", 2);
   }

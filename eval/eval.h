@@ -55,6 +55,10 @@ struct EvalOptions {
   double key_tolerance = 0.12;
   std::string camera;
   bool allow_partial = false;
+  // Photos: calibrated cameras to measure the registration against (eval/pose_accuracy.h), in
+  // any format eval/camera_files.h reads; with them, too few registered photos are triangulated
+  // with the reference poses (eval/known_poses.h). No ground-truth mesh is needed.
+  std::string reference_cameras;
 
   // False with a one-line `error` when a field is out of its range or the folders are not one
   // run folder or one photos folder. evaluate() checks it first.

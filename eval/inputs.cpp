@@ -309,11 +309,18 @@ bool load_planned_cameras(const fs::path& run_dir, const ImageSet& images, Groun
 std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::path& run_dir,
                                              bool photos, const ImageSet& images, std::ostream& log,
                                              std::string* error) {
-  if (photos && o.ground_truth.empty() && o.scene.empty()) {
-    *error = "photos need a ground truth: --ground-truth MESH or --scene FILE";
-    return std::nullopt;
-  }
   GroundTruth gt;
+  if (photos && o.ground_truth.empty() && o.scene.empty()) {
+    if (!o.reconstruction.empty() || o.poisson) {
+      *error = fmt::format(
+          "{} measures against a ground-truth mesh: give --ground-truth MESH or "
+          "--scene FILE",
+          o.poisson ? "--poisson" : "--reconstruction");
+      return std::nullopt;
+    }
+    gt.description = "none (photos without a ground-truth mesh: registration only)";
+    return gt;
+  }
   std::string warning;
   if (!load_ground_truth_mesh(o, run_dir, photos, gt, error, &warning)) return std::nullopt;
   if (!warning.empty()) log << "rigc eval: warning: " << warning << "\n";
@@ -349,6 +356,56 @@ bool check_images_for_colmap(const EvalOptions& o, const ImageSet& images, const
   return true;
 }
 
+// Names of `names` (at most three, then how many more), for a message.
+std::string some_names(const std::vector<std::string>& names) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size() && i < 3; ++i) text += (i ? ", " : "") + names[i];
+  if (names.size() > 3) text += fmt::format(" and {} more", names.size() - 3);
+  return text;
+}
+
+// --reference-cameras: a camera for every photo (more are a warning); intrinsics without a size
+// take their photo's.
+bool load_reference_cameras(const EvalOptions& o, EvalInputs& in, std::ostream& log,
+                            std::string* error) {
+  auto file = read_camera_file(o.reference_cameras, error);
+  if (!file) return false;
+  KnownCameras known = known_cameras(*file);
+  std::vector<std::string> missing, extra;
+  for (const auto& name : in.images.names) {
+    if (!known.count(name)) missing.push_back(name);
+  }
+  for (const auto& [name, camera] : known) {
+    if (!in.images.size.count(name)) extra.push_back(name);
+  }
+  if (!missing.empty()) {
+    std::vector<std::string> named;
+    for (const auto& [name, camera] : known) named.push_back(name);
+    *error = fmt::format(
+        "{} has no camera for {} of the {} photos in {} ({}); its cameras are named {}",
+        o.reference_cameras, missing.size(), in.images.names.size(), in.images.dir.string(),
+        some_names(missing), named.empty() ? "(none)" : some_names(named));
+    return false;
+  }
+  if (!extra.empty() && !o.quiet) {
+    log << fmt::format(
+        "rigc eval: warning: {} has cameras for {} images not among the photos ({})\n",
+        o.reference_cameras, extra.size(), some_names(extra));
+  }
+  for (auto& [name, camera] : known) {
+    const auto size = in.images.size.find(name);
+    if (camera.intrinsics && camera.intrinsics->width == 0 && size != in.images.size.end()) {
+      camera.intrinsics->width = size->second.first;
+      camera.intrinsics->height = size->second.second;
+    }
+  }
+  std::erase_if(known, [&](const auto& entry) { return !in.images.size.count(entry.first); });
+  protect_input_file(o.reference_cameras, "the reference cameras");
+  in.reference = std::move(known);
+  in.reference_description = fmt::format("{} ({})", o.reference_cameras, file->format);
+  return true;
+}
+
 }  // namespace
 
 std::optional<EvalInputs> gather_inputs(const EvalOptions& o, std::ostream& log,
@@ -369,6 +426,7 @@ std::optional<EvalInputs> gather_inputs(const EvalOptions& o, std::ostream& log,
   if (!truth) return refuse();
   in.truth = std::move(*truth);
   if (!check_images_for_colmap(o, in.images, in.truth, log, &error)) return refuse();
+  if (!o.reference_cameras.empty() && !load_reference_cameras(o, in, log, &error)) return refuse();
 
   in.out = o.output_dir.empty() ? in.run_dir / "eval" : fs::path(o.output_dir);
   std::error_code ec;

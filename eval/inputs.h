@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "eval/camera_files.h"
 #include "eval/eval.h"
 #include "ir/ir.h"
 #include "run/colmap_text.h"
@@ -31,7 +32,8 @@ struct ImageSet {
 };
 
 // The ground truth: a triangle mesh in the frame of the ground-truth cameras (the object frame
-// for a run), and the run's planned cameras when it has them.
+// for a run), and the run's planned cameras when it has them. Photos may come without a mesh
+// (no triangles): then registration and the reference cameras are what is measured.
 struct GroundTruth {
   std::vector<Eigen::Vector3f> positions;
   std::vector<std::array<std::uint32_t, 3>> triangles;
@@ -51,6 +53,10 @@ struct EvalInputs {
   std::filesystem::path out;      // the output folder (created)
   ImageSet images;
   GroundTruth truth;
+  // Photos: --reference-cameras, one for each photo (intrinsics' sizes filled from the photos).
+  KnownCameras reference;
+  std::string reference_description;  // "FILE (FORMAT)"; empty without reference cameras
+  bool has_mesh() const { return !truth.triangles.empty(); }
 };
 
 // True when every image has a planned pose: the neighbours matcher can choose its pairs.

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libyaml-cpp-dev libtinygltf-dev libstb-dev libopenimageio-dev openimageio-tools
   libassimp-dev assimp-testmodels libeigen3-dev libcli11-dev libfmt-dev libssl-dev zlib1g-dev
-  nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libtbb-dev libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema python3-yaml
   povray blender colmap libopen3d-dev libembree-dev libnanoflann-dev fonts-dejavu-core
   libcpp-httplib-dev libjs-three chromium chromium-driver python3-selenium
