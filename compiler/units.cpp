@@ -23,6 +23,8 @@ const std::vector<UnitDef>& unit_table() {
       {"m", QuantityKind::kLength, 1.0},
       {"cm", QuantityKind::kLength, 0.01},
       {"mm", QuantityKind::kLength, 0.001},
+      {"um", QuantityKind::kLength, 1e-6},  // a pixel's pitch
+      {"µm", QuantityKind::kLength, 1e-6},
       {"in", QuantityKind::kLength, 0.0254},
       {"deg", QuantityKind::kAngle, kDegree},
       {"°", QuantityKind::kAngle, kDegree},
@@ -116,6 +118,7 @@ std::string kind_units(QuantityKind kind) {
 std::string format_quantity(double v, QuantityKind kind) {
   switch (kind) {
     case QuantityKind::kLength:
+      if (v != 0 && std::abs(v) < 1e-4) return fmt::format("{:g}um", v * 1e6);
       if (std::abs(v) < 0.01) return fmt::format("{:g}mm", v * 1000);
       if (std::abs(v) < 1) return fmt::format("{:g}cm", v * 100);
       return fmt::format("{:g}m", v);

@@ -20,6 +20,8 @@ TEST(Units, LengthsConvertToMeters) {
   EXPECT_DOUBLE_EQ(parse_ok("2 in", QuantityKind::kLength), 0.0508);
   EXPECT_DOUBLE_EQ(parse_ok("1.5", QuantityKind::kLength), 1.5);  // bare number: meters
   EXPECT_DOUBLE_EQ(parse_ok("-20cm", QuantityKind::kLength), -0.2);
+  EXPECT_DOUBLE_EQ(parse_ok("5um", QuantityKind::kLength), 5e-6);  // a pixel's pitch
+  EXPECT_DOUBLE_EQ(parse_ok("3.76µm", QuantityKind::kLength), 3.76e-6);
 }
 
 TEST(Units, AnglesConvertToRadians) {
@@ -90,6 +92,7 @@ TEST(Units, OverflowAfterTheUnitIsRejected) {
 TEST(Units, FormatsForMessages) {
   EXPECT_EQ(format_quantity(0.8, QuantityKind::kLength), "80cm");
   EXPECT_EQ(format_quantity(0.002, QuantityKind::kLength), "2mm");
+  EXPECT_EQ(format_quantity(5e-6, QuantityKind::kLength), "5um");
   EXPECT_EQ(format_quantity(1.0 / 125, QuantityKind::kTime), "1/125s");
   EXPECT_EQ(format_quantity(0.8, QuantityKind::kFNumber), "f/0.8");
 }
