@@ -295,10 +295,16 @@ class Checker {
   void read_light_aim(const YAML::Node& node, spec::LightSpec& light_spec);
   void read_light_shape(const YAML::Node& node, ir::Light& light);
   void read_camera(const YAML::Node& node, spec::SceneSpec& scene);
+  void read_camera_kind(const YAML::Node& node, spec::SceneSpec& scene);
   void read_body(const YAML::Node& body, ir::Camera& camera);
   void read_sensor(const YAML::Node& sensor, ir::Camera& camera);
+  void read_intrinsics(const YAML::Node& node, spec::SceneSpec& scene);
+  std::optional<double> focal_length_px(const YAML::Node& node, const std::string& what,
+                                        const limits::Quantity& limit);
+  void read_principal_point(const YAML::Node& node, const char* key, int size_px, double& out);
+  void size_intrinsics_camera(const YAML::Node& node, spec::SceneSpec& scene);
   void read_exif_text(const YAML::Node& node, ir::Camera& camera);
-  void read_lens(const YAML::Node& lens, ir::Camera& camera);
+  void read_lens(const YAML::Node& lens, ir::Camera& camera, bool needs_focal_length);
   void read_lens_preset(const YAML::Node& lens, ir::Camera& camera);
   void check_lens_limits(const YAML::Node& node, spec::SceneSpec& scene);
   void read_distortion(const YAML::Node& distortion, ir::Camera& camera);
@@ -307,7 +313,7 @@ class Checker {
   void read_white_balance(const YAML::Node& wb, ir::Camera& camera);
   void read_effects(const YAML::Node& effects, ir::Camera& camera);
   void read_output(const YAML::Node& output, ir::Camera& camera);
-  void finish_camera(ir::Camera& camera);
+  void finish_camera(ir::Camera& camera, bool pixels_measured);
   void read_shots(const YAML::Node& node, spec::SceneSpec& scene);
   void read_coverage(const YAML::Node& node, spec::SceneSpec& scene);
   void read_turntable_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
@@ -315,6 +321,10 @@ class Checker {
   void read_orbit_shots(const YAML::Node& node, spec::ShotGroupSpec& group);
   void read_ring(const YAML::Node& node, spec::OrbitShotsSpec& orbit);
   void read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group);
+  void read_pose_aim(const YAML::Node& node, spec::PoseShotSpec& pose);
+  std::optional<Eigen::Matrix3d> rotation(const YAML::Node& node);
+  std::optional<Eigen::Matrix3d> rotation_matrix(const YAML::Node& node);
+  std::optional<Eigen::Matrix3d> rotation_quaternion(const YAML::Node& node);
 
   std::string file_;
   std::string base_dir_;
@@ -742,26 +752,19 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
   camera.loc = loc(node);
   if (!expect_map(node, "camera")) return;
   check_keys(node,
-             {"body", "sensor", "make", "model", "lens", "exposure", "focus", "white_balance",
-              "effects", "output"},
+             {"body", "sensor", "intrinsics", "make", "model", "lens", "exposure", "focus",
+              "white_balance", "effects", "output"},
              "camera");
-  const bool has_body = static_cast<bool>(node["body"]);
-  const bool has_sensor = static_cast<bool>(node["sensor"]);
-  if (has_body && has_sensor) {
-    error(node["sensor"], "give the camera either a 'body' preset or a 'sensor', not both");
-  } else if (!has_body && !has_sensor) {
-    error(node,
-          "the camera needs a 'body' preset (e.g. canon-6d) or a 'sensor' {width, height, "
-          "pixels}");
-  }
-  if (has_body) read_body(node["body"], camera);
-  if (has_sensor) read_sensor(node["sensor"], camera);
+  read_camera_kind(node, scene);
   read_exif_text(node, camera);
+  // Intrinsics give the focal length in pixels: the lens may then leave out its focal length.
+  const bool has_intrinsics = static_cast<bool>(node["intrinsics"]);
   if (const YAML::Node lens = node["lens"]) {
-    read_lens(lens, camera);
-  } else {
+    read_lens(lens, camera, !has_intrinsics);
+  } else if (!has_intrinsics) {
     error(node, "the camera needs a 'lens' with a focal_length");
   }
+  if (scene.intrinsics) size_intrinsics_camera(node, scene);
   if (const YAML::Node exposure = node["exposure"]) {
     read_exposure(exposure, camera);
   } else {
@@ -772,7 +775,31 @@ void Checker::read_camera(const YAML::Node& node, spec::SceneSpec& scene) {
   if (const YAML::Node wb = node["white_balance"]) read_white_balance(wb, camera);
   if (const YAML::Node effects = node["effects"]) read_effects(effects, camera);
   if (const YAML::Node output = node["output"]) read_output(output, camera);
-  finish_camera(camera);
+  finish_camera(camera, has_intrinsics);
+}
+
+// What the camera is: a body preset, a sensor, or measured intrinsics (exactly one of them).
+void Checker::read_camera_kind(const YAML::Node& node, spec::SceneSpec& scene) {
+  const bool has_body = static_cast<bool>(node["body"]);
+  const bool has_sensor = static_cast<bool>(node["sensor"]);
+  const bool has_intrinsics = static_cast<bool>(node["intrinsics"]);
+  if (has_intrinsics && (has_body || has_sensor)) {
+    error(node["intrinsics"],
+          fmt::format("give the camera either 'intrinsics' or a '{}', not both: the intrinsics "
+                      "fix the image size and the focal length in pixels",
+                      has_body ? "body" : "sensor"));
+    return;
+  }
+  if (has_body && has_sensor) {
+    error(node["sensor"], "give the camera either a 'body' preset or a 'sensor', not both");
+  } else if (!has_body && !has_sensor && !has_intrinsics) {
+    error(node,
+          "the camera needs a 'body' preset (e.g. canon-6d) or a 'sensor' {width, height, "
+          "pixels}");
+  }
+  if (has_body) read_body(node["body"], scene.camera);
+  if (has_sensor) read_sensor(node["sensor"], scene.camera);
+  if (has_intrinsics) read_intrinsics(node["intrinsics"], scene);
 }
 
 void Checker::read_body(const YAML::Node& body, ir::Camera& camera) {
@@ -821,6 +848,112 @@ void Checker::read_sensor(const YAML::Node& sensor, ir::Camera& camera) {
   }
 }
 
+// A camera known by its intrinsics (a calibration's, COLMAP's PINHOLE): the image size, fx, fy
+// and the principal point in pixels (pixel centres at +0.5), kept as given.
+void Checker::read_intrinsics(const YAML::Node& node, spec::SceneSpec& scene) {
+  namespace limit = limits::camera;
+  ir::Camera& camera = scene.camera;
+  camera.body = "custom";
+  camera.make = "RigC";
+  camera.model = "custom intrinsics";
+  if (!expect_map(node, "intrinsics")) return;
+  check_keys(node, {"width", "height", "fx", "fy", "cx", "cy", "pixel_pitch"}, "intrinsics");
+  bool complete = true;
+  for (const char* key : {"width", "height", "fx", "fy", "cx", "cy"}) {
+    if (node[key]) continue;
+    complete = false;
+    if (lacks(node, key)) error(node, fmt::format("intrinsics need '{}'", key));
+  }
+  const int errors_before = diag_.error_count();
+  spec::IntrinsicsSpec k;
+  k.loc = loc(node);
+  const auto pixels = [&](const char* key, const limits::Integer& limit) {
+    return node[key] ? integer(node[key], fmt::format("image {}", key), limit) : std::nullopt;
+  };
+  const std::optional<int> width = pixels("width", limit::kIntrinsicsWidth);
+  const std::optional<int> height = pixels("height", limit::kIntrinsicsHeight);
+  camera.width_px = width.value_or(camera.width_px);
+  camera.height_px = height.value_or(camera.height_px);
+  if (node["fx"]) k.fx = focal_length_px(node["fx"], "fx", limit::kIntrinsicsFx).value_or(0);
+  if (node["fy"]) k.fy = focal_length_px(node["fy"], "fy", limit::kIntrinsicsFy).value_or(0);
+  // The principal point is checked against a valid image size only.
+  if (width) read_principal_point(node, "cx", *width, k.cx);
+  if (height) read_principal_point(node, "cy", *height, k.cy);
+  if (node["pixel_pitch"]) {
+    k.pixel_pitch_m = quantity(node["pixel_pitch"], "pixel pitch", limit::kPixelPitch);
+  }
+  if (complete && diag_.error_count() == errors_before) scene.intrinsics = k;
+}
+
+// A focal length in pixels: positive and within `limit`.
+std::optional<double> Checker::focal_length_px(const YAML::Node& node, const std::string& what,
+                                               const limits::Quantity& limit) {
+  const std::optional<double> value = quantity(node, limit.kind, what);
+  if (!value) return std::nullopt;
+  if (!(*value > 0)) {
+    error(node, fmt::format("{} {:g} is not a positive focal length in pixels", what, *value));
+    return std::nullopt;
+  }
+  return quantity(node, what, limit);
+}
+
+// cx or cy: inside the image of `size_px` pixels (its edges at 0 and size_px).
+void Checker::read_principal_point(const YAML::Node& node, const char* key, int size_px,
+                                   double& out) {
+  if (!node[key]) return;
+  const std::optional<double> value = quantity(node[key], QuantityKind::kNumber, key);
+  if (!value) return;
+  if (!(*value > 0 && *value < size_px)) {
+    error(node[key], fmt::format("{} {:g} px is outside the image (0..{} px; pixel centres are "
+                                 "at +0.5, the image centre at {:g})",
+                                 key, *value, size_px, size_px / 2.0));
+    return;
+  }
+  out = *value;
+}
+
+// The size in metres of an intrinsics camera, so that its focal length, depth of field and
+// exposure mean something: a pixel pitch (given, else the lens's focal length / fx, else 5 um)
+// makes the focal length fx·pitch and the sensor width·pitch by height·pitch·fx/fy.
+void Checker::size_intrinsics_camera(const YAML::Node& node, spec::SceneSpec& scene) {
+  constexpr double kDefaultPixelPitch_m = 5e-6;
+  constexpr double kFocalTolerance = 0.01;  // of the focal length
+  ir::Camera& camera = scene.camera;
+  const spec::IntrinsicsSpec& k = *scene.intrinsics;
+  // The lens's focal length, or its preset's (then at the preset's line).
+  const YAML::Node lens = node["lens"];
+  const bool focal = lens && lens.IsMap() && (lens["focal_length"] || lens["preset"]);
+  const YAML::Node focal_node = !focal                 ? node
+                                : lens["focal_length"] ? lens["focal_length"]
+                                                       : lens["preset"];
+  const auto mm = [](double m) { return fmt::format("{:g}mm", m * 1000); };
+  const auto um = [](double m) { return fmt::format("{:g}um", m * 1e6); };
+  double pitch = kDefaultPixelPitch_m;
+  if (k.pixel_pitch_m) {
+    pitch = *k.pixel_pitch_m;
+    if (focal &&
+        std::abs(camera.focal_length_m - k.fx * pitch) > kFocalTolerance * camera.focal_length_m) {
+      error(focal_node, fmt::format("focal length {} disagrees with the intrinsics: fx {:g} px at "
+                                    "pixel pitch {} is {}; give one of them",
+                                    mm(camera.focal_length_m), k.fx, um(pitch), mm(k.fx * pitch)));
+      return;
+    }
+  } else if (focal) {
+    pitch = camera.focal_length_m / k.fx;
+    const limits::Quantity& limit = limits::camera::kPixelPitch;
+    if (pitch < limit.min || pitch > limit.max) {
+      error(focal_node,
+            fmt::format("focal length {} over fx {:g} px is a pixel pitch of {}, outside "
+                        "{}..{}",
+                        mm(camera.focal_length_m), k.fx, um(pitch), um(limit.min), um(limit.max)));
+      return;
+    }
+  }
+  if (!focal) camera.focal_length_m = k.fx * pitch;
+  camera.sensor_width_m = camera.width_px * pitch;
+  camera.sensor_height_m = camera.height_px * pitch * k.fx / k.fy;
+}
+
 // The EXIF make and model: one line of printable text that fits in a JPEG marker (libjpeg
 // aborts, "Bogus marker length", on a longer one). EXIF text is NUL-terminated, so a "\0"
 // would cut the tag short.
@@ -847,13 +980,13 @@ void Checker::read_exif_text(const YAML::Node& node, ir::Camera& camera) {
   }
 }
 
-void Checker::read_lens(const YAML::Node& lens, ir::Camera& camera) {
+void Checker::read_lens(const YAML::Node& lens, ir::Camera& camera, bool needs_focal_length) {
   namespace limit = limits::camera;
   if (!expect_map(lens, "lens")) return;
   check_keys(lens, {"preset", "focal_length", "distortion", "vignetting"}, "lens");
   if (lens["focal_length"]) {
     read(lens, "focal_length", "focal length", limit::kFocalLength, camera.focal_length_m);
-  } else if (!lens["preset"] && lacks(lens, "focal_length")) {
+  } else if (needs_focal_length && !lens["preset"] && lacks(lens, "focal_length")) {
     error(lens, "lens needs a 'focal_length' (e.g. 50mm) or a 'preset'");
   }
   if (lens["preset"]) read_lens_preset(lens, camera);
@@ -1001,10 +1134,12 @@ void Checker::read_output(const YAML::Node& output, ir::Camera& camera) {
   read(output, "quality", "JPEG quality", limits::camera::kJpegQuality, camera.jpeg_quality);
 }
 
-// What follows from the sensor: the circle of confusion, and a warning on non-square pixels.
-void Checker::finish_camera(ir::Camera& camera) {
+// What follows from the sensor: the circle of confusion, and a warning on non-square pixels
+// (unless they were measured: a calibration's fx and fy are what they are).
+void Checker::finish_camera(ir::Camera& camera, bool pixels_measured) {
   // Acceptable circle of confusion: the sensor diagonal / 1500 (0.029 mm for full frame).
   camera.circle_of_confusion_m = std::hypot(camera.sensor_width_m, camera.sensor_height_m) / 1500.0;
+  if (pixels_measured) return;
   const double pixel_aspect =
       (camera.sensor_width_m / camera.width_px) / (camera.sensor_height_m / camera.height_px);
   if (std::abs(pixel_aspect - 1) > 0.02) {
@@ -1114,7 +1249,7 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   group.kind = ir::ShotKind::kPose;
   spec::PoseShotSpec& pose = group.pose;
   if (!expect_map(node, "a pose shot")) return;
-  check_keys(node, {"position", "look_at", "up", "turntable"}, "a pose shot");
+  check_keys(node, {"position", "look_at", "rotation", "up", "turntable"}, "a pose shot");
   if (node["position"]) {
     if (auto p = vec3(node["position"], "camera position", limits::shots::kPosePosition)) {
       pose.position = *p;
@@ -1122,7 +1257,23 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   } else {
     error(node, "a pose shot needs a 'position'");
   }
+  read_pose_aim(node, pose);
+  read(node, "turntable", "turntable angle", limits::shots::kPoseTurntable, pose.turntable_rad);
+}
+
+// Where the camera looks: at a target (with an up direction), or along a rotation.
+void Checker::read_pose_aim(const YAML::Node& node, spec::PoseShotSpec& pose) {
   pose.look_at.loc = loc(node);
+  if (const YAML::Node rotation_node = node["rotation"]) {
+    if (node["look_at"]) {
+      error(rotation_node, "give a pose either 'look_at' or 'rotation', not both");
+    } else if (node["up"]) {
+      error(node["up"], "'up' goes with 'look_at': a 'rotation' fixes the camera's roll itself");
+    } else {
+      pose.camera_from_world = rotation(rotation_node);
+    }
+    return;
+  }
   if (node["look_at"]) {
     if (auto t = target(node["look_at"], "look_at", limits::shots::kPoseLookAt)) {
       pose.look_at = *t;
@@ -1131,7 +1282,82 @@ void Checker::read_pose_shot(const YAML::Node& node, spec::ShotGroupSpec& group)
   if (node["up"]) {
     if (auto u = direction(node["up"], "up", "up must not be zero")) pose.up = *u;
   }
-  read(node, "turntable", "turntable angle", limits::shots::kPoseTurntable, pose.turntable_rad);
+}
+
+// How far a given rotation may be from one (R^T R from the identity, entry by entry).
+constexpr double kRotationTolerance = 1e-4;
+
+// COLMAP's camera_from_world rotation, a 3x3 matrix or {quaternion: [qw, qx, qy, qz]}: a proper
+// rotation within kRotationTolerance, re-orthonormalised (the nearest rotation, by SVD) so that
+// values written to a few digits give an exact one.
+std::optional<Eigen::Matrix3d> Checker::rotation(const YAML::Node& node) {
+  std::optional<Eigen::Matrix3d> r =
+      node.IsMap() ? rotation_quaternion(node) : rotation_matrix(node);
+  if (!r) return std::nullopt;
+  const double deviation =
+      (r->transpose() * *r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(deviation <= kRotationTolerance)) {
+    error(node, fmt::format("the rotation is not orthonormal (R^T R is {:.2g} off the identity; "
+                            "at most {:g}): give COLMAP's camera_from_world rotation",
+                            deviation, kRotationTolerance));
+    return std::nullopt;
+  }
+  if (r->determinant() < 0) {
+    error(node,
+          "the rotation is a reflection (determinant -1), not a rotation: a camera_from_world "
+          "rotation has determinant +1");
+    return std::nullopt;
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(*r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return Eigen::Matrix3d(svd.matrixU() * svd.matrixV().transpose());
+}
+
+// [[r11, r12, r13], [r21, r22, r23], [r31, r32, r33]], rows first.
+std::optional<Eigen::Matrix3d> Checker::rotation_matrix(const YAML::Node& node) {
+  if (!node.IsSequence() || node.size() != 3) {
+    error(node,
+          "rotation must be a 3x3 matrix [[r11, r12, r13], [r21, r22, r23], [r31, r32, "
+          "r33]] or {quaternion: [qw, qx, qy, qz]}");
+    return std::nullopt;
+  }
+  Eigen::Matrix3d r;
+  bool ok = true;
+  for (int row = 0; row < 3; ++row) {
+    const auto values = vec3(node[row], QuantityKind::kNumber, "a rotation's row");
+    if (values) r.row(row) = values->transpose();
+    ok = ok && values;
+  }
+  if (!ok) return std::nullopt;
+  return r;
+}
+
+// {quaternion: [qw, qx, qy, qz]} (COLMAP's images.txt order), of unit norm.
+std::optional<Eigen::Matrix3d> Checker::rotation_quaternion(const YAML::Node& node) {
+  check_keys(node, {"quaternion"}, "rotation");
+  const YAML::Node q = node["quaternion"];
+  if (!q) {
+    if (lacks(node, "quaternion")) error(node, "rotation needs a 'quaternion' [qw, qx, qy, qz]");
+    return std::nullopt;
+  }
+  if (!q.IsSequence() || q.size() != 4) {
+    error(q, "quaternion must be a list of four values [qw, qx, qy, qz] (COLMAP's order)");
+    return std::nullopt;
+  }
+  Eigen::Vector4d wxyz;
+  for (int i = 0; i < 4; ++i) {
+    const auto value = quantity(q[i], QuantityKind::kNumber, "quaternion");
+    if (!value) return std::nullopt;
+    wxyz[i] = *value;
+  }
+  // Off unit norm by no more than a matrix may be off orthonormal.
+  const double norm2 = wxyz.squaredNorm();
+  if (!(std::abs(norm2 - 1) <= kRotationTolerance)) {
+    error(q, fmt::format("quaternion of norm {:.6g} is not a unit quaternion (COLMAP writes unit "
+                         "quaternions)",
+                         std::sqrt(norm2)));
+    return std::nullopt;
+  }
+  return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized().toRotationMatrix();
 }
 
 // The mark of the first key or scalar value under `root` that is not UTF-8. yaml-cpp passes a

@@ -109,6 +109,18 @@ namespace camera {
 inline constexpr Quantity kSensorWidth{"camera.sensor.width", QuantityKind::kLength, 0.001, 0.2};
 inline constexpr Quantity kSensorHeight{"camera.sensor.height", QuantityKind::kLength, 0.001, 0.2};
 inline constexpr Integer kSensorPixels{"camera.sensor.pixels", 16, 20000};
+// A camera given by its intrinsics: an image of the sizes a sensor may have, focal lengths in
+// pixels, and the pitch that gives them a size in metres (the focal length, the sensor).
+inline constexpr Integer kIntrinsicsWidth{"camera.intrinsics.width", kSensorPixels.min,
+                                          kSensorPixels.max};
+inline constexpr Integer kIntrinsicsHeight{"camera.intrinsics.height", kSensorPixels.min,
+                                           kSensorPixels.max};
+inline constexpr Quantity kIntrinsicsFx{"camera.intrinsics.fx", QuantityKind::kNumber, 0, 1e6,
+                                        true};
+inline constexpr Quantity kIntrinsicsFy{"camera.intrinsics.fy", QuantityKind::kNumber, 0, 1e6,
+                                        true};
+inline constexpr Quantity kPixelPitch{"camera.intrinsics.pixel_pitch", QuantityKind::kLength,
+                                      0.5e-6, 50e-6};
 // EXIF text: a JPEG marker holds under 64 KB; real cameras write a few dozen characters.
 inline constexpr Count kMake{"camera.make", Count::kBytes, 255};
 inline constexpr Count kModel{"camera.model", Count::kBytes, 255};
@@ -200,6 +212,9 @@ inline constexpr std::array kQuantities = {
     studio::kLightLookAt,
     camera::kSensorWidth,
     camera::kSensorHeight,
+    camera::kIntrinsicsFx,
+    camera::kIntrinsicsFy,
+    camera::kPixelPitch,
     camera::kFocalLength,
     camera::kDistortionK1,
     camera::kDistortionK2,
@@ -236,8 +251,10 @@ inline constexpr std::array kQuantities = {
     coverage::kMinFrameFill,
 };
 inline constexpr std::array kIntegers = {
-    kLanguageVersion,      object::kPrimitiveDetail, object::kPrimitiveSeed, object::kPatternSeed,
-    camera::kSensorPixels, camera::kJpegQuality,     shots::kTurntableSteps, shots::kRingCount,
+    kLanguageVersion,          object::kPrimitiveDetail, object::kPrimitiveSeed,
+    object::kPatternSeed,      camera::kSensorPixels,    camera::kIntrinsicsWidth,
+    camera::kIntrinsicsHeight, camera::kJpegQuality,     shots::kTurntableSteps,
+    shots::kRingCount,
 };
 inline constexpr std::array kCounts = {kSceneName, studio::kLights, camera::kMake, camera::kModel};
 

@@ -128,6 +128,7 @@ class Lowering {
   void lower_camera();
   void lower_lights();
   void lower_shots();
+  void add_rotation_pose(const spec::PoseShotSpec& pose, const SourceLoc& loc);
   void place_backdrop();
   Vec3 aim_point(const spec::Target& target) const {
     if (!target.object) return target.point;
@@ -328,15 +329,25 @@ std::string distortion_problem(const ir::Distortion& d, double half_x, double ha
 
 void Lowering::lower_camera() {
   ir::Camera& camera = scene_.camera;
-  camera.fx = camera.focal_length_m * camera.width_px / camera.sensor_width_m;
-  camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
-  camera.cx = camera.width_px / 2.0;
-  camera.cy = camera.height_px / 2.0;
+  if (const auto& given = spec_.intrinsics) {
+    // Measured intrinsics are the truth: kept as given, not recomputed from the focal length.
+    camera.fx = given->fx;
+    camera.fy = given->fy;
+    camera.cx = given->cx;
+    camera.cy = given->cy;
+  } else {
+    camera.fx = camera.focal_length_m * camera.width_px / camera.sensor_width_m;
+    camera.fy = camera.focal_length_m * camera.height_px / camera.sensor_height_m;
+    camera.cx = camera.width_px / 2.0;
+    camera.cy = camera.height_px / 2.0;
+  }
+  // The frame's farther edge from the principal point on each axis, in normalised coordinates.
+  const double half_x = std::max(camera.cx, camera.width_px - camera.cx) / camera.fx;
+  const double half_y = std::max(camera.cy, camera.height_px - camera.cy) / camera.fy;
   // With the effect off the mapping is neither rendered nor exported.
-  const std::string lens_problem =
-      camera.effects.distortion
-          ? distortion_problem(camera.distortion, camera.cx / camera.fx, camera.cy / camera.fy)
-          : std::string();
+  const std::string lens_problem = camera.effects.distortion
+                                       ? distortion_problem(camera.distortion, half_x, half_y)
+                                       : std::string();
   if (!lens_problem.empty()) error(camera.distortion_loc, lens_problem);
   // The photographer's acceptable circle of confusion unless the scene sets its own.
   if (scene_.coverage.max_blur_px <= 0) {
@@ -453,6 +464,10 @@ void Lowering::lower_shots() {
       }
       case ir::ShotKind::kPose: {
         const auto& pose = group.pose;
+        if (pose.camera_from_world) {
+          add_rotation_pose(pose, group.loc);
+          break;
+        }
         const Vec3 aim = aim_point(pose.look_at);
         if ((aim - pose.position).norm() < 1e-6) {
           error(group.loc, "a pose's position and look_at are the same point");
@@ -464,6 +479,17 @@ void Lowering::lower_shots() {
       }
     }
   }
+}
+
+// A pose given by COLMAP's camera_from_world rotation and the camera centre, both in the world
+// frame whatever the turntable angle (which turns the object, not the camera, as for look_at).
+// `focus: auto` focuses at the object's centre's depth.
+void Lowering::add_rotation_pose(const spec::PoseShotSpec& pose, const SourceLoc& loc) {
+  Mat4 world_from_camera = Mat4::Identity();
+  world_from_camera.block<3, 3>(0, 0) = pose.camera_from_world->transpose();
+  world_from_camera.block<3, 1>(0, 3) = pose.position;
+  add_shot(ir::ShotKind::kPose, world_from_camera, pose.turntable_rad, 0, aim_point(spec::Target{}),
+           loc);
 }
 
 void Lowering::place_backdrop() {

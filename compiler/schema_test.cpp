@@ -42,14 +42,40 @@ TEST(Schema, RejectsWhatTheCompilerRejectsForItsShape) {
   // the schema states (out_of_range.yaml's values are bare numbers), not about files, geometry
   // or ranges of quantities with units, which a schema cannot see.
   const std::vector<std::string> bad = {
-      "unknown_keys.yaml",  "wrong_units.yaml",  "unknown_names.yaml", "missing_sections.yaml",
-      "not_a_mapping.yaml", "wrong_shapes.yaml", "out_of_range.yaml"};
+      "unknown_keys.yaml",     "wrong_units.yaml",         "unknown_names.yaml",
+      "missing_sections.yaml", "not_a_mapping.yaml",       "wrong_shapes.yaml",
+      "out_of_range.yaml",     "pose_rotation.yaml",       "intrinsics_values.yaml",
+      "intrinsics_size.yaml",  "intrinsics_with_body.yaml"};
   for (const auto& name : bad) {
     const std::string path = testing::source_path("tests/bad_scenes/" + name);
     testing::ProcessResult result = validate({path});
     EXPECT_EQ(result.exit_code, 1) << name << ": " << result.out << result.err;
     EXPECT_NE(result.out.find("invalid"), std::string::npos) << name;
   }
+}
+
+// A real capture's cameras: poses by rotation (a matrix or a quaternion), a camera by its
+// intrinsics with no lens.
+TEST(Schema, AcceptsPosesByRotationAndCamerasByIntrinsics) {
+  const std::string text = R"(rigc: 1
+object: {primitive: sphere, fit: {height: 20cm}, surface: {pattern: speckle}}
+camera:
+  intrinsics: {width: 640, height: 480, fx: 1520.4, fy: 1525.9, cx: 302.3, cy: 246.9, pixel_pitch: 5um}
+  exposure: {aperture: f/8, shutter: 1/125, iso: 200}
+shots:
+  - pose: {position: [0.31m, -0.62m, 1.07m],
+           rotation: [[0.894427, 0.447214, 0], [0.135285, -0.270571, -0.953147], [-0.42626, 0.852521, -0.302507]]}
+  - pose: {position: [0.31m, -0.62m, 1.07m], rotation: {quaternion: [0.57475, 0.785415, 0.185411, -0.13568]}, turntable: 30deg}
+)";
+  testing::TempDir dir;
+  const std::string path = dir.file("twin.yaml");
+  testing::write_text(path, text);
+  testing::ProcessResult result = validate({path});
+  EXPECT_EQ(result.exit_code, 0) << result.out << result.err;
+  DiagnosticEngine diag;
+  std::string messages;
+  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  EXPECT_TRUE(compile_scene_file(path, diag)) << messages;
 }
 
 }  // namespace

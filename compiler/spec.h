@@ -75,6 +75,9 @@ struct PoseShotSpec {
   ir::Vec3 position{0, -1, 0};
   Target look_at;
   ir::Vec3 up{0, 0, 1};
+  // COLMAP's camera_from_world rotation in the world frame, orthonormalised: given instead of
+  // look_at (and up).
+  std::optional<Eigen::Matrix3d> camera_from_world;
   double turntable_rad = 0;
 };
 
@@ -83,6 +86,13 @@ struct ShotGroupSpec {
   TurntableShotsSpec turntable;
   OrbitShotsSpec orbit;
   PoseShotSpec pose;
+  SourceLoc loc;
+};
+
+// A camera given by its intrinsics (`camera: {intrinsics: ...}`): pixels, as COLMAP states them.
+struct IntrinsicsSpec {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::optional<double> pixel_pitch_m;
   SourceLoc loc;
 };
 
@@ -100,7 +110,8 @@ struct SceneSpec {
   ir::Studio studio;  // lights without resolved directions
   std::vector<LightSpec> lights;
   bool backdrop_distance_set = false;
-  ir::Camera camera;  // intrinsics not yet computed
+  ir::Camera camera;  // intrinsics not yet computed, unless given:
+  std::optional<IntrinsicsSpec> intrinsics;
   bool focus_auto = true;
   double focus_distance_m = 1;
   // The lens preset's closest focus, which `focus: auto` cannot go under; 0 without a preset.

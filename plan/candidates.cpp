@@ -236,7 +236,21 @@ std::string orbit_ring(const Station& station, double azimuth_deg) {
                      angle_text(station.elevation_rad / kDegree), angle_text(azimuth_deg));
 }
 
+// A rotation-given pose keeps its position and rotation to the last digit: it reproduces a real
+// camera.
+std::string rotation_pose_entry(const spec::PoseShotSpec& pose) {
+  const Eigen::Matrix3d& r = *pose.camera_from_world;
+  std::string rows;
+  for (int i = 0; i < 3; ++i) {
+    rows += fmt::format("{}[{}, {}, {}]", i ? ", " : "", r(i, 0), r(i, 1), r(i, 2));
+  }
+  const Vec3& c = pose.position;
+  return fmt::format("  - pose: {{position: [{}m, {}m, {}m], rotation: [{}], turntable: {}}}\n",
+                     c.x(), c.y(), c.z(), rows, angle_text(pose.turntable_rad / kDegree));
+}
+
 std::string pose_entry(const spec::PoseShotSpec& pose) {
+  if (pose.camera_from_world) return rotation_pose_entry(pose);
   return fmt::format("  - pose: {{position: {}, look_at: {}, up: [{}, {}, {}], turntable: {}}}\n",
                      point_text(pose.position), target_text(pose.look_at), pose.up.x(), pose.up.y(),
                      pose.up.z(), angle_text(pose.turntable_rad / kDegree));
