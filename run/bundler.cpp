@@ -2,10 +2,31 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "io/atomic_file.h"
 #include "run/colmap_text.h"
 
 namespace rigc::run {
+
+std::string bundler_camera_problem(const ir::Camera& camera, double scale) {
+  constexpr double kMostFocalDifference = 0.005;  // of fx
+  constexpr double kMostPrincipalOffset_px = 0.01;
+  const auto out = output_camera(camera, scale, nullptr);
+  if (!out) return {};
+  if (std::abs(out->fy - out->fx) > kMostFocalDifference * out->fx) {
+    return fmt::format("Bundler's cameras have one focal length, this one fx {:g} and fy {:g} px",
+                       out->fx, out->fy);
+  }
+  if (std::abs(out->cx - out->width / 2.0) > kMostPrincipalOffset_px ||
+      std::abs(out->cy - out->height / 2.0) > kMostPrincipalOffset_px) {
+    return fmt::format(
+        "Bundler's cameras have their principal point at the image centre ({:g}, "
+        "{:g}), this one at ({:g}, {:g})",
+        out->width / 2.0, out->height / 2.0, out->cx, out->cy);
+  }
+  return {};
+}
 
 bool write_bundler(const std::filesystem::path& out_path, const std::filesystem::path& list_path,
                    const ir::Scene& scene, const std::vector<int>& shots, double scale,

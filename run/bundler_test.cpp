@@ -62,5 +62,25 @@ TEST(Bundler, AListThatDoesNotMatchIsAnError) {
   EXPECT_NE(error.find("lists 1 images"), std::string::npos) << error;
 }
 
+// Bundler states one focal length and no principal point: a camera with fx != fy beyond a body's
+// rounding, or its principal point off the centre, gets no bundle.out rather than a wrong one.
+TEST(Bundler, DescribesOnlyCamerasWithOneFocalLengthAndACentredPrincipalPoint) {
+  ir::Camera camera;
+  camera.width_px = 640;
+  camera.height_px = 480;
+  camera.fx = 1520.4;
+  camera.fy = 1522;  // 0.1 %: a body's rounding
+  camera.cx = 320;
+  camera.cy = 240;
+  EXPECT_EQ(bundler_camera_problem(camera, 0.5), "");
+  camera.fy = 1545.9;
+  EXPECT_NE(bundler_camera_problem(camera, 1).find("one focal length"), std::string::npos);
+  camera.fy = 1520.4;
+  camera.cx = 302.3;
+  EXPECT_NE(bundler_camera_problem(camera, 1).find("principal point at the image centre (320, "
+                                                   "240), this one at (302.3, 240)"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigc::run

@@ -273,6 +273,29 @@ bool check_one_scale(const Manifest& manifest, const ir::Scene& scene,
   return false;
 }
 
+namespace {
+
+// bundle.out for a camera Bundler can describe; for another (fx != fy, a principal point off the
+// centre: a real camera's intrinsics) none, and an earlier one removed, rather than a wrong one.
+bool write_bundler_if_it_fits(const fs::path& run_dir, const ir::Scene& scene,
+                              const std::vector<int>& present, double scale,
+                              const GroundTruthPoints& points, std::ostream& log,
+                              std::string* error) {
+  const std::string problem = bundler_camera_problem(scene.camera, scale);
+  if (problem.empty()) {
+    return write_bundler(run_dir / "bundle.out", run_dir / "bundle.list.txt", scene, present, scale,
+                         points, error);
+  }
+  std::error_code ignored;
+  fs::remove(run_dir / "bundle.out", ignored);
+  fs::remove(run_dir / "bundle.list.txt", ignored);
+  log << fmt::format("rigc: note: no bundle.out: {}; sparse/ and transforms.json state it\n",
+                     problem);
+  return true;
+}
+
+}  // namespace
+
 int finish_run(const ir::Scene& scene, const Manifest& manifest, const fs::path& run_dir,
                double scale, int failures, size_t shots, std::ostream& log) {
   // Ground truth for every shot that has its image in this run folder.
@@ -289,8 +312,7 @@ int finish_run(const ir::Scene& scene, const Manifest& manifest, const fs::path&
              : GroundTruthPoints{};
   if (!camera || !write_colmap_sparse(run_dir / "sparse", scene, present, scale, &error, &points) ||
       !write_transforms_json(run_dir / "transforms.json", scene, present, scale, &error) ||
-      !write_bundler(run_dir / "bundle.out", run_dir / "bundle.list.txt", scene, present, scale,
-                     points, &error) ||
+      !write_bundler_if_it_fits(run_dir, scene, present, scale, points, log, &error) ||
       !write_camera_csv(run_dir / "cameras.csv", scene, present, &error)) {
     log << fmt::format("rigc: error: {}\n", error);
     return 2;
