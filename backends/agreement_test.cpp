@@ -359,6 +359,18 @@ TEST(ReferenceAgreement, PortraitOffCentreAlbedo) {
   expect_same_albedo(scene, 2, 0.125);
 }
 
+// A camera as a calibration states it (the scene's `intrinsics`): fx and fy 8 % apart and the
+// principal point off the centre. Every renderer takes them from the IR: POV-Ray through its
+// direction, right and up vectors, Cycles through its pixel aspect and lens shift.
+TEST(ReferenceAgreement, MeasuredIntrinsicsAlbedo) {
+  ir::Scene scene = paper_scene_with_noise();
+  ir::Camera& camera = scene.camera;
+  camera.fy = 1.08 * camera.fx;
+  camera.cx = 0.45 * camera.width_px;
+  camera.cy = 0.56 * camera.height_px;
+  expect_same_albedo(scene, 2, 0.125);
+}
+
 // The paper scene's statue with vertex colours (bands of hue about 4 cm wide, as a scan's colours
 // vary) under its speckle: each renderer interpolates the colours over every triangle. The
 // statue at detail 3 (triangles several pixels wide): at detail 6, about a pixel each, POV-Ray
