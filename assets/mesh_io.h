@@ -25,8 +25,8 @@ struct LoadedModel {
 // *error to one line that names the file and says what is wrong (no crash, no silent empty mesh).
 std::optional<LoadedModel> load_model(const std::string& path, std::string* error);
 
-// Writes a mesh as binary little-endian PLY (positions, normals, uvs if any). For benchmarks and
-// coverage output. Returns false and sets *error on failure.
+// Writes a mesh as binary little-endian PLY (positions, normals, uvs and colours as 8-bit sRGB if
+// any). For benchmarks, coverage output and twins. Returns false and sets *error on failure.
 bool write_ply(const std::string& path, const ir::Mesh& mesh, std::string* error);
 
 }  // namespace rigc

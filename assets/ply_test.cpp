@@ -150,6 +150,24 @@ TEST(MeshIoWritePly, WithoutNormalsOrUvsNormalsAreComputed) {
   }
 }
 
+TEST(MeshIoWritePly, VertexColoursComeBackAsTheLinearColoursWritten) {
+  TempDir dir;
+  ir::Mesh mesh = make_primitive(PrimitiveKind::kSphere, 2, 1);
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    mesh.colors.emplace_back(0.02f * static_cast<float>(i % 50), 0.5f, 1.0f);
+  }
+  std::string error;
+  ASSERT_TRUE(write_ply(dir.file("sphere.ply"), mesh, &error)) << error;
+  const LoadedModel m = load_ok(dir.file("sphere.ply"));
+  ASSERT_EQ(m.vertex_colors.size(), mesh.colors.size());
+  for (std::size_t i = 0; i < mesh.colors.size(); ++i) {
+    // 8-bit sRGB holds a linear value to within half a step of its encoding.
+    ASSERT_TRUE(m.vertex_colors[i].isApprox(mesh.colors[i], 0.01f) ||
+                (m.vertex_colors[i] - mesh.colors[i]).cwiseAbs().maxCoeff() < 0.003f)
+        << i << ": " << m.vertex_colors[i].transpose() << " against " << mesh.colors[i].transpose();
+  }
+}
+
 TEST(MeshIoWritePly, ReportsFailures) {
   const ir::Mesh mesh = make_primitive(PrimitiveKind::kBox, 1, 1);
   std::string error;

@@ -1,8 +1,10 @@
 // write_ply: a mesh as binary little-endian PLY.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -29,6 +31,8 @@ std::optional<std::string> unwritable(const ir::Mesh& mesh) {
     return "normals and positions differ in count";
   }
   if (!mesh.uvs.empty() && mesh.uvs.size() != n) return "uvs and positions differ in count";
+  if (!mesh.colors.empty() && mesh.colors.size() != n)
+    return "colours and positions differ in count";
   if (n > std::numeric_limits<std::uint32_t>::max()) return "too many vertices";
   for (const auto& t : mesh.triangles) {
     if (t[0] >= n || t[1] >= n || t[2] >= n) return "a triangle index is out of range";
@@ -42,6 +46,8 @@ std::string ply_header(const ir::Mesh& mesh) {
   header += "property float x\nproperty float y\nproperty float z\n";
   if (!mesh.normals.empty()) header += "property float nx\nproperty float ny\nproperty float nz\n";
   if (!mesh.uvs.empty()) header += "property float s\nproperty float t\n";
+  if (!mesh.colors.empty())
+    header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   header += fmt::format("element face {}\n", mesh.triangles.size());
   header += "property list uchar uint vertex_indices\nend_header\n";
   return header;
@@ -81,6 +87,13 @@ class ChunkedWriter {
   std::vector<unsigned char> chunk_;
 };
 
+// A linear colour channel as a scanner writes it: 8-bit sRGB.
+unsigned char srgb_byte(float linear) {
+  const float v = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
+  const float encoded = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
+  return static_cast<unsigned char>(std::lround(255 * encoded));
+}
+
 // The vertices, then the faces; false if a write failed.
 bool write_ply_body(const ir::Mesh& mesh, ChunkedWriter* out) {
   const bool normals = !mesh.normals.empty();
@@ -94,6 +107,9 @@ bool write_ply_body(const ir::Mesh& mesh, ChunkedWriter* out) {
       // PLY texture coordinates have t = 0 at the image bottom.
       out->put_float(mesh.uvs[i].x());
       out->put_float(1.0f - mesh.uvs[i].y());
+    }
+    if (!mesh.colors.empty()) {
+      for (int k = 0; k < 3; ++k) out->put8(srgb_byte(mesh.colors[i][k]));
     }
     out->flush(false);
   }
