@@ -168,7 +168,9 @@ TEST(ChromaKey, BlackVelvetAndALightTentAreKeyedByBrightness) {
     const auto backdrop = backdrop_brightness_at_borders(im);
     ASSERT_TRUE(backdrop.has_value()) << dark;
     EXPECT_EQ(*backdrop, dark ? BrightBackdrop::kDark : BrightBackdrop::kBright);
-    const auto mask = key_brightness(im, *backdrop);
+    // The key, then the velvet's fold at the frame's edge dropped, as eval's masks do.
+    auto mask = key_brightness(im, *backdrop);
+    drop_border_components(mask, im.width, im.height);
     int wrong = 0;
     for (int y = 0; y < im.height; ++y) {
       for (int x = 0; x < im.width; ++x) {

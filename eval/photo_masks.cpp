@@ -20,8 +20,6 @@ namespace {
 
 // Keying works on pictures this size at most: the silhouette needs no more.
 constexpr int kKeySide = 1024;
-// The outline grows by this much (working pixels) so silhouette features keep their support.
-constexpr int kGrowPx = 2;
 
 // A mask that keeps almost nothing or almost everything is no mask: the key found no object.
 bool plausible_coverage(double coverage) {
@@ -56,12 +54,15 @@ std::map<std::pair<int, int>, StillBackground> still_backgrounds(
 
 // One photo's keyed mask (empty when no key applies), and its line of the report.
 std::vector<std::uint8_t> key_one(const KeyImage& picture, const std::optional<Chroma>& hint,
-                                  const StillBackground* still, double tolerance, json& entry) {
+                                  const StillBackground* still, const PhotoMaskOptions& o,
+                                  json& entry) {
+  const double tolerance = o.tolerance;
   // Black velvet or a light tent: keyed by brightness (a green screen is neither).
   if (const auto brightness = hint ? std::nullopt : backdrop_brightness_at_borders(picture)) {
     entry["backdrop"] = *brightness == BrightBackdrop::kDark ? "dark" : "bright";
-    return clean_object_mask(key_brightness(picture, *brightness), picture.width, picture.height,
-                             kGrowPx);
+    std::vector<std::uint8_t> mask = key_brightness(picture, *brightness);
+    drop_border_components(mask, picture.width, picture.height);
+    return clean_object_mask(std::move(mask), picture.width, picture.height, o.grow_px);
   }
   const auto key = backdrop_at_borders(picture, hint, tolerance);
   if (!key && !still) return {};
@@ -75,7 +76,7 @@ std::vector<std::uint8_t> key_one(const KeyImage& picture, const std::optional<C
     for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = std::min(mask[i], moving[i]);
   }
   entry["still_background"] = still != nullptr;
-  return clean_object_mask(std::move(mask), picture.width, picture.height, kGrowPx);
+  return clean_object_mask(std::move(mask), picture.width, picture.height, o.grow_px);
 }
 
 bool key_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::path& dir, json& report,
@@ -104,7 +105,7 @@ bool key_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::path
     const auto s = still.find({p.width, p.height});
     if (s != still.end()) report["still_fraction"] = s->second.still_fraction;
     json entry;
-    const auto mask = key_one(p, hint, s == still.end() ? nullptr : &s->second, o.tolerance, entry);
+    const auto mask = key_one(p, hint, s == still.end() ? nullptr : &s->second, o, entry);
     const double coverage = coverage_of(mask);
     entry["coverage"] = coverage;
     if (!plausible_coverage(coverage)) {

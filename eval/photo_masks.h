@@ -19,6 +19,9 @@ struct PhotoMaskOptions {
   std::string masks_dir;                   // masks made elsewhere: same stems, any common format
   std::optional<ir::Vec3> backdrop_color;  // the scene's green screen (linear RGB), if any
   double tolerance = 0.12;                 // chromaticity distance keyed as the backdrop
+  // A keyed outline grows by this much (working pixels, 1024 on the long side) so that COLMAP's
+  // features on the silhouette keep their support; 0 for the silhouette itself (a hull).
+  int grow_px = 2;
   bool quiet = false;
 };
 
