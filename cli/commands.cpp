@@ -290,6 +290,8 @@ const std::vector<Command>& commands() {
       {"studio", "the interactive capture studio in a browser", run_studio_command},
       {"sweep", "compare capture configurations: scene variants, locally or on Slurm",
        run_sweep_command},
+      {"twin", "make a digital twin of a real capture (cameras, visual hull, photo colours)",
+       run_twin_command},
       {"version", "print the version", run_version},
   };
   return table;

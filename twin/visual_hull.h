@@ -1,0 +1,69 @@
+// The object as the photos' silhouettes bound it: a visual hull carved on a voxel grid (a point
+// is kept when every photo shows the object there, or all but `max_misses`: the object must be
+// in frame in all of them)
+// and meshed at the silhouettes'
+// edges by Open3D's marching cubes. A hull cannot carve what no silhouette shows: concavities
+// (the space between columns seen end-on, a bowl's inside) stay filled (docs/twin.md).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "eval/geometry.h"
+
+namespace rigc::twin {
+
+// A silhouette: per pixel, how much of it is the object (0..1), row-major.
+struct Silhouette {
+  int width = 0, height = 0;
+  std::vector<float> coverage;
+  float at(int x, int y) const { return coverage[static_cast<std::size_t>(y) * width + x]; }
+};
+
+struct SilhouetteView {
+  eval::ViewCamera camera;  // its width and height are the silhouette's
+  const Silhouette* silhouette = nullptr;
+};
+
+struct HullOptions {
+  int resolution = 128;  // voxels along the region's longest side
+  int min_views = 3;     // a point must fall inside this many photos to be kept
+  // A point outside this many silhouettes is still kept: a key that cut a shaded part of the
+  // object out of one photo would otherwise carve it from the hull in every view.
+  int max_misses = 0;
+};
+
+struct VisualHull {
+  std::vector<Eigen::Vector3f> positions;               // the views' world frame
+  std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+  Eigen::AlignedBox3d region;                           // the grid carved
+  double voxel_m = 0;                                   // the grid's spacing, in the views' units
+  double filled_share = 0;                              // of the grid's points kept
+};
+
+// Where the object can be: a box around the point nearest to every view's ray through its
+// silhouette's centroid, as large as the widest silhouette seen from the nearest view, doubled.
+// nullopt with `error` when fewer than 3 views show any object or the rays do not meet.
+std::optional<Eigen::AlignedBox3d> hull_search_region(const std::vector<SilhouetteView>& views,
+                                                      std::string* error);
+
+// Carves `region` at `options.resolution`, twice: coarsely over the region, then finely over the
+// part kept (grown by two voxels). nullopt with `error` when fewer than 3 silhouettes are given,
+// nothing is kept, or the hull fills the whole region (the silhouettes keep everything: no
+// backdrop was found).
+std::optional<VisualHull> carve_visual_hull(const std::vector<SilhouetteView>& views,
+                                            const Eigen::AlignedBox3d& region,
+                                            const HullOptions& options, std::string* error);
+
+// The silhouette `mesh` casts in `camera`: the share of each pixel covered, 0 or 1 at its centre.
+Silhouette render_silhouette(const eval::ViewCamera& camera, const VisualHull& hull);
+
+// Intersection over union of two silhouettes of one size, each thresholded at half.
+double silhouette_iou(const Silhouette& a, const Silhouette& b);
+
+}  // namespace rigc::twin
