@@ -38,7 +38,8 @@ int run_twin_command(std::vector<std::string> args) {
   app.add_option("--ring-views", o.ring_views,
                  "also write ring_N.yaml: the twin with N views on the real cameras' ring")
       ->check(CLI::Range(0, 720));
-  app.add_flag("!--no-render", o.render, "skip rendering the twin and the contact sheet");
+  app.add_flag("!--no-render", o.render,
+               "skip rendering the twin, the contact sheet and the lights' scaling to the photos");
   app.add_flag("-q,--quiet", o.quiet, "print errors only");
   if (auto code = parse_options(app, args)) return *code;
   if (!height.empty()) {

@@ -163,7 +163,7 @@ TEST(EvalEndToEnd, ADenserRingOnTheTemplesTwinRegistersMoreThanThePhotos) {
   const fs::path twin = dir.path() / "twin";
   auto r = run_rigc({"twin", source_path(kTemple), "--reference-cameras",
                      source_path(kTemple + "/templeSR_par.txt"), "--ring-views", "32", "-o",
-                     twin.string(), "--no-render"});
+                     twin.string()});  // rendered: the lights are scaled to the photos then
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = run_rigc({"render", (twin / "ring_32.yaml").string(), "-o", dir.file("ring")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
