@@ -124,22 +124,6 @@ std::optional<std::vector<std::pair<std::string, eval::ViewCamera>>> capture_cam
   return cameras;
 }
 
-// A mask file as a silhouette (first channel, 0..1).
-std::optional<Silhouette> read_silhouette(const fs::path& path, std::string* error) {
-  OIIO::ImageBuf in(path.string());
-  if (!in.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
-    *error = fmt::format("cannot read the mask {}: {}", path.string(), in.geterror());
-    return std::nullopt;
-  }
-  Silhouette s;
-  s.width = in.spec().width;
-  s.height = in.spec().height;
-  s.coverage.resize(static_cast<std::size_t>(s.width) * s.height);
-  in.get_pixels(OIIO::ROI(0, s.width, 0, s.height, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT,
-                s.coverage.data());
-  return s;
-}
-
 // A photo's pixels in linear RGB.
 std::optional<std::vector<Eigen::Vector3f>> read_linear(const fs::path& path, int w, int h,
                                                         std::string* error) {
@@ -195,9 +179,10 @@ std::optional<std::vector<CapturedPhoto>> captured_photos(
     return std::nullopt;
   }
   if (!whole.empty() && !o.quiet) {
-    log << fmt::format("rigc twin: warning: left out {} photos whose masks keep more than 90 % "
-                       "of them (no backdrop found), {} first\n",
-                       whole.size(), whole.front());
+    log << fmt::format(
+        "rigc twin: warning: left out {} photos whose masks keep more than 90 % "
+        "of them (no backdrop found), {} first\n",
+        whole.size(), whole.front());
   }
   return photos;
 }

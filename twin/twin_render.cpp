@@ -10,6 +10,7 @@
 
 #include "backends/registry.h"
 #include "compiler/frontend.h"
+#include "dslr/image_io.h"
 #include "io/atomic_file.h"
 #include "run/colmap_text.h"
 #include "run/run_loop.h"
@@ -18,6 +19,21 @@ namespace rigc::twin {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+std::optional<Silhouette> read_silhouette(const fs::path& path, std::string* error) {
+  OIIO::ImageBuf in(path.string());
+  if (!in.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
+    *error = fmt::format("cannot read the mask {}: {}", path.string(), in.geterror());
+    return std::nullopt;
+  }
+  Silhouette s;
+  s.width = in.spec().width;
+  s.height = in.spec().height;
+  s.coverage.resize(static_cast<std::size_t>(s.width) * s.height);
+  in.get_pixels(OIIO::ROI(0, s.width, 0, s.height, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT,
+                s.coverage.data());
+  return s;
+}
 
 namespace {
 
@@ -39,9 +55,8 @@ std::optional<RenderedView> read_render(const fs::path& run, const ir::Scene& sc
                                         std::string* error) {
   const ir::Shot& s = scene.shots.at(static_cast<std::size_t>(shot));
   OIIO::ImageBuf image((run / run::image_relative_path(scene.camera, s)).string());
-  OIIO::ImageBuf mask((run / run::mask_relative_path(s)).string());
-  if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT) ||
-      !mask.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
+  auto mask = read_silhouette(run / run::mask_relative_path(s), error);
+  if (!mask || !image.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
     *error = fmt::format("cannot read the twin's render of shot {} in {}", shot, run.string());
     return std::nullopt;
   }
@@ -51,11 +66,7 @@ std::optional<RenderedView> read_render(const fs::path& run, const ir::Scene& sc
       OIIO::ImageBufAlgo::channels(image, 3, {0, 1, 2}), "sRGB", "linear");
   v.linear.resize(static_cast<std::size_t>(w) * h);
   linear.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, v.linear.data());
-  v.silhouette.width = w;
-  v.silhouette.height = h;
-  v.silhouette.coverage.resize(v.linear.size());
-  mask.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT,
-                  v.silhouette.coverage.data());
+  v.silhouette = std::move(*mask);
   return v;
 }
 
@@ -186,18 +197,10 @@ bool write_contact_sheet(const std::vector<CapturedPhoto>& photos,
     paste(renders[k].linear, x + tile, y);
   }
   const OIIO::ImageBuf srgb = OIIO::ImageBufAlgo::colorconvert(sheet, "linear", "sRGB");
-  const fs::path tmp = temporary_path_beside(path);
-  if (!srgb.write(tmp.string(), OIIO::TypeDesc::UINT8, "png")) {
-    *error = fmt::format("cannot write {}: {}", path.string(), srgb.geterror());
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    return false;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    *error = fmt::format("cannot write {}", path.string());
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(width) * height * 3);
+  srgb.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, bytes.data());
+  if (!dslr::write_pixels(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8),
+                          bytes.data(), error)) {
     return false;
   }
   return true;

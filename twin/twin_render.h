@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -23,6 +24,9 @@ struct CapturedPhoto {
   Silhouette silhouette;
   std::vector<Eigen::Vector3f> linear;
 };
+
+// A mask file as a silhouette (its first channel, 0..1); nullopt with `error`.
+std::optional<Silhouette> read_silhouette(const std::filesystem::path& path, std::string* error);
 
 // Renders the twin at `scene_path` (written from `scene`, in shot order of `photos`) into
 // OUT/render, rewriting the scene with its lights scaled to the photos' brightness; writes

@@ -3,7 +3,6 @@
 // evaluation by COLMAP is EvalEndToEnd.* (slow and external).
 #include "twin/twin.h"
 
-#include <OpenImageIO/imagebuf.h>
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -17,6 +16,7 @@
 
 #include "run/colmap_text.h"
 #include "tests/test_support.h"
+#include "twin/twin_render.h"
 #include "twin/visual_hull.h"
 
 namespace rigc::twin {
@@ -28,22 +28,6 @@ using rigc::testing::source_path;
 using ::testing::HasSubstr;
 
 const std::string kTemple = "tests/real/templeSparseRing";
-
-// A run's mask as a silhouette.
-std::optional<Silhouette> read_mask(const fs::path& path, std::string* error) {
-  OIIO::ImageBuf in(path.string());
-  if (!in.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
-    *error = path.string() + ": " + in.geterror();
-    return std::nullopt;
-  }
-  Silhouette s;
-  s.width = in.spec().width;
-  s.height = in.spec().height;
-  s.coverage.resize(static_cast<std::size_t>(s.width) * s.height);
-  in.get_pixels(OIIO::ROI(0, s.width, 0, s.height, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT,
-                s.coverage.data());
-  return s;
-}
 
 nlohmann::json read_json(const fs::path& path) {
   std::ifstream in(path);
@@ -199,8 +183,8 @@ TEST(TwinTempleExternal, EveryRendererDrawsTheTwinsSilhouette) {
                              "--shots", "4", "--samples", "16", "-o", run.string()});
     ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.err;
     std::string error;
-    const auto mine = read_mask(run / "masks" / "shot_004.png", &error);
-    const auto preview = read_mask(dir / "render" / "masks" / "shot_004.png", &error);
+    const auto mine = read_silhouette(run / "masks" / "shot_004.png", &error);
+    const auto preview = read_silhouette(dir / "render" / "masks" / "shot_004.png", &error);
     ASSERT_TRUE(mine && preview) << error;
     EXPECT_GT(silhouette_iou(*mine, *preview), 0.97) << backend;
   }
