@@ -79,7 +79,7 @@ std::string scene_yaml(const TwinScene& t) {
   y += fmt::format(
       "  intrinsics: {{width: {}, height: {}, fx: {:.9g}, fy: {:.9g}, cx: {:.9g}, cy: {:.9g}}}\n",
       t.camera.width, t.camera.height, t.camera.fx, t.camera.fy, t.camera.cx, t.camera.cy);
-  y += "  exposure: {aperture: f/4, shutter: 1/30, iso: 100}\n";
+  y += "  exposure: {aperture: f/3.2, shutter: 1/30, iso: 100}\n";
   y += "  focus: auto\n";
   y += "  white_balance: 5500K\n";
   y += "shots:\n";

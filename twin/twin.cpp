@@ -343,6 +343,14 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   if (o.render) {
     const int rc = render_and_compare(scene_path, scene, *photos, out, report, log, &error);
     if (rc != 0) return fail(log, rc, error);
+    const json& c = report["comparison"];
+    if (!o.quiet) {
+      log << fmt::format(
+          "rigc twin: rendered {} views: silhouette IoU against the photos' masks median {:.3f}, "
+          "lowest {:.3f}; {}\n",
+          photos->size(), c["median_silhouette_iou"].get<double>(),
+          c["min_silhouette_iou"].get<double>(), c["contact_sheet"].get<std::string>());
+    }
   }
   if (o.ring_views > 0) {
     TwinScene ring = scene;

@@ -241,10 +241,6 @@ int render_and_compare(const fs::path& scene_path, TwinScene& scene,
                           {"min_silhouette_iou", ious.front()},
                           {"median_silhouette_iou", ious[ious.size() / 2]},
                           {"photos", per_photo}};
-  log << fmt::format(
-      "rigc twin: rendered {} views: silhouette IoU against the photos' masks median {:.3f}, "
-      "lowest {:.3f}; {}\n",
-      photos.size(), ious[ious.size() / 2], ious.front(), sheet.string());
   return 0;
 }
 
