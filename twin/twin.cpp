@@ -225,9 +225,9 @@ TwinScene twin_scene(const TwinOptions& o, const VisualHull& hull,
   for (const auto& p : hull.positions) box.extend(p.cast<double>());
   t.object_size = box.sizes();
   t.backdrop_linear = backdrop_color(photos);
-  // As wide as the object's footprint: nothing overhangs it, and in the backdrop's colour it
-  // shows as little as the real stand did.
-  t.table_diameter_m = std::max(0.01, std::hypot(box.sizes().x(), box.sizes().y()));
+  // A thin stand in the backdrop's colour, as the photos' support was (check warns that the
+  // object overhangs it): a table as wide as the object showed as a dark disc in every view.
+  t.table_diameter_m = std::max(0.01, 0.2 * std::min(box.sizes().x(), box.sizes().y()));
   t.camera = photos.front().camera;
   Vec3 towards = Vec3::Zero();
   double distance = 0;
