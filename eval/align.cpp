@@ -78,8 +78,6 @@ double rotation_angle_deg(const Eigen::Matrix3d& r) {
   return std::acos(c) * 180 / M_PI;
 }
 
-namespace {
-
 ViewCamera view_camera(const run::ColmapCamera& cam, const Mat4& camera_from_world) {
   ViewCamera v;
   v.camera_from_world = camera_from_world;
@@ -98,6 +96,8 @@ ViewCamera view_camera(const run::ColmapCamera& cam, const Mat4& camera_from_wor
   }
   return v;
 }
+
+namespace {
 
 json similarity_json(const Similarity& s) {
   json m = json::array();

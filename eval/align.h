@@ -60,6 +60,10 @@ std::vector<Vec3> points_inside(const std::vector<Vec3>& points, const Eigen::Al
                                 std::size_t limit = std::numeric_limits<std::size_t>::max(),
                                 std::vector<std::size_t>* indices = nullptr);
 
+// A COLMAP camera's pinhole at a pose: f, cx, cy of the one-focal models (SIMPLE_PINHOLE,
+// SIMPLE_RADIAL, RADIAL), fx, fy, cx, cy of the others; distortion left out.
+ViewCamera view_camera(const run::ColmapCamera& camera, const Mat4& camera_from_world);
+
 // Where a camera of pose camera_from_world is, in the world.
 Vec3 camera_centre(const Mat4& camera_from_world);
 double rotation_angle_deg(const Eigen::Matrix3d& r);

@@ -158,6 +158,13 @@ std::vector<std::pair<int, int>> sequential_ring_pairs(int n, int overlap) {
   return pairs;
 }
 
+const run::ColmapCamera* SparseModel::camera_of(const run::ColmapImage& image) const {
+  const auto it = std::find_if(cameras.begin(), cameras.end(), [&](const run::ColmapCamera& c) {
+    return c.camera_id == image.camera_id;
+  });
+  return it == cameras.end() ? nullptr : &*it;
+}
+
 double SparseModel::mean_track_length() const {
   if (points.empty()) return 0;
   double sum = 0;

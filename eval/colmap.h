@@ -71,6 +71,8 @@ struct SparseModel {
   std::vector<run::ColmapCamera> cameras;
   std::vector<run::ColmapImage> images;
   std::vector<Point3D> points;
+  // The camera `image` was taken with, or null when the model has no camera of its id.
+  const run::ColmapCamera* camera_of(const run::ColmapImage& image) const;
   double mean_track_length() const;
   double mean_reprojection_error() const;  // over observations, like COLMAP's own report
 };

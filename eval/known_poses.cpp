@@ -6,6 +6,7 @@
 #include <chrono>
 #include <map>
 
+#include "eval/align.h"
 #include "eval/colmap_database.h"
 #include "io/atomic_file.h"
 
@@ -29,14 +30,10 @@ std::string cameras_text(const DatabaseContents& db, const KnownCameras& referen
       *error = fmt::format("{} has no reference camera with intrinsics", im.name);
       return {};
     }
-    const run::ColmapCamera& k = *ref->second.intrinsics;
     const auto [w, h] = size[im.camera_id];
-    // A shared focal length (SIMPLE_*, RADIAL) is f, f; the principal point follows it.
-    const bool one_focal = k.model.rfind("SIMPLE_", 0) == 0 || k.model == "RADIAL";
-    const double fx = k.params[0], fy = one_focal ? k.params[0] : k.params[1];
-    const double cx = k.params[one_focal ? 1 : 2], cy = k.params[one_focal ? 2 : 3];
+    const ViewCamera k = view_camera(*ref->second.intrinsics, ir::Mat4::Identity());
     lines[im.camera_id] = fmt::format("{} PINHOLE {} {} {:.17g} {:.17g} {:.17g} {:.17g}\n",
-                                      im.camera_id, w, h, fx, fy, cx, cy);
+                                      im.camera_id, w, h, k.fx, k.fy, k.cx, k.cy);
   }
   std::string text = "# The reference cameras' intrinsics (rigc eval --reference-cameras)\n";
   for (const auto& [id, line] : lines) text += line;

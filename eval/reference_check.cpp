@@ -21,13 +21,9 @@ void report_pose_accuracy(const EvalOptions& o, const EvalInputs& in, const Spar
                           EvalReport& report, std::ostream& log) {
   std::map<std::string, Mat4> estimated;
   std::map<std::string, run::ColmapCamera> intrinsics;
-  std::map<int, const run::ColmapCamera*> camera_by_id;
-  for (const auto& c : model.cameras) camera_by_id[c.camera_id] = &c;
   for (const auto& im : model.images) {
     estimated[im.name] = im.camera_from_world;
-    if (const auto c = camera_by_id.find(im.camera_id); c != camera_by_id.end()) {
-      intrinsics[im.name] = *c->second;
-    }
+    if (const run::ColmapCamera* c = model.camera_of(im)) intrinsics[im.name] = *c;
   }
   const PoseAccuracy acc =
       measure_pose_accuracy(in.images.names, in.reference, estimated, intrinsics);

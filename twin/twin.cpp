@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "assets/mesh_io.h"
+#include "eval/align.h"
 #include "eval/colmap.h"
 #include "eval/eval.h"
 #include "eval/inputs.h"
@@ -53,19 +54,16 @@ bool check_options(const TwinOptions& o, std::string* error) {
   return false;
 }
 
+// The camera's pinhole at the photo's size (a calibration may be of another size).
 eval::ViewCamera view_of(const eval::KnownCamera& known, int width, int height) {
-  eval::ViewCamera c;
-  c.camera_from_world = known.camera_from_world;
+  eval::ViewCamera c = eval::view_camera(*known.intrinsics, known.camera_from_world);
+  const double scale = c.width > 0 ? static_cast<double>(width) / c.width : 1;
   c.width = width;
   c.height = height;
-  const auto& k = known.intrinsics->params;
-  const bool one_focal =
-      known.intrinsics->model.rfind("SIMPLE_", 0) == 0 || known.intrinsics->model == "RADIAL";
-  const double scale = known.intrinsics->width > 0 ? double(width) / known.intrinsics->width : 1;
-  c.fx = scale * k[0];
-  c.fy = scale * (one_focal ? k[0] : k[1]);
-  c.cx = scale * k[one_focal ? 1 : 2];
-  c.cy = scale * k[one_focal ? 2 : 3];
+  c.fx *= scale;
+  c.fy *= scale;
+  c.cx *= scale;
+  c.cy *= scale;
   return c;
 }
 
@@ -110,11 +108,11 @@ std::optional<std::vector<std::pair<std::string, eval::ViewCamera>>> capture_cam
     *exit_code = kToolError;
     return std::nullopt;
   }
-  std::map<int, const run::ColmapCamera*> by_id;
-  for (const auto& c : model->cameras) by_id[c.camera_id] = &c;
   std::map<std::string, eval::ViewCamera> by_name;
   for (const auto& im : model->images) {
-    eval::KnownCamera known{im.camera_from_world, *by_id.at(im.camera_id)};
+    const run::ColmapCamera* camera = model->camera_of(im);
+    if (!camera) continue;  // none: read_sparse_model has checked the ids
+    eval::KnownCamera known{im.camera_from_world, *camera};
     const auto [w, h] = in.images.size.at(im.name);
     by_name[im.name] = view_of(known, w, h);
   }
