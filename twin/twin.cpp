@@ -208,8 +208,9 @@ json vec_json(const Vec3& v) {
   return {v.x(), v.y(), v.z()};
 }
 
-// The twin's scene: hull and cameras in the object frame, the studio guessed.
-TwinScene twin_scene(const TwinOptions& o, const VisualHull& hull,
+// The twin's scene: the hull (its bounds in the object frame) and the cameras moved there, the
+// studio guessed.
+TwinScene twin_scene(const TwinOptions& o, const Eigen::AlignedBox3d& box,
                      const std::vector<CapturedPhoto>& photos, const eval::Similarity& to_object) {
   TwinScene t;
   t.name = fs::path(o.photos_dir).filename().string() + "-twin";
@@ -219,8 +220,6 @@ TwinScene twin_scene(const TwinOptions& o, const VisualHull& hull,
                  : fmt::format("the photos in {} and the cameras of {}", o.photos_dir,
                                o.reference_cameras);
   t.mesh_file = "object.ply";
-  Eigen::AlignedBox3d box;
-  for (const auto& p : hull.positions) box.extend(p.cast<double>());
   t.object_size = box.sizes();
   t.backdrop_linear = backdrop_color(photos);
   // A thin stand in the backdrop's colour, as the photos' support was (check warns that the
@@ -301,24 +300,29 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   std::vector<eval::ViewCamera> view_cameras;
   for (const auto& p : *photos) view_cameras.push_back(p.camera);
   const Vec3 up = up_of_cameras(view_cameras, hull->region.center());
-  double scale = 1;
-  if (o.object_height_m) {
-    const eval::Similarity turn = object_from_capture(up, hull->positions, 1);
-    Eigen::AlignedBox3d box;
-    for (const auto& p : hull->positions) box.extend(turn.apply(p.cast<double>()));
-    scale = *o.object_height_m / box.sizes().z();
+  eval::Similarity to_object = object_from_capture(up, hull->positions);
+  VisualHull placed = *hull;
+  for (auto& p : placed.positions) p = to_object.apply(p.cast<double>()).cast<float>();
+  Eigen::AlignedBox3d box;
+  for (const auto& p : placed.positions) box.extend(p.cast<double>());
+  // A registration's scale from the object's height; resting on z = 0 and centred, the placed
+  // hull scales about the origin.
+  const double scale = o.object_height_m ? *o.object_height_m / box.sizes().z() : 1;
+  if (scale != 1) {
+    eval::Similarity scaling;
+    scaling.scale = scale;
+    to_object = scaling * to_object;
+    for (auto& p : placed.positions) p *= static_cast<float>(scale);
+    box = Eigen::AlignedBox3d(scale * box.min(), scale * box.max());
+    placed.voxel_m *= scale;
   }
-  const eval::Similarity to_object = object_from_capture(up, hull->positions, scale);
   std::vector<ColorPhoto> color_photos;
   for (const auto& p : *photos) color_photos.push_back({p.camera, p.linear});
   const auto colors = color_vertices(*hull, color_photos);
-  VisualHull placed = *hull;
-  for (auto& p : placed.positions) p = to_object.apply(p.cast<double>()).cast<float>();
-  placed.voxel_m *= scale;
   if (!write_twin_mesh(placed, colors, out / "object.ply", &error)) {
     return fail(log, kToolError, error);
   }
-  TwinScene scene = twin_scene(o, placed, *photos, to_object);
+  TwinScene scene = twin_scene(o, box, *photos, to_object);
   const fs::path scene_path = out / "scene.yaml";
   if (!write_file_atomically(scene_path, scene_yaml(scene), &error)) {
     return fail(log, kToolError, error);
@@ -355,8 +359,6 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
     ring.name += fmt::format("-ring-{}", o.ring_views);
     std::vector<eval::ViewCamera> real;
     for (const auto& [name, camera] : scene.shots) real.push_back(camera);
-    Eigen::AlignedBox3d box;
-    for (const auto& p : placed.positions) box.extend(p.cast<double>());
     ring.shots.clear();
     const auto views = ring_views(real, box.center(), o.ring_views);
     for (std::size_t k = 0; k < views.size(); ++k) {

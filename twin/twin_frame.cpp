@@ -30,14 +30,12 @@ Vec3 up_of_cameras(const std::vector<eval::ViewCamera>& cameras, const Vec3& obj
   return (mean_centre - object_centre).dot(normal) >= 0 ? normal : Vec3(-normal);
 }
 
-eval::Similarity object_from_capture(const Vec3& up, const std::vector<Eigen::Vector3f>& points,
-                                     double scale) {
+eval::Similarity object_from_capture(const Vec3& up, const std::vector<Eigen::Vector3f>& points) {
   eval::Similarity s;
-  s.scale = scale;
   s.rotation =
       Eigen::Quaterniond::FromTwoVectors(up.normalized(), Vec3::UnitZ()).toRotationMatrix();
   Eigen::AlignedBox3d turned;
-  for (const auto& p : points) turned.extend(scale * (s.rotation * p.cast<double>()));
+  for (const auto& p : points) turned.extend(s.rotation * p.cast<double>());
   s.translation = Vec3(-turned.center().x(), -turned.center().y(), -turned.min().z());
   return s;
 }

@@ -18,10 +18,10 @@ namespace rigc::twin {
 Eigen::Vector3d up_of_cameras(const std::vector<eval::ViewCamera>& cameras,
                               const Eigen::Vector3d& object_centre);
 
-// x -> scale * R * x + t taking the capture's frame to the object frame: `up` to +Z, the turned,
-// scaled `points` (the hull's vertices) centred over the origin with their lowest at z = 0.
+// x -> R * x + t taking the capture's frame to the object frame: `up` to +Z, the turned
+// `points` (the hull's vertices) centred over the origin with their lowest at z = 0.
 eval::Similarity object_from_capture(const Eigen::Vector3d& up,
-                                     const std::vector<Eigen::Vector3f>& points, double scale);
+                                     const std::vector<Eigen::Vector3f>& points);
 
 // A camera of the capture, seen from the object frame.
 eval::ViewCamera in_object_frame(const eval::ViewCamera& camera,
