@@ -57,9 +57,9 @@ enum class BrightBackdrop { kDark, kBright };
 // when they are brighter than four fifths; nullopt otherwise.
 std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& image);
 
-// 255 where a pixel's luminance is on the object's side of a threshold halfway from the one that
-// best splits the image's histogram in two (Otsu's) towards the backdrop, 0 where it is the
-// backdrop's.
+// 255 where a pixel's luminance is on the object's side of a threshold a fifth of the way from
+// the one that best splits the image's histogram in two (Otsu's) towards the backdrop, 0 where
+// it is the backdrop's.
 std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop backdrop);
 
 // Removes the object pixels of the components that touch the image's border: with a brightness
