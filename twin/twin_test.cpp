@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "eval/camera_files.h"
 #include "run/colmap_text.h"
 #include "tests/test_support.h"
 #include "twin/twin_render.h"
@@ -82,6 +83,21 @@ TEST(TwinTemple, TheTwinIsASceneLikeAnyOther) {
   const auto truth = run::read_colmap_images(dir / "render" / "sparse" / "images.txt", &error);
   ASSERT_TRUE(truth) << error;
   ASSERT_EQ(truth->size(), 16u);
+  const auto calibration =
+      eval::read_camera_file(source_path(kTemple + "/templeSR_par.txt"), &error);
+  ASSERT_TRUE(calibration) << error;
+  // The shots are the photos in name order: shot_000 is templeSR0001.png.
+  std::map<std::string, ir::Mat4> shot_pose;
+  for (const auto& im : *truth) shot_pose[im.name] = im.camera_from_world;
+  std::optional<Eigen::Matrix3d> world_turn;  // object frame -> calibration frame
+  for (std::size_t k = 0; k < calibration->images.size(); ++k) {
+    const Eigen::Matrix3d real = calibration->images[k].camera_from_world.topLeftCorner<3, 3>();
+    const Eigen::Matrix3d twin =
+        shot_pose.at(fmt::format("shot_{:03d}.jpg", k)).topLeftCorner<3, 3>();
+    const Eigen::Matrix3d turn = real.transpose() * twin;
+    if (!world_turn) world_turn = turn;
+    EXPECT_LT((turn - *world_turn).cwiseAbs().maxCoeff(), 1e-6) << "shot " << k;
+  }
 }
 
 TEST(TwinCommand, BadInputsAreClearErrors) {
