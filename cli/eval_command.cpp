@@ -56,8 +56,9 @@ void add_eval_options(CLI::App& app, eval::EvalOptions& o) {
       ->check(CLI::Range(1.0, 180.0))
       ->capture_default_str();
   app.add_flag("!--no-masks", o.use_masks, "ignore the run's masks/ (object masks)");
-  app.add_flag("--refine-intrinsics", o.refine_intrinsics,
-               "let COLMAP refine the run's known camera (default: keep it fixed)");
+  app.add_flag(
+      "--refine-intrinsics", o.refine_intrinsics,
+      "let COLMAP refine the known camera, the run's or a photo body's (default: keep it fixed)");
   app.add_flag("--reuse-colmap", o.reuse_colmap,
                "reuse the COLMAP model already in the output folder");
   app.add_flag("!--no-icp", o.icp, "skip the ICP refinement after the camera alignment");

@@ -437,7 +437,8 @@ class ColmapPipeline {
     r_.prior["cameras"].push_back(entry);
     r_.prior["refined_by_colmap"] = photo_focal_unknown_ || o_.refine_intrinsics
                                         ? "focal length and k1"
-                                        : "k1 (the focal length from the sensor is kept)";
+                                        : "nothing (the focal length from the sensor is kept, "
+                                          "k1 held at 0; --refine-intrinsics refines both)";
   }
 
   // The intrinsics prior: the run's ground-truth camera (exact), else COLMAP reads EXIF.
@@ -588,8 +589,10 @@ class ColmapPipeline {
                  "--Mapper.min_model_size", "3"};
     if (photos_ && !photo_focal_unknown_ && !o_.refine_intrinsics) {
       // Focal lengths from the bodies' sensors: refining them from a turntable's narrow views
-      // is ill-conditioned; the lens's k1 is unknown and refined.
-      argv.insert(argv.end(), {"--Mapper.ba_refine_focal_length", "0"});
+      // is ill-conditioned. So is k1 for a small object near the frame's centre: refined, it
+      // drifts, and the mapper restarts from pair after pair and can register nothing.
+      argv.insert(argv.end(),
+                  {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_extra_params", "0"});
     }
     if (exact_prior_ && !o_.refine_intrinsics) {
       // A known camera: refining focal length and distortion from two narrow-angle views of a
