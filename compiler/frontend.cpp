@@ -4,14 +4,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <filesystem>
-#include <fstream>
 #include <tuple>
 
 #include "compiler/check.h"
 #include "compiler/limits.h"
-#include "io/file_status.h"
+#include "io/bounded_file.h"
 
 namespace rigc {
 
@@ -37,24 +35,18 @@ std::optional<ir::Scene> compile_scene_text(const std::string& text, const std::
 }
 
 std::optional<std::string> read_scene_file(const std::string& path, DiagnosticEngine& diag) {
-  if (const std::string why = why_not_readable(path); !why.empty()) {
-    diag.error({path, 0, 0}, fmt::format("cannot read the scene file: it {}", why));
+  std::string why;
+  auto file = read_bounded_file(path, limits::kMostSceneFileBytes, &why);
+  if (!file) {
+    diag.error({path, 0, 0},
+               why.starts_with("is larger")
+                   ? fmt::format("the scene file {} (a scene is text; meshes and textures are "
+                                 "files of their own)",
+                                 why)
+                   : fmt::format("cannot read the scene file: it {}", why));
     return std::nullopt;
   }
-  std::ifstream in(path, std::ios::binary);
-  // Read in chunks up to the limit, so that /dev/zero as the scene file cannot exhaust memory.
-  std::string text;
-  std::array<char, 1 << 16> chunk;
-  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-    if (text.size() > limits::kMostSceneFileBytes) {
-      diag.error({path, 0, 0}, fmt::format("the scene file is larger than {} MB (a scene is text; "
-                                           "meshes and textures are files of their own)",
-                                           limits::kMostSceneFileBytes >> 20));
-      return std::nullopt;
-    }
-  }
-  return text;
+  return std::move(file->bytes);
 }
 
 std::optional<ir::Scene> compile_scene_file(const std::string& path, DiagnosticEngine& diag) {
