@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 
 #include "compiler/yaml_text.h"
@@ -140,9 +141,36 @@ bool is_safe_value_text(const std::string& value) {
   return value.front() != '-' || (value.size() > 1 && value[1] != ' ');
 }
 
+bool is_safe_key_text(const std::string& key) {
+  if (key.empty() || key.size() > 64) return false;
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  const auto word = [&](char c) { return (c >= 'a' && c <= 'z') || c == '_' || digit(c); };
+  if (std::all_of(key.begin(), key.end(), digit)) return true;
+  return !digit(key.front()) && std::all_of(key.begin(), key.end(), word);
+}
+
+namespace {
+
+// Empty when every key of `path` is is_safe_key_text, else the message naming the first that
+// is not.
+std::string bad_key_in(const ScenePath& path) {
+  for (const auto& key : path) {
+    if (is_safe_key_text(key)) continue;
+    std::string shown = key.substr(0, 64);
+    for (char& c : shown) {
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    }
+    return "'" + shown + "' is not a scene key (lowercase letters, digits and underscores)";
+  }
+  return "";
+}
+
+}  // namespace
+
 std::optional<std::string> set_value(const std::string& text, const ScenePath& path,
                                      const std::string& value, std::string* error) {
   if (!is_safe_value_text(value)) return *error = "'" + value + "' is not a value", std::nullopt;
+  if (std::string bad = bad_key_in(path); !bad.empty()) return *error = bad, std::nullopt;
   const auto root = load(text, error);
   if (!root) return std::nullopt;
   YAML::Node node = *root;
@@ -172,6 +200,7 @@ namespace {
 
 std::optional<YAML::Node> find_list(const std::string& text, const ScenePath& path,
                                     std::string* error) {
+  if (std::string bad = bad_key_in(path); !bad.empty()) return *error = bad, std::nullopt;
   auto root = load(text, error);
   if (!root) return std::nullopt;
   YAML::Node node = *root;

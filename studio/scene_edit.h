@@ -16,10 +16,15 @@ using ScenePath = std::vector<std::string>;
 // plain scalars, on one line, with no character that could start other YAML structure.
 bool is_safe_value_text(const std::string& value);
 
+// Whether `key` is one step of a ScenePath: a scene-language key (lowercase letters, digits and
+// underscores, starting with a letter or underscore, at most 64) or a list index (digits).
+bool is_safe_key_text(const std::string& key);
+
 // `text` with the value at `path` replaced by `value` (is_safe_value_text). A missing key is
 // added to the deepest map that exists (in its style: a flow map gets `, key: value`, a block map
 // a new line at its keys' indentation). Nullopt with `error` when the text does not parse, the
-// path crosses something that is not a map or list, or the value is a block collection.
+// path crosses something that is not a map or list, a key is not is_safe_key_text, or the value
+// is a block collection.
 std::optional<std::string> set_value(const std::string& text, const ScenePath& path,
                                      const std::string& value, std::string* error);
 

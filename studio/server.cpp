@@ -44,9 +44,22 @@ void send_outcome(httplib::Response& res, const Outcome& outcome) {
   }
 }
 
-// The request's body as a JSON object; nullopt after a 400 when it is not one.
+// The request's body as a JSON object; nullopt after a 400 when it is not one. The parser is
+// iterative, but copying or destroying a value recurses: a body nested deeper than any request
+// needs is refused while it is parsed, before a value of that depth exists.
 std::optional<nlohmann::json> json_body(const httplib::Request& req, httplib::Response& res) {
-  nlohmann::json body = nlohmann::json::parse(req.body, nullptr, false);
+  constexpr int kMostDepth = 16;
+  bool too_deep = false;
+  const nlohmann::json::parser_callback_t within_depth =
+      [&too_deep](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+        too_deep = too_deep || depth > kMostDepth;
+        return !too_deep;
+      };
+  nlohmann::json body = nlohmann::json::parse(req.body, within_depth, false);
+  if (too_deep) {
+    send_error(res, 400, fmt::format("the request's body nests deeper than {} levels", kMostDepth));
+    return std::nullopt;
+  }
   if (body.is_discarded() || !body.is_object()) {
     send_error(res, 400, "the request's body is not a JSON object");
     return std::nullopt;
