@@ -1,8 +1,10 @@
 // The studio's HTTP API, through a real server on an ephemeral port and httplib's client.
 #include "studio/server.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fstream>
@@ -17,6 +19,8 @@
 
 namespace rigc::studio {
 namespace {
+
+using ::testing::HasSubstr;
 
 std::string read(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -299,6 +303,82 @@ TEST_F(StudioApi, BadRequestsGetA4xxAndTheServerStaysUp) {
   EXPECT_EQ(client_->Get("/api/frame?width=200&draft=yes")->status, 400);
   EXPECT_EQ(client_->Get("/api/nothing")->status, 404);
   EXPECT_EQ(client_->Get("/api/state")->status, 200);
+}
+
+// A body nested far deeper than any request is refused while it is parsed: copying such a value
+// recursed until the stack overflowed, and the unsaved edits went with the process.
+TEST_F(StudioApi, ADeeplyNestedBodyIsRefusedAndTheServerStaysUp) {
+  const std::string deep = std::string(60000, '[') + std::string(60000, ']');
+  for (const char* route : {"/api/set", "/api/view", "/api/reference", "/api/lights/add"}) {
+    const auto res = client_->Post(route, "{\"path\": " + deep + "}", "application/json");
+    ASSERT_TRUE(res) << route;
+    EXPECT_EQ(res->status, 400) << route;
+    EXPECT_THAT(res->body, HasSubstr("nests deeper than")) << route;
+  }
+  EXPECT_EQ(client_->Get("/api/state")->status, 200);
+}
+
+// Keys are checked like values: a key with a newline or YAML's punctuation would write a section
+// of its own into the scene.
+TEST_F(StudioApi, APathKeyThatIsNotASceneKeyIsRefused) {
+  for (const char* path : {"camera.body\ncoverage", "camera.exposure.iso: 3\ncoverage",
+                           "studio.{lights}", "camera..iso", "camera.Exposure"}) {
+    const auto res = post("/api/set", {{"path", path}, {"value", "400"}});
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 422) << path;
+    EXPECT_THAT(res->body, HasSubstr("is not a scene key")) << path;
+  }
+  EXPECT_FALSE(state()["unsaved"].get<bool>());
+}
+
+// Save replaces the file the studio opened and read, and nothing else: not a file a symbolic link
+// put in its place leads to, nor edits made on disk since the last read.
+TEST_F(StudioApi, SaveRefusesALinkPutInTheScenesPlaceAndEditsMadeOnDisk) {
+  const std::filesystem::path elsewhere = dir_.path() / "elsewhere.txt";
+  std::ofstream(elsewhere) << "not a scene\n";
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.iso"}, {"value", "400"}})->status, 200);
+  std::filesystem::remove(scene_file_);
+  std::filesystem::create_symlink(elsewhere, scene_file_);
+  auto res = post("/api/save", {});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 422);
+  EXPECT_THAT(res->body, HasSubstr("not to the file the studio opened"));
+  EXPECT_EQ(read(elsewhere), "not a scene\n");
+
+  std::filesystem::remove(scene_file_);
+  std::string edited = kStudioTestScene;
+  edited.replace(edited.find("iso: 200"), 8, "iso: 800");
+  std::ofstream(scene_file_) << edited;  // between two polls of the page
+  res = post("/api/save", {});
+  EXPECT_EQ(res->status, 422);
+  EXPECT_THAT(res->body, HasSubstr("changed on disk since the studio read it (line"));
+  EXPECT_THAT(res->body, HasSubstr("iso: 800"));
+  EXPECT_EQ(read(scene_file_), edited);
+  // Once the studio has read it (the page's next poll), Save writes the studio's scene.
+  EXPECT_DOUBLE_EQ(state()["camera"]["iso"].get<double>(), 800);
+  ASSERT_EQ(post("/api/set", {{"path", "camera.exposure.iso"}, {"value", "400"}})->status, 200);
+  EXPECT_EQ(post("/api/save", {})->status, 200);
+  EXPECT_THAT(read(scene_file_), HasSubstr("iso: 400"));
+}
+
+// A pipe, a folder or a file past the scene limit in the scene's place is named in the state,
+// at once: the studio neither waits on the pipe nor reads the file, and keeps the last good scene.
+TEST_F(StudioApi, APipeAFolderOrAHugeFileInTheScenesPlaceIsNamedAndTheSceneKept) {
+  std::filesystem::remove(scene_file_);
+  ASSERT_EQ(::mkfifo(scene_file_.c_str(), 0600), 0);
+  nlohmann::json s = state();
+  EXPECT_THAT(s["file_error"].get<std::string>(), HasSubstr("is not a regular file"));
+  EXPECT_EQ(s["name"], "studio-test");
+  EXPECT_EQ(post("/api/save", {})->status, 422);
+  std::filesystem::remove(scene_file_);
+  std::filesystem::create_directory(scene_file_);
+  EXPECT_THAT(state()["file_error"].get<std::string>(), HasSubstr("is a folder"));
+  std::filesystem::remove(scene_file_);
+  std::ofstream(scene_file_) << kStudioTestScene << std::string(17 << 20, '#');
+  EXPECT_THAT(state()["file_error"].get<std::string>(), HasSubstr("is larger than 16 MB"));
+  std::ofstream(scene_file_) << kStudioTestScene;
+  EXPECT_EQ(state()["file_error"], "");
+  EXPECT_EQ(client_->Get("/api/frame?width=200")->status, 200);
 }
 
 // Listening on every interface, the server answers to the machine's own names and addresses.

@@ -15,9 +15,12 @@
 #include "backends/preview/preview_backend.h"
 #include "compiler/diagnostics.h"
 #include "compiler/frontend.h"
+#include "compiler/limits.h"
 #include "compiler/presets.h"
 #include "dslr/lens.h"
 #include "io/atomic_file.h"
+#include "io/bounded_file.h"
+#include "io/file_status.h"
 #include "plan/plan_scene.h"
 #include "plan/scene_text.h"
 #include "raster/shadow_map_cache.h"
@@ -86,7 +89,9 @@ std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* 
                                        fs::path run_folder) {
   std::unique_ptr<Session> session(new Session());
   session->file_ = scene_file;
-  session->disk_text_ = session->read_disk(error);
+  session->disk_text_ = session->read_disk(error, &session->disk_identity_);
+  if (!error->empty()) return nullptr;
+  session->opened_target_ = file_to_replace(scene_file, error);
   if (!error->empty()) return nullptr;
   const Outcome outcome = session->apply_text(session->disk_text_, Change::kAnything);
   if (!outcome.ok) {
@@ -126,16 +131,44 @@ Outcome Session::start_reference(const ReferenceRequest& request) {
   return {};
 }
 
-std::string Session::read_disk(std::string* error) const {
-  std::ifstream in(file_, std::ios::binary);
-  if (!in) {
-    *error = fmt::format("rigc: error: cannot read {}\n", file_.string());
+std::string Session::read_disk(std::string* error, FileIdentity* identity) const {
+  std::string why;
+  auto file = read_bounded_file(file_, limits::kMostSceneFileBytes, &why);
+  if (!file) {
+    *error = fmt::format("rigc: error: cannot read {}: it {}\n", file_.string(), why);
     return {};
   }
-  std::ostringstream text;
-  text << in.rdbuf();
   error->clear();
-  return text.str();
+  *identity = file->identity;
+  return std::move(file->bytes);
+}
+
+// Empty when file_ still leads to the file the session opened, that file is the one read or saved
+// last and it holds what was read: otherwise why Save must not replace it.
+std::string Session::changed_on_disk() const {
+  std::string error;
+  const fs::path target = file_to_replace(file_, &error);
+  if (!error.empty()) return error;
+  if (target != opened_target_) {
+    return fmt::format("{} now leads to {}, not to the file the studio opened ({})", file_.string(),
+                       target.string(), opened_target_.string());
+  }
+  if (names_nothing(target)) return "";  // deleted since: Save writes it anew
+  FileIdentity identity;
+  const std::string now = read_disk(&error, &identity);
+  if (!error.empty()) return error;
+  if (identity == disk_identity_ && now == disk_text_) return "";
+  std::size_t line = 1, at = 0;
+  while (at < now.size() && at < disk_text_.size() && now[at] == disk_text_[at]) {
+    if (now[at++] == '\n') ++line;
+  }
+  const std::size_t start = now.rfind('\n', at == 0 ? 0 : at - 1);
+  const std::size_t from = start == std::string::npos || at == 0 ? 0 : start + 1;
+  const std::string now_line = now.substr(from, now.find('\n', from) - from);
+  return fmt::format(
+      "{} changed on disk since the studio read it (line {} now reads '{}'); the studio "
+      "loads it on its next poll, then Save writes your changes over it",
+      file_.string(), line, now_line.substr(0, 80));
 }
 
 // Compiles `text`; when it compiles it becomes the session's scene, otherwise the last good
@@ -325,9 +358,14 @@ Outcome Session::save() {
   std::lock_guard lock(mutex_);
   const Compiled compiled = compile_text(text_, file_);
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
+  if (const std::string changed = changed_on_disk(); !changed.empty()) {
+    return Outcome::fail("rigc: error: not saved: " + changed);
+  }
   std::string error;
   if (!write_file_atomically(file_, text_, &error)) return Outcome::fail("rigc: error: " + error);
   disk_text_ = text_;
+  if (const auto identity = identity_of(file_)) disk_identity_ = *identity;
+  disk_error_.clear();
   file_error_.clear();
   return {};
 }
@@ -335,8 +373,13 @@ Outcome Session::save() {
 void Session::reload_if_changed() {
   std::lock_guard lock(mutex_);
   std::string error;
-  const std::string text = read_disk(&error);
-  if (!error.empty() || text == disk_text_) return;
+  FileIdentity identity;
+  const std::string text = read_disk(&error, &identity);
+  if (error != disk_error_) ++revision_;
+  disk_error_ = error;
+  if (!error.empty()) return;
+  disk_identity_ = identity;
+  if (text == disk_text_) return;
   disk_text_ = text;
   const std::string before = text_;
   const Outcome outcome = apply_text(text, Change::kAnything);
@@ -408,7 +451,7 @@ nlohmann::json Session::state() {
   return {{"file", file_.filename().string()},
           {"name", scene.name},
           {"unsaved", text_ != disk_text_},
-          {"file_error", file_error_},
+          {"file_error", disk_error_.empty() ? file_error_ : disk_error_},
           {"captures", captures_},
           {"revision", revision_},
           {"reloads", reloads_},

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/coverage.h"
+#include "io/bounded_file.h"
 #include "ir/ir.h"
 #include "raster/shadow_map_cache.h"
 #include "run/backend.h"
@@ -140,7 +141,8 @@ class Session {
   static ir::Shot as_view_shot(ir::Shot shot);
   std::shared_ptr<const ir::Scene> view_scene();
   std::string view_pose_text(const View& view) const;
-  std::string read_disk(std::string* error) const;
+  std::string read_disk(std::string* error, FileIdentity* identity) const;
+  std::string changed_on_disk() const;
   nlohmann::json coverage_json(const ir::Scene& scene,
                                const analysis::CoverageResult& coverage) const;
   std::string text_snapshot(const std::shared_ptr<const ir::Scene>& scene);
@@ -162,7 +164,12 @@ class Session {
   std::mutex render_mutex_, analysis_mutex_, coverage_mutex_;
   std::filesystem::path file_;
   std::string disk_text_;  // the file as last read or saved
-  std::string text_;       // the scene as the user changed it
+  // The file read or saved last, and the one file_ led to when the session opened (through a
+  // symbolic link, if file_ is one): Save replaces that file and no other.
+  FileIdentity disk_identity_;
+  std::filesystem::path opened_target_;
+  std::string disk_error_;  // why the file could not be read at the last poll
+  std::string text_;        // the scene as the user changed it
   struct UndoEntry {
     std::string text;
     Change change;
