@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 
+#include "studio/deadline_server.h"
 #include "studio/page_files.h"
 
 namespace rigc::studio {
@@ -130,7 +131,9 @@ std::string random_token() {
 }
 
 StudioServer::StudioServer(Session& session, ServerOptions options)
-    : session_(session), options_(std::move(options)), server_(new httplib::Server()) {
+    : session_(session),
+      options_(std::move(options)),
+      server_(new DeadlineServer(options_.request_deadline, options_.workers)) {
   if (options_.token.empty()) options_.token = random_token();
   server_->set_payload_max_length(1 << 20);
   server_->set_tcp_nodelay(true);

@@ -3,6 +3,7 @@
 // X-Rigc-Token); a Host or Origin header naming another host is refused (DNS rebinding).
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <string>
 
@@ -18,6 +19,10 @@ struct ServerOptions {
   std::string host = "127.0.0.1";
   int port = 0;       // 0: any free port
   std::string token;  // empty: a random one
+  // A request (line, headers and body) must arrive within this; connections are served by
+  // `workers` threads.
+  std::chrono::milliseconds request_deadline{10000};
+  int workers = 32;
 };
 
 // 32 hex digits from the system's random source.

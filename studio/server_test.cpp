@@ -1,9 +1,12 @@
 // The studio's HTTP API, through a real server on an ephemeral port and httplib's client.
 #include "studio/server.h"
 
+#include <arpa/inet.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -408,6 +411,71 @@ TEST(StudioServerHosts, OnEveryInterfaceTheMachinesOwnNamesAreAccepted) {
   EXPECT_EQ(client.Get("/api/state", {{"Host", "0.0.0.0" + suffix}})->status, 403);
   server.stop();
   thread.join();
+}
+
+// Connects to 127.0.0.1:port; -1 when it cannot.
+int connect_to(int port) {
+  const int sock = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(sock, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+    ::close(sock);
+    return -1;
+  }
+  return sock;
+}
+
+// Slow clients, more than there are workers, each sending its request's header a byte at a
+// time: the server closes each when its request is late, and answers a quick client meanwhile.
+TEST(StudioServerDeadline, ClientsTricklingTheirHeadersAreClosedAndOthersServed) {
+  testing::TempDir dir;
+  const auto scene_file = dir.path() / "scene.yaml";
+  std::ofstream(scene_file) << kStudioTestScene;
+  std::string error;
+  const auto session = Session::open(scene_file, &error, dir.path() / "run");
+  ASSERT_TRUE(session) << error;
+  ServerOptions options;
+  options.request_deadline = std::chrono::milliseconds(500);
+  options.workers = 4;
+  StudioServer server(*session, options);
+  const int port = server.bind(&error);
+  ASSERT_GT(port, 0) << error;
+  std::thread serving([&] { server.run(); });
+  while (!server.is_running()) std::this_thread::yield();
+
+  const std::string request = "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                              "\r\nX-Rigc-Token: " + server.token() + "\r\n\r\n";
+  constexpr int kSlowClients = 8;  // twice the workers
+  std::vector<std::size_t> sent(kSlowClients, 0);
+  std::vector<std::thread> slow;
+  for (int c = 0; c < kSlowClients; ++c) {
+    slow.emplace_back([&, c] {
+      const int sock = connect_to(port);
+      if (sock < 0) return;
+      // One byte every 100 ms: the whole header would take over 10 s.
+      for (; sent[c] < request.size(); ++sent[c]) {
+        if (::send(sock, &request[sent[c]], 1, MSG_NOSIGNAL) != 1) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        char byte;
+        if (::recv(sock, &byte, 1, MSG_DONTWAIT) == 0) break;  // closed by the server
+      }
+      ::close(sock);
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  httplib::Client quick("127.0.0.1", port);
+  quick.set_default_headers({{"X-Rigc-Token", server.token()}});
+  const auto res = quick.Get("/api/state");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  for (auto& t : slow) t.join();
+  for (int c = 0; c < kSlowClients; ++c) {
+    EXPECT_LT(sent[c], request.size()) << "slow client " << c << " sent its whole request";
+  }
+  server.stop();
+  serving.join();
 }
 
 TEST_F(StudioApi, LightsAreAddedChangedAndRemoved) {
