@@ -2,6 +2,7 @@
 // written, outputs named like its inputs, run folders holding other runs.
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -20,6 +21,7 @@ namespace rigc {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::HasSubstr;
 using testing::read_text;
 using testing::run_process;
 using testing::run_rigc;
@@ -276,6 +278,39 @@ TEST(CliOutputs, ARunFolderHoldsOneSceneAndOnlyRecordedImages) {
 
 // Messages: a symbolic link loop as -o or among --photos was "internal error: filesystem error",
 // and -o a dangling link "images: File exists" (render) or the link replaced (compile).
+// eval clears its own work folders (OUT/masks, OUT/colmap) each run; it refuses, touching
+// nothing, when one of them holds an input: the masks it is given, or the photos themselves.
+TEST(CliOutputs, EvalNeverClearsAFolderThatHoldsItsInputs) {
+  TempDir dir;
+  write_text(dir.file("s.yaml"), sphere_scene("inputs", 3));
+  auto result = run_rigc({"render", dir.file("s.yaml"), "--scale", "0.05", "-o", dir.file("run")});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const fs::path out = dir.path() / "out";
+  fs::create_directories(out / "masks");
+  for (const auto& name : files_in(dir.path() / "run" / "masks")) {
+    fs::copy_file(dir.path() / "run" / "masks" / name, out / "masks" / name);
+  }
+  const auto masks = files_in(out / "masks");
+  ASSERT_FALSE(masks.empty());
+  result = run_rigc({"eval", "--photos", dir.file("run/images"), "-o", out.string(), "--masks",
+                     (out / "masks").string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("will not clear '" + (out / "masks").string()));
+  EXPECT_THAT(result.err, HasSubstr("the masks given by --masks"));
+  EXPECT_EQ(files_in(out / "masks"), masks);
+
+  fs::create_directories(out / "colmap");
+  for (const auto& name : files_in(dir.path() / "run" / "images")) {
+    fs::copy_file(dir.path() / "run" / "images" / name, out / "colmap" / name);
+  }
+  const auto photos = files_in(out / "colmap");
+  result = run_rigc({"eval", "--photos", (out / "colmap").string(), "-o", out.string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("will not clear '" + (out / "colmap").string()));
+  EXPECT_THAT(result.err, HasSubstr("a photo ("));
+  EXPECT_EQ(files_in(out / "colmap"), photos);
+}
+
 TEST(CliOutputs, OutputPathsThatCannotBeFollowedAreUserErrors) {
   TempDir dir;
   write_text(dir.file("s.yaml"), sphere_scene("links", 1));

@@ -14,6 +14,7 @@
 
 #include "io/child_processes.h"
 #include "io/files.h"
+#include "io/output_paths.h"
 
 namespace rigc::eval {
 
@@ -307,7 +308,11 @@ class ColmapPipeline {
       return r_;
     }
     std::error_code ec;
-    fs::remove_all(work_, ec);
+    std::string error;
+    if (!clear_output_folder(work_, &error)) {
+      fail(1, error);
+      return r_;
+    }
     fs::create_directories(work_ / "sparse", ec);
     fs::create_directories(logs_, ec);
     if (!prepare_images() || !probe()) return r_;

@@ -9,6 +9,7 @@
 #include "eval/align.h"
 #include "eval/colmap_database.h"
 #include "io/atomic_file.h"
+#include "io/output_paths.h"
 
 namespace rigc::eval {
 
@@ -85,9 +86,13 @@ ColmapRun triangulate_known_poses(const EvalOptions& o, const EvalInputs& in, co
   const fs::path work = in.out / "colmap" / "known_poses";
   const fs::path logs = in.out / "logs";
   std::error_code ec;
-  fs::remove_all(work, ec);
-  fs::create_directories(work / "model", ec);
   std::string error;
+  if (!clear_output_folder(work, &error)) {
+    r.exit_code = 1;
+    r.failure = error;
+    return r;
+  }
+  fs::create_directories(work / "model", ec);
   if (!write_known_model(in.out / "colmap" / "database.db", in.reference, work / "input", &error)) {
     r.exit_code = 1;
     r.failure = error;

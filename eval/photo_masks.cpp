@@ -10,6 +10,8 @@
 #include "dslr/image_io.h"
 #include "eval/chroma_key.h"
 #include "io/atomic_file.h"
+#include "io/input_files.h"
+#include "io/output_paths.h"
 
 namespace rigc::eval {
 
@@ -197,9 +199,8 @@ std::optional<PhotoMasks> make_photo_masks(const ImageSet& images, const PhotoMa
                                            std::string* error) {
   PhotoMasks result;
   const fs::path dir = out / "masks";
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  fs::create_directories(dir, ec);
+  if (!o.masks_dir.empty()) protect_input_folder(o.masks_dir, "the masks given by --masks");
+  if (!clear_output_folder(dir, error)) return std::nullopt;
   const bool ok = o.masks_dir.empty() ? key_masks(images, o, dir, result.report, error)
                                       : import_masks(images, o, dir, result.report, error);
   if (!ok) return std::nullopt;

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "io/atomic_file.h"
+#include "io/input_files.h"
 
 namespace rigc::eval {
 
@@ -86,14 +87,22 @@ bool develop_raw_photos(ImageSet& images, const fs::path& out, std::ostream& log
   int fresh = 0;
   for (const auto& name : images.names) {
     const std::string stem = fs::path(name).stem().string();
-    std::string new_name = name;
+    const std::string new_name = is_raw_photo(name) ? stem + ".jpg" : name;
+    if (raw_stems.count(stem) && !is_raw_photo(name)) continue;  // the camera's JPEG of a RAW
+    // Photos in OUT/developed itself: neither replaced by a link to themselves nor developed over
+    // (a link there is this folder's own, from an earlier run).
+    const bool own_link = fs::is_symlink(fs::symlink_status(dir / new_name, ec));
+    if (const auto input = own_link ? std::nullopt : protected_input_at(dir / new_name)) {
+      *error = fmt::format(
+          "will not write {}: it is {}, an input of this command; choose "
+          "another output folder",
+          (dir / new_name).string(), *input);
+      return false;
+    }
     if (is_raw_photo(name)) {
-      new_name = stem + ".jpg";
       bool cached = false;
       if (!develop_raw(images.dir / name, dir / new_name, &cached, error)) return false;
       fresh += !cached;
-    } else if (raw_stems.count(stem)) {
-      continue;  // the camera's JPEG of a RAW that is here too
     } else {
       fs::remove(dir / name, ec);
       fs::create_symlink(fs::absolute(images.dir / name), dir / name, ec);

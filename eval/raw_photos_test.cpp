@@ -1,6 +1,7 @@
 #include "eval/raw_photos.h"
 
 #include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -185,6 +186,29 @@ TEST(RawPhotos, ARawAndItsJpegAreOnePhotoAndABrokenRawIsNamed) {
   set.names = {"IMG_0002.NEF"};
   EXPECT_FALSE(develop_raw_photos(set, dir.path() / "out", log, true, &error));
   EXPECT_NE(error.find("IMG_0002.NEF"), std::string::npos) << error;
+}
+
+// Photos in eval's own OUT/developed: the RAW's developed JPEG would replace the camera's JPEG
+// of that name, and a JPEG would be replaced by a link to itself. eval refuses instead.
+TEST(RawPhotos, PhotosInTheDevelopedFolderAreNeitherReplacedNorLinkedToThemselves) {
+  rigc::testing::TempDir dir;
+  const fs::path developed = dir.path() / "out" / "developed";
+  fs::create_directories(developed);
+  write_test_dng(developed / "IMG_0001.DNG", 64, 48, 0.18);
+  OIIO::ImageBuf grey(OIIO::ImageSpec(64, 48, 3, OIIO::TypeDesc::UINT8));
+  OIIO::ImageBufAlgo::fill(grey, {0.5f, 0.5f, 0.5f});
+  for (const char* name : {"IMG_0001.jpg", "IMG_0002.jpg"}) {
+    ASSERT_TRUE(grey.write((developed / name).string()));
+  }
+  const std::string camera_jpeg = rigc::testing::read_text((developed / "IMG_0001.jpg").string());
+  const auto r = rigc::testing::run_rigc(
+      {"eval", "--photos", developed.string(), "-o", (dir.path() / "out").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("will not write " + (developed / "IMG_0001.jpg").string()),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(rigc::testing::read_text((developed / "IMG_0001.jpg").string()), camera_jpeg);
+  EXPECT_FALSE(fs::is_symlink(developed / "IMG_0002.jpg"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 namespace rigc {
 namespace {
@@ -17,7 +18,26 @@ struct Registry {
   std::mutex mutex;
   bool enabled = false;
   std::map<FileId, std::string> inputs;
+  // Where each input and input folder is (symbolic links resolved), for the folders a command
+  // clears.
+  std::vector<std::pair<std::filesystem::path, std::string>> places;
 };
+
+std::filesystem::path resolved(const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+  return ec ? std::filesystem::absolute(path, ec).lexically_normal() : p;
+}
+
+// Whether `path` is `dir` or lies under it (both resolved).
+bool is_at_or_under(const std::filesystem::path& path, const std::filesystem::path& dir) {
+  auto p = path.begin();
+  for (auto d = dir.begin(); d != dir.end(); ++d, ++p) {
+    if (d->empty()) continue;  // a trailing separator
+    if (p == path.end() || *p != *d) return false;
+  }
+  return true;
+}
 
 Registry& registry() {
   static Registry instance;
@@ -43,7 +63,27 @@ void protect_input_file(const std::filesystem::path& path, const std::string& wh
   if (!id) return;
   Registry& r = registry();
   std::lock_guard lock(r.mutex);
-  if (r.enabled) r.inputs.emplace(*id, what);
+  if (!r.enabled) return;
+  r.inputs.emplace(*id, what);
+  r.places.emplace_back(resolved(path), what);
+}
+
+void protect_input_folder(const std::filesystem::path& dir, const std::string& what) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  Registry& r = registry();
+  std::lock_guard lock(r.mutex);
+  if (r.enabled) r.places.emplace_back(resolved(dir), what);
+}
+
+std::optional<std::string> protected_input_within(const std::filesystem::path& dir) {
+  Registry& r = registry();
+  const std::filesystem::path folder = resolved(dir);
+  std::lock_guard lock(r.mutex);
+  for (const auto& [place, what] : r.places) {
+    if (is_at_or_under(place, folder)) return what + " (" + place.string() + ")";
+  }
+  return std::nullopt;
 }
 
 std::optional<std::string> protected_input_at(const std::filesystem::path& path) {

@@ -18,6 +18,14 @@ void enable_input_protection();
 // an input; `what` names it in messages ("the scene's mesh"). Thread-safe.
 void protect_input_file(const std::filesystem::path& path, const std::string& what);
 
+// Records the folder `dir` as an input (photos, masks made elsewhere): a folder the command
+// clears must not hold it.
+void protect_input_folder(const std::filesystem::path& dir, const std::string& what);
+
+// "WHAT (PATH)" for the first recorded input or input folder that is `dir` or lies under it
+// (symbolic links resolved), for a command about to clear `dir`.
+std::optional<std::string> protected_input_within(const std::filesystem::path& dir);
+
 // What the file at `path` (following symbolic links) is when it is a recorded input, for
 // "cannot write PATH: it is WHAT, an input of this command".
 std::optional<std::string> protected_input_at(const std::filesystem::path& path);

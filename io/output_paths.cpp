@@ -6,6 +6,8 @@
 #include <regex>
 #include <system_error>
 
+#include "io/input_files.h"
+
 namespace rigc {
 namespace {
 
@@ -53,6 +55,18 @@ bool make_output_folder(const std::filesystem::path& dir, std::string* error) {
   set_error(error, fmt::format("cannot create the output folder '{}': {}", dir.string(),
                                (ec ? ec : is_dir_ec).message()));
   return false;
+}
+
+bool clear_output_folder(const std::filesystem::path& dir, std::string* error) {
+  if (const auto input = protected_input_within(dir)) {
+    set_error(error, fmt::format("will not clear '{}': it holds {}, an input of this command; "
+                                 "choose another output folder",
+                                 dir.string(), *input));
+    return false;
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  return make_output_folder(dir, error);
 }
 
 }  // namespace rigc

@@ -16,4 +16,9 @@ bool is_temporary_name(const std::string& filename);
 // no permission. Never throws.
 bool make_output_folder(const std::filesystem::path& dir, std::string* error);
 
+// Empties the folder `dir` (a command's own work folder, rewritten each run) and makes it anew.
+// Refuses, touching nothing, when `dir` is or holds an input of this command
+// (io/input_files.h): `-o OUT --masks OUT/masks` must not delete the masks it is about to read.
+bool clear_output_folder(const std::filesystem::path& dir, std::string* error);
+
 }  // namespace rigc
