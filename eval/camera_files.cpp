@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "io/bounded_file.h"
 #include "run/camera_csv.h"
 
 namespace rigc::eval {
@@ -21,11 +21,26 @@ using nlohmann::json;
 
 namespace {
 
+// The camera file at `path` as a stream, read whole and bounded (io/bounded_file.h); nullopt with
+// `error` naming it and why.
+std::optional<std::istringstream> open_camera_file(const fs::path& path, std::string* error) {
+  std::string why;
+  auto file = read_bounded_file(path, kMostCameraFileBytes, &why);
+  if (!file) {
+    *error = fmt::format("{}: cannot read it: it {}", path.string(), why);
+    return std::nullopt;
+  }
+  return std::istringstream(std::move(file->bytes));
+}
+
 // Little-endian binary reader over a whole file; `ok` turns false on a short read.
 class BinaryReader {
  public:
-  explicit BinaryReader(const fs::path& path) : in_(path, std::ios::binary) {}
-  bool opened() const { return static_cast<bool>(in_); }
+  BinaryReader(const fs::path& path, std::string* error) {
+    if (auto in = open_camera_file(path, error)) in_ = std::move(*in);
+    opened_ = error->empty();
+  }
+  bool opened() const { return opened_; }
   template <typename T>
   T read() {
     T value{};
@@ -45,7 +60,8 @@ class BinaryReader {
   bool ok = true;
 
  private:
-  std::ifstream in_;
+  std::istringstream in_;
+  bool opened_ = false;
 };
 
 // The parameter count of a COLMAP camera model id (colmap/sensor/models.h).
@@ -178,8 +194,9 @@ bool read_par_line(const std::string& line, run::ColmapImage* image, run::Colmap
 
 std::optional<std::vector<run::ColmapCamera>> read_colmap_cameras_bin(const fs::path& path,
                                                                       std::string* error) {
-  BinaryReader in(path);
-  if (!in.opened()) return bad_file(path, "cannot open", error), std::nullopt;
+  error->clear();
+  BinaryReader in(path, error);
+  if (!in.opened()) return std::nullopt;
   std::vector<run::ColmapCamera> cameras;
   const auto count = in.read<std::uint64_t>();
   for (std::uint64_t i = 0; in.ok && i < count; ++i) {
@@ -199,8 +216,9 @@ std::optional<std::vector<run::ColmapCamera>> read_colmap_cameras_bin(const fs::
 
 std::optional<std::vector<run::ColmapImage>> read_colmap_images_bin(const fs::path& path,
                                                                     std::string* error) {
-  BinaryReader in(path);
-  if (!in.opened()) return bad_file(path, "cannot open", error), std::nullopt;
+  error->clear();
+  BinaryReader in(path, error);
+  if (!in.opened()) return std::nullopt;
   std::vector<run::ColmapImage> images;
   const auto count = in.read<std::uint64_t>();
   for (std::uint64_t i = 0; in.ok && i < count; ++i) {
@@ -228,9 +246,12 @@ std::optional<std::vector<run::ColmapImage>> read_colmap_images_bin(const fs::pa
 std::optional<std::vector<run::ColmapImage>> read_bundler(const fs::path& out_path,
                                                           const fs::path& list_path,
                                                           std::string* error) {
-  std::ifstream out(out_path), list(list_path);
-  if (!out) return bad_file(out_path, "cannot open", error), std::nullopt;
-  if (!list) return bad_file(list_path, "cannot open", error), std::nullopt;
+  auto opened_out = open_camera_file(out_path, error);
+  if (!opened_out) return std::nullopt;
+  auto opened_list = open_camera_file(list_path, error);
+  if (!opened_list) return std::nullopt;
+  std::istream& out = *opened_out;
+  std::istream& list = *opened_list;
   std::string header;
   std::getline(out, header);
   if (!header.starts_with("# Bundle file")) {
@@ -283,7 +304,9 @@ std::optional<std::vector<run::ColmapImage>> read_bundler(const fs::path& out_pa
 
 std::optional<std::vector<run::ColmapImage>> read_meshroom_sfm(const fs::path& path,
                                                                std::string* error) {
-  const json doc = json::parse(std::ifstream(path, std::ios::binary), nullptr, false);
+  auto in = open_camera_file(path, error);
+  if (!in) return std::nullopt;
+  const json doc = json::parse(*in, nullptr, false);
   if (doc.is_discarded() || !doc.is_object() || !doc.contains("views") || !doc.contains("poses") ||
       !doc["views"].is_array() || !doc["poses"].is_array()) {
     return bad_file(path, "is not a Meshroom SfMData JSON (views and poses)", error), std::nullopt;
@@ -326,9 +349,9 @@ std::optional<std::vector<run::ColmapImage>> read_meshroom_sfm(const fs::path& p
 }
 
 std::optional<CameraFile> read_middlebury_par(const fs::path& path, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return bad_file(path, "cannot open", error), std::nullopt;
-  const auto lines = content_lines(in);
+  auto in = open_camera_file(path, error);
+  if (!in) return std::nullopt;
+  const auto lines = content_lines(*in);
   long count = -1;
   if (lines.empty() || !(std::istringstream(lines.front().second) >> count) || count < 1) {
     return bad_file(path, "does not start with the number of images (not a Middlebury _par.txt)",
@@ -362,9 +385,9 @@ std::optional<CameraFile> read_middlebury_par(const fs::path& path, std::string*
 
 std::optional<std::vector<run::ColmapImage>> read_rigc_camera_csv(const fs::path& path,
                                                                   std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return bad_file(path, "cannot open", error), std::nullopt;
-  const auto lines = content_lines(in);
+  auto in = open_camera_file(path, error);
+  if (!in) return std::nullopt;
+  const auto lines = content_lines(*in);
   if (lines.empty() || lines.front().second.rfind("label,x,y,z,omega,phi,kappa", 0) != 0) {
     return bad_file(path, "has no header 'label,x,y,z,omega,phi,kappa' (not RigC's cameras.csv)",
                     error),

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -71,6 +72,24 @@ TEST(CameraFiles, BrokenFilesAreNamed) {
   EXPECT_NE(error.find("ends early"), std::string::npos) << error;
   EXPECT_FALSE(read_camera_file(dir.file("c.xyz"), &error));
   EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+}
+
+// Neither read forever nor waited on: /dev/zero behind a Bundler .out (it read 4.4 GB), a pipe
+// named *.sfm (it blocked for ever), a folder whose images.txt is a pipe.
+TEST(CameraFiles, DevicesAndPipesAreRefusedUnread) {
+  rigc::testing::TempDir dir;
+  std::string error;
+  std::filesystem::create_symlink("/dev/zero", dir.file("zero.out"));
+  rigc::testing::write_text(dir.file("zero.list.txt"), "x.jpg\n");
+  EXPECT_FALSE(read_camera_file(dir.file("zero.out"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("zero.out: cannot read it: it is not a regular file"));
+  ASSERT_EQ(::mkfifo(dir.file("pipe.sfm").c_str(), 0600), 0);
+  EXPECT_FALSE(read_camera_file(dir.file("pipe.sfm"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("is not a regular file"));
+  std::filesystem::create_directory(dir.file("model"));
+  ASSERT_EQ(::mkfifo(dir.file("model/images.txt").c_str(), 0600), 0);
+  EXPECT_FALSE(read_camera_file(dir.file("model"), &error));
+  EXPECT_THAT(error, ::testing::HasSubstr("is not a regular file"));
 }
 
 TEST(CameraFiles, RigcCameraCsvGivesTheRunsPoses) {

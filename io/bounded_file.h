@@ -12,6 +12,11 @@
 
 namespace rigc {
 
+// Other tools' camera files and sparse models (COLMAP, Bundler, Meshroom, Middlebury): a model of
+// many thousand photos, its 2D points included, stays well under this. (The scene's own bound is
+// compiler/limits.h's kMostSceneFileBytes.)
+inline constexpr std::size_t kMostCameraFileBytes = std::size_t{512} << 20;
+
 // Which file a path led to when it was read (symbolic links followed): a writer compares it with
 // the file there now before it replaces what it read.
 struct FileIdentity {

@@ -15,6 +15,7 @@
 #include <system_error>
 
 #include "dslr/lens.h"
+#include "io/bounded_file.h"
 #include "io/files.h"
 #include "run/ground_truth_points.h"
 
@@ -229,11 +230,13 @@ bool is_blank_or_comment(std::string_view line) {
 // error message on malformed input.
 template <typename OnLine>
 bool read_lines(const fs::path& path, std::string* error, OnLine on_line) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    if (error != nullptr) *error = fmt::format("cannot open {}", path.string());
+  std::string why;
+  auto file = read_bounded_file(path, kMostCameraFileBytes, &why);
+  if (!file) {
+    if (error != nullptr) *error = fmt::format("cannot read {}: it {}", path.string(), why);
     return false;
   }
+  std::istringstream in(std::move(file->bytes));
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
