@@ -14,6 +14,7 @@
 #include "dslr/lens.h"
 #include "io/atomic_file.h"
 #include "io/files.h"
+#include "io/output_paths.h"
 #include "raster/rasterizer.h"
 
 namespace rigc::analysis {
@@ -366,6 +367,8 @@ bool write_coverage_outputs(const ir::Scene& scene, const scene::StudioScene& st
     *error = fmt::format("cannot create '{}': {}", (dir / "pictures").string(), ec.message());
     return false;
   }
+  remove_abandoned_temporaries(dir);  // an interrupted run's half-written meshes and pictures
+  remove_abandoned_temporaries(dir / "pictures");
   const FaceColors colors = face_colors(coverage);
   const PictureFrame frame(scene, picture_width);
   return write_coverage_meshes(dir, studio.object, colors, error) &&

@@ -1,8 +1,10 @@
 #include "io/output_paths.h"
 
 #include <fmt/format.h>
+#include <signal.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <regex>
 #include <system_error>
 
@@ -21,6 +23,24 @@ void set_error(std::string* error, std::string text) {
 bool is_temporary_name(const std::string& filename) {
   static const std::regex pattern(R"(\..+\.tmp\.[0-9]+\.[0-9]+\.[0-9a-f]+)");
   return std::regex_match(filename, pattern);
+}
+
+int remove_abandoned_temporaries(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  static const std::regex pattern(R"(\..+\.tmp\.([0-9]+)\.[0-9]+\.[0-9a-f]+)");
+  int removed = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::smatch match;
+    std::error_code file_ec;
+    if (!std::regex_match(name, match, pattern) || !it->is_regular_file(file_ec)) continue;
+    const long pid = std::strtol(match[1].str().c_str(), nullptr, 10);
+    const bool writer_alive =
+        pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+    if (!writer_alive && fs::remove(it->path(), file_ec)) ++removed;
+  }
+  return removed;
 }
 
 bool make_output_folder(const std::filesystem::path& dir, std::string* error) {

@@ -11,6 +11,11 @@ namespace rigc {
 // crashed or killed writer left behind.
 bool is_temporary_name(const std::string& filename);
 
+// Removes from `dir` (not its subfolders) the temporaries whose writer is no longer running on
+// this machine: what an interrupted run left behind, safe beside a writer still at work. The
+// number removed.
+int remove_abandoned_temporaries(const std::filesystem::path& dir);
+
 // Creates the folder `dir` and its parents unless it is there. False with one line in `error` (if
 // not null) naming `dir` and why: a symbolic link that loops or leads nowhere, a file in the way,
 // no permission. Never throws.
