@@ -11,6 +11,8 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
+#include "compiler/check.h"
+#include "compiler/frontend.h"
 #include "io/input_files.h"
 #include "sweep/local_executor.h"
 #include "sweep/results.h"
@@ -80,15 +82,26 @@ std::optional<sweep::SweepSpec> spec_from_options(const SweepArguments& a, Diagn
   spec.scale = a.scale;
   spec.samples = a.samples;
   std::string error;
+  std::optional<sweep::Axis> backends;
   for (const std::string& text : a.vary) {
     auto axis = sweep::parse_vary_option(text, &error);
     if (!axis) {
       std::cerr << "rigc: error: " << error << '\n';
       return std::nullopt;
     }
+    if (axis->is_backend()) {
+      // `--vary backend=preview,cycles` says what `--backend preview,cycles` says.
+      if (backends || a.backend != SweepArguments{}.backend) {
+        std::cerr << "rigc: error: the renderers are given twice: by --vary backend=... and "
+                     "by --backend (give one)\n";
+        return std::nullopt;
+      }
+      backends = std::move(axis);
+      continue;
+    }
     spec.axes.push_back(std::move(*axis));
   }
-  auto backends = sweep::parse_vary_option("backend=" + a.backend, &error);
+  if (!backends) backends = sweep::parse_vary_option("backend=" + a.backend, &error);
   if (!backends) {
     std::cerr << "rigc: error: --backend: " << error << '\n';
     return std::nullopt;
@@ -113,13 +126,12 @@ std::optional<sweep::SweepSpec> spec_from_options(const SweepArguments& a, Diagn
   return spec;
 }
 
-std::optional<std::string> read_scene_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::error_code ec;
-  if (!in || fs::is_directory(path, ec)) return std::nullopt;
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+// The scene's text, read by the front end (bounded) and parsed once, so that a scene too large,
+// not YAML or nested too deep is refused at its line before any variant is made.
+std::optional<std::string> read_scene_text(const std::string& path, DiagnosticEngine& diag) {
+  auto text = read_scene_file(path, diag);
+  if (!text || !parse_yaml(*text, path, diag)) return std::nullopt;
+  return text;
 }
 
 int print_failures(const std::vector<sweep::FailedTask>& failed) {
@@ -167,11 +179,8 @@ int run_sweep_command(std::vector<std::string> args) {
   if (!spec) return kExitUserError;
   protect_input_file(a.input, a.vary.empty() ? "the sweep file" : "the scene file");
   protect_input_file(spec->scene_path, "the scene file");
-  const auto scene_text = read_scene_text(spec->scene_path);
-  if (!scene_text) {
-    std::cerr << fmt::format("rigc: error: cannot read the scene file {}\n", spec->scene_path);
-    return kExitUserError;
-  }
+  const auto scene_text = read_scene_text(spec->scene_path, diag);
+  if (!scene_text) return kExitUserError;
   const fs::path out =
       a.output.empty() ? fs::path("out") / sweep::folder_name(spec->name) : fs::path(a.output);
   std::vector<sweep::Variant> variants;

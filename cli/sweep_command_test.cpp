@@ -150,6 +150,64 @@ TEST(CliSweep, BadSweepsAreUserErrorsBeforeAnythingRuns) {
   EXPECT_NE(no_scene.err.find("cannot read the scene file"), std::string::npos) << no_scene.err;
 }
 
+// A sweep file named like a table the sweep writes at the end is refused before any variant runs.
+TEST(CliSweep, ASweepFileInTheTablesPlaceIsRefusedBeforeAnythingRuns) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  const std::string out = dir.file("out");
+  fs::create_directories(out);
+  const std::string sweep =
+      "rigc-sweep: 1\nscene: ../scene.yaml\nvary:\n"
+      "  shots[0].turntable.steps: [3, 4]\nscale: 0.05\n"
+      "measure: [coverage]\n";
+  write_text(out + "/results.md", sweep);
+  const auto r = run_rigc({"sweep", out + "/results.md", "-o", out});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("it is the sweep file, an input of this command"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(read_text(out + "/results.md"), sweep);
+  EXPECT_FALSE(fs::exists(out + "/steps-3"));
+}
+
+// The scene is read by the front end: a device, a file past the scene limit, or nesting past the
+// language's depth is refused at once, at its line where it has one.
+TEST(CliSweep, AScenePastTheLanguagesBoundsIsRefusedAtItsLine) {
+  TempDir dir;
+  const auto sweep_of = [&](const std::string& scene) {
+    return run_rigc({"sweep", scene, "--vary", "camera.exposure.iso=100,200", "-o", dir.file("out"),
+                     "--status"});
+  };
+  auto r = sweep_of("/dev/zero");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("is not a regular file"), std::string::npos) << r.err;
+  write_text(dir.file("big.yaml"), small_scene() + std::string(17 << 20, '#'));
+  r = sweep_of(dir.file("big.yaml"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("larger than 16 MB"), std::string::npos) << r.err;
+  write_text(dir.file("deep.yaml"), "rigc: 1\nname: deep\nobject: " + std::string(100000, '[') +
+                                        std::string(100000, ']') + "\n");
+  r = sweep_of(dir.file("deep.yaml"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("deep.yaml:3:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nest deeper than"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("out")));
+}
+
+// `--vary backend=...` is the renderers' axis, as `--backend a,b` is; both at once are refused.
+TEST(CliSweep, VaryingTheBackendIsTheBackendsAxis) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  auto r = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "backend=preview,povray", "-o",
+                     dir.file("out"), "--status"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir.file("out/backend-preview")));
+  EXPECT_TRUE(fs::exists(dir.file("out/backend-povray")));
+  r = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "backend=preview,povray", "--backend",
+                "cycles", "-o", dir.file("out2"), "--status"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("the renderers are given twice"), std::string::npos) << r.err;
+}
+
 // True when a Slurm cluster answers (scripts/slurm_cluster.sh start; its slurm.conf is used when
 // SLURM_CONF is not set).
 bool slurm_cluster_up() {

@@ -12,6 +12,7 @@
 
 #include "backends/registry.h"
 #include "compiler/check.h"
+#include "io/bounded_file.h"
 #include "run/backend.h"
 #include "sweep/scene_edit.h"
 
@@ -237,21 +238,13 @@ std::optional<SweepSpec> parse_sweep_text(const std::string& text, const std::st
 }
 
 std::optional<SweepSpec> read_sweep_file(const std::string& path, DiagnosticEngine& diag) {
-  std::ifstream in(path, std::ios::binary);
-  std::error_code ec;
-  if (!in || fs::is_directory(path, ec)) {
-    diag.error({path, 0, 0}, "cannot read the sweep file");
+  std::string why;
+  const auto file = read_bounded_file(path, kMostSweepBytes, &why);
+  if (!file) {
+    diag.error({path, 0, 0}, "cannot read the sweep file: it " + why);
     return std::nullopt;
   }
-  std::string text;
-  text.resize(kMostSweepBytes + 1);
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.size() > kMostSweepBytes) {
-    diag.error({path, 0, 0}, "the sweep file is larger than 1 MB");
-    return std::nullopt;
-  }
-  return parse_sweep_text(text, path, diag);
+  return parse_sweep_text(file->bytes, path, diag);
 }
 
 std::optional<Axis> parse_vary_option(const std::string& text, std::string* error) {

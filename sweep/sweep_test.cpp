@@ -276,6 +276,16 @@ TEST(SweepVariants, AModelFileEditedInPlaceChangesTheVariantsKey) {
   EXPECT_NE(after[1], before[1]);
 }
 
+// 64 axes of two values make 2^64 variants: the count saturates past the bound instead of
+// overflowing to none.
+TEST(SweepVariants, AGridPastTheBoundIsCountedAsPastIt) {
+  SweepSpec spec;
+  for (int a = 0; a < 64; ++a) {
+    spec.axes.push_back({"camera.axis" + std::to_string(a), {}, {{"1", {}}, {"2", {}}}});
+  }
+  EXPECT_EQ(expand_variants(spec).size(), 1001u);
+}
+
 TEST(SweepResults, PlotAxesTickAtRoundNumbers) {
   const AxisTicks f = nice_ticks(-0.0066, 0.5329);
   EXPECT_EQ(f.values, (std::vector<double>{-0.2, 0.0, 0.2, 0.4, 0.6}));

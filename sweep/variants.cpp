@@ -128,8 +128,12 @@ void report_compile_errors(const SweepSpec& spec, const Variant& variant,
 
 std::vector<Variant> expand_variants(const SweepSpec& spec) {
   const auto groups = grid_groups(spec);
+  // The grid's size, saturated past the bound: 2^64 variants overflowed to 0.
   std::size_t total = 1;
-  for (const auto& group : groups) total *= spec.axes[group[0]].values.size();
+  for (const auto& group : groups) {
+    const std::size_t n = spec.axes[group[0]].values.size();
+    total = n != 0 && total > kMostVariants / n ? kMostVariants + 1 : total * n;
+  }
   std::vector<Variant> variants;
   std::set<std::string> names;
   for (std::size_t i = 0; i < total && i < kMostVariants + 1; ++i) {
@@ -226,6 +230,11 @@ nlohmann::json sweep_json(const SweepSpec& spec, const std::vector<Variant>& var
 
 bool write_variant_folders(const SweepSpec& spec, const std::vector<Variant>& variants,
                            const fs::path& out_dir, std::string* error) {
+  // The tables written once the variants have run: refused now (an input in their place), not
+  // after hours of renders.
+  for (const char* table : {"results.csv", "timings.csv", "results.md", "sweep.json"}) {
+    if (file_to_replace(out_dir / table, error).empty()) return false;
+  }
   for (const Variant& v : variants) {
     const fs::path dir = out_dir / v.name;
     std::error_code ec;
