@@ -311,6 +311,25 @@ TEST(CliOutputs, EvalNeverClearsAFolderThatHoldsItsInputs) {
   EXPECT_EQ(files_in(out / "colmap"), photos);
 }
 
+// eval's reports are JSON: a photo whose name is not UTF-8 is refused, named, before COLMAP runs.
+TEST(CliOutputs, APhotoNameThatIsNotUtf8IsRefusedBeforeColmap) {
+  TempDir dir;
+  write_text(dir.file("s.yaml"), sphere_scene("names", 3));
+  auto result = run_rigc({"render", dir.file("s.yaml"), "--scale", "0.05", "-o", dir.file("run")});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  fs::create_directories(dir.path() / "photos");
+  int k = 0;
+  for (const auto& name : files_in(dir.path() / "run" / "images")) {
+    const std::string to = k++ == 0 ? "caf\xe9.jpg" : name;
+    fs::copy_file(dir.path() / "run" / "images" / name, dir.path() / "photos" / to);
+  }
+  result = run_rigc({"eval", "--photos", dir.file("photos"), "-o", dir.file("out")});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("is not valid UTF-8; rename it"));
+  EXPECT_THAT(result.err, ::testing::Not(HasSubstr("internal error")));
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "colmap"));
+}
+
 TEST(CliOutputs, OutputPathsThatCannotBeFollowedAreUserErrors) {
   TempDir dir;
   write_text(dir.file("s.yaml"), sphere_scene("links", 1));

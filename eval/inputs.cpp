@@ -11,6 +11,7 @@
 #include "compiler/frontend.h"
 #include "eval/raw_photos.h"
 #include "io/input_files.h"
+#include "ir/utf8_text.h"
 #include "run/manifest.h"
 #include "run/scene_inputs.h"
 
@@ -165,6 +166,16 @@ std::optional<ImageSet> find_images(const fs::path& run_dir, bool photos, std::s
     return std::nullopt;
   }
   set.names = list_images(set.dir);
+  // eval.json and COLMAP's text model hold the names: a name that is not UTF-8 ended eval in an
+  // internal error after COLMAP had run.
+  for (const auto& name : set.names) {
+    if (valid_utf8(name)) continue;
+    *error = fmt::format(
+        "{}: the file name '{}' is not valid UTF-8; rename it (eval's reports "
+        "are JSON, which holds UTF-8 text only)",
+        set.dir.string(), valid_utf8_text(name));
+    return std::nullopt;
+  }
   if (set.names.size() < 2) {
     *error =
         fmt::format("{} has {} image(s); SfM needs at least 2", set.dir.string(), set.names.size());

@@ -56,7 +56,10 @@ EvalReport::EvalReport(const EvalInputs& in, std::ostream& log, EvalSummary& sum
 
 bool EvalReport::write() {
   std::string why;
-  if (!rigc::write_file_atomically(out_ / "eval.json", report_.dump(2) + "\n", &why)) {
+  // Paths may hold any bytes; JSON holds UTF-8 only, so a stray byte becomes U+FFFD.
+  if (!rigc::write_file_atomically(
+          out_ / "eval.json", report_.dump(2, ' ', false, json::error_handler_t::replace) + "\n",
+          &why)) {
     log_ << "rigc eval: error: " << why << "\n";
     return false;
   }

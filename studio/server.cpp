@@ -28,13 +28,19 @@ constexpr const char* kThreeDir = "/usr/share/javascript/three/";
 constexpr const char* kJson = "application/json; charset=utf-8";
 constexpr const char* kJavaScript = "application/javascript; charset=utf-8";
 
+// JSON text of `body`; bytes that are not UTF-8 (a scene's broken line quoted in its diagnostics)
+// become U+FFFD instead of an exception and a 500 for every answer.
+std::string json_text(const nlohmann::json& body) {
+  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 void send_error(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
-  res.set_content(nlohmann::json{{"error", message}}.dump(), kJson);
+  res.set_content(json_text(nlohmann::json{{"error", message}}), kJson);
 }
 
 void send_json(httplib::Response& res, const nlohmann::json& body) {
-  res.set_content(body.dump(), kJson);
+  res.set_content(json_text(body), kJson);
 }
 
 void send_outcome(httplib::Response& res, const Outcome& outcome) {

@@ -384,6 +384,20 @@ TEST_F(StudioApi, APipeAFolderOrAHugeFileInTheScenesPlaceIsNamedAndTheSceneKept)
   EXPECT_EQ(client_->Get("/api/frame?width=200")->status, 200);
 }
 
+// A byte that is not UTF-8 in the scene on disk is the file's error, located, and every answer
+// stays JSON (it made each /api/state a 500).
+TEST_F(StudioApi, ASceneWithABrokenByteIsAFileErrorAndTheStateStaysJson) {
+  std::string text = kStudioTestScene;
+  text.replace(text.find("name: studio-test"), 17, "name: caf\xe9");
+  std::ofstream(scene_file_) << text;
+  const auto res = client_->Get("/api/state");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto s = nlohmann::json::parse(res->body);
+  EXPECT_THAT(s["file_error"].get<std::string>(), HasSubstr("not valid UTF-8"));
+  EXPECT_EQ(s["name"], "studio-test");
+}
+
 // Listening on every interface, the server answers to the machine's own names and addresses.
 TEST(StudioServerHosts, OnEveryInterfaceTheMachinesOwnNamesAreAccepted) {
   testing::TempDir dir;
