@@ -55,6 +55,12 @@ PhotoExif read_photo_exif(const fs::path& path) {
   return exif;
 }
 
+bool is_focal_length_mm(double mm) {
+  // A phone's lens is about 2 mm; the longest lenses made about 5000 mm.
+  constexpr double kShortestMm = 1, kLongestMm = 5000;
+  return std::isfinite(mm) && mm >= kShortestMm && mm <= kLongestMm;
+}
+
 std::optional<CameraStatement> parse_camera_statement(const std::string& text, std::string* error) {
   const auto comma = text.find(',');
   auto refuse = [&](const std::string& why) {
@@ -74,8 +80,7 @@ std::optional<CameraStatement> parse_camera_statement(const std::string& text, s
   }
   s.body = *preset;
   const auto [end, ec] = std::from_chars(focal.data(), focal.data() + focal.size(), s.focal_mm);
-  if (ec != std::errc() || end != focal.data() + focal.size() || !std::isfinite(s.focal_mm) ||
-      s.focal_mm <= 0 || s.focal_mm > 5000) {
+  if (ec != std::errc() || end != focal.data() + focal.size() || !is_focal_length_mm(s.focal_mm)) {
     return refuse(fmt::format("'{}' is no focal length in mm (e.g. 50mm)", text.substr(comma + 1)));
   }
   return s;
@@ -118,34 +123,44 @@ PhotoCamera camera_of(const PhotoExif& exif, const std::optional<CameraStatement
   c.height = size.second;
   std::optional<BodyPreset> body;
   double focal_mm = 0;
+  // Why the EXIF's body preset cannot give the focal length (50/0 read as inf, 0, 1e9 mm).
+  std::string unusable;
   if (statement) {
     body = statement->body;
     focal_mm = statement->focal_mm;
     c.source = fmt::format("--camera: body preset {}, {} mm", body->name, focal_mm);
-  } else if ((body = preset_for_exif(exif.make, exif.model)) && exif.focal_mm > 0) {
+  } else if ((body = preset_for_exif(exif.make, exif.model))) {
     focal_mm = exif.focal_mm;
     c.source = fmt::format("EXIF: {} {} (body preset {}), {} mm", exif.make, exif.model, body->name,
                            focal_mm);
-  } else {
-    body.reset();
+    if (!is_focal_length_mm(focal_mm)) {
+      unusable = fmt::format(
+          "{} {} is body preset {}, but its EXIF focal length ({} mm) is no "
+          "focal length",
+          exif.make, exif.model, body->name, exif.focal_mm);
+      body.reset();
+    }
   }
   if (body) {
     c.focal_px = focal_length_px(*body, focal_mm, c.width, c.height);
     c.sensor_known = true;
     c.label = fmt::format("{}, {} mm, {} x {}", body->model, focal_mm, c.width, c.height);
-  } else if (exif.focal_35mm > 0) {
+  } else if (is_focal_length_mm(exif.focal_35mm)) {
     // A 35 mm film frame is 36 mm wide.
     c.focal_px = exif.focal_35mm / 36.0 * std::max(c.width, c.height);
-    c.source = fmt::format("EXIF: 35 mm equivalent {} mm ({} {} is no body preset)",
-                           exif.focal_35mm, exif.make, exif.model);
+    c.source = fmt::format(
+        "EXIF: 35 mm equivalent {} mm ({})", exif.focal_35mm,
+        unusable.empty() ? exif.make + " " + exif.model + " is no body preset" : unusable);
     c.label = fmt::format("{} {}, {} mm (35 mm eq.), {} x {}", exif.make, exif.model,
                           exif.focal_35mm, c.width, c.height);
   } else {
-    c.source = exif.model.empty() ? "none: no EXIF camera (COLMAP guesses; --camera states it)"
-                                  : fmt::format(
-                                        "none: {} {} is no body preset and its EXIF has "
-                                        "no 35 mm focal length (--camera states it)",
-                                        exif.make, exif.model);
+    c.source = exif.model.empty()
+                   ? "none: no EXIF camera (COLMAP guesses; --camera states it)"
+                   : fmt::format(
+                         "none: {} and its EXIF has no 35 mm focal length (--camera "
+                         "states it)",
+                         unusable.empty() ? exif.make + " " + exif.model + " is no body preset"
+                                          : unusable);
     c.label = fmt::format("unknown camera, {} x {}", c.width, c.height);
   }
   return c;

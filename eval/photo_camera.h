@@ -24,6 +24,10 @@ struct PhotoExif {
 };
 PhotoExif read_photo_exif(const std::filesystem::path& path);
 
+// Whether `mm` can be a lens's focal length: finite, 1..5000 mm. EXIF's 50/0 reads as inf, and
+// 1e9 mm is written as a rational of 1/2^31.
+bool is_focal_length_mm(double mm);
+
 // `--camera canon-6d,50mm`: a body preset and a focal length.
 struct CameraStatement {
   BodyPreset body;

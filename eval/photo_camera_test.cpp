@@ -1,7 +1,10 @@
 #include "eval/photo_camera.h"
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <limits>
 
 #include "eval/colmap.h"
 #include "tests/test_support.h"
@@ -88,6 +91,31 @@ TEST(PhotoCamera, EachBodyAndZoomGetsACameraAndTheStatementCoversMissingExif) {
   ASSERT_EQ(stated->size(), 1u);
   EXPECT_EQ((*stated)[0].images.size(), 5u);
   EXPECT_NE((*stated)[0].source.find("--camera"), std::string::npos);
+}
+
+// EXIF's focal length 50/0 reads as inf: neither it, 0 nor 1e9 mm reaches COLMAP, and the body
+// is named as the preset it is.
+TEST(PhotoCamera, AnExifFocalLengthThatIsNoneIsNamedAndNotUsed) {
+  rigc::testing::TempDir dir;
+  const float focals[] = {std::numeric_limits<float>::infinity(), 0.0f, 1e9f};
+  std::vector<std::string> names;
+  for (int k = 0; k < 3; ++k) {
+    names.push_back(fmt::format("{}.jpg", k));
+    write_photo(dir.path() / names.back(), 96, 64, "Canon", "Canon EOS 6D", focals[k]);
+  }
+  std::string error;
+  const auto cameras = photo_cameras(image_set(dir.path(), names, 96, 64), "", &error);
+  ASSERT_TRUE(cameras.has_value()) << error;
+  for (const auto& camera : *cameras) {
+    EXPECT_EQ(camera.focal_px, 0) << camera.source;
+    EXPECT_FALSE(camera.sensor_known);
+    EXPECT_NE(camera.source.find("is body preset canon-6d, but its EXIF focal length ("),
+              std::string::npos)
+        << camera.source;
+  }
+  EXPECT_FALSE(is_focal_length_mm(std::numeric_limits<double>::infinity()));
+  EXPECT_FALSE(is_focal_length_mm(1e9));
+  EXPECT_TRUE(is_focal_length_mm(50));
 }
 
 TEST(PhotoCamera, CaptureOrderFollowsExifTimeElseTheFileNames) {
