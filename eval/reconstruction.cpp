@@ -24,6 +24,7 @@
 #include "eval/camera_files.h"
 #include "eval/colmap.h"
 #include "eval/measure.h"
+#include "eval/reconstruction_headers.h"
 
 namespace rigc::eval {
 
@@ -78,6 +79,22 @@ bool take_mesh(const open3d::geometry::TriangleMesh& mesh, ReconstructionGeometr
   g.has_colors = mesh.HasVertexColors();
   g.has_normals = mesh.HasVertexNormals();
   return true;
+}
+
+// False with `error` when every triangle of a mesh is a line or a point: there is no surface to
+// sample, which Open3D reports only as an exception.
+bool mesh_has_area(const ReconstructionGeometry& g, std::string* error) {
+  double area = 0;
+  for (const auto& t : g.triangles) {
+    area += (g.positions[t[1]] - g.positions[t[0]])
+                .cast<double>()
+                .cross((g.positions[t[2]] - g.positions[t[0]]).cast<double>())
+                .norm();
+  }
+  if (area > 0) return true;
+  *error = fmt::format("its {} faces have no area (every triangle is a line or a point)",
+                       g.triangles.size());
+  return false;
 }
 
 // glTF / GLB: RigC's loader, in the same axes as a ground truth from a glTF.
@@ -275,10 +292,21 @@ std::optional<ReconstructionGeometry> load_reconstruction(const fs::path& path,
         path.string(), ext);
     return std::nullopt;
   }
+  if (const std::string why = header_overclaims(path, ext); !why.empty()) {
+    *error = fmt::format("{}: {}", path.string(), why);
+    return std::nullopt;
+  }
   ReconstructionGeometry g;
   std::string why;
-  const bool ok = (ext == ".gltf" || ext == ".glb") ? load_gltf(path, g, &why)
-                                                    : load_with_open3d(path, ext, g, &why);
+  bool ok = false;
+  try {
+    ok = ((ext == ".gltf" || ext == ".glb") ? load_gltf(path, g, &why)
+                                            : load_with_open3d(path, ext, g, &why)) &&
+         (!g.is_mesh() || mesh_has_area(g, &why));
+  } catch (const std::bad_alloc&) {
+    // What the header checks cannot see: counts inside the data (a face list's length).
+    why = "claims more data than memory can hold (a count in it past what it holds)";
+  }
   if (!ok) {
     *error = why.starts_with(path.string()) ? why : fmt::format("{}: {}", path.string(), why);
     return std::nullopt;
