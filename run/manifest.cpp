@@ -4,6 +4,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "io/bounded_file.h"
 #include "io/files.h"
 #include "ir/ir_json.h"
 
@@ -48,9 +49,12 @@ std::optional<ShotRecord> record_from_json(const std::string& name, const json& 
 Manifest Manifest::load(const fs::path& path) {
   Manifest manifest;
   try {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return manifest;
-    const json j = json::parse(in, nullptr, /*allow_exceptions=*/false);
+    // A manifest of thousands of shots is a few megabytes; a pipe or device in its place is none.
+    constexpr std::size_t kMostManifestBytes = std::size_t{64} << 20;
+    std::string why;
+    const auto file = read_bounded_file(path, kMostManifestBytes, &why);
+    if (!file) return manifest;
+    const json j = json::parse(file->bytes, nullptr, /*allow_exceptions=*/false);
     if (!j.is_object()) return manifest;
     if (auto it = j.find("rigc_version"); it != j.end() && it->is_string()) {
       manifest.rigc_version_ = it->get<std::string>();
