@@ -35,5 +35,8 @@ void colmap_images(std::string_view input);
 void colmap_points(std::string_view input);
 // A run folder's manifest.json.
 void manifest(std::string_view input);
+// A studio edit request: its route on the first line, its body after, answered by one session
+// on the studio's test scene.
+void studio_edits(std::string_view input);
 
 }  // namespace rigc::fuzz

@@ -1,5 +1,5 @@
-// The entry points that need eval/ (a library of their own, so that the other harnesses build
-// without it) and the list of every harness.
+// The entry points that need eval/ (a library of their own with studio_entries.cpp, so that the
+// other harnesses build without them) and the list of every harness.
 #include <array>
 #include <string>
 
@@ -10,7 +10,7 @@
 namespace rigc::fuzz {
 
 std::span<const Harness> harnesses() {
-  static constexpr std::array<Harness, 10> kHarnesses{{
+  static constexpr std::array<Harness, 11> kHarnesses{{
       {"scene", scene},
       {"ply", ply},
       {"obj", obj},
@@ -21,6 +21,7 @@ std::span<const Harness> harnesses() {
       {"colmap_images", colmap_images},
       {"colmap_points", colmap_points},
       {"manifest", manifest},
+      {"studio_edits", studio_edits},
   }};
   return kHarnesses;
 }

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "studio/deadline_server.h"
+#include "studio/edit_requests.h"
 #include "studio/page_files.h"
 
 namespace rigc::studio {
@@ -41,47 +42,6 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 
 void send_json(httplib::Response& res, const nlohmann::json& body) {
   res.set_content(json_text(body), kJson);
-}
-
-void send_outcome(httplib::Response& res, const Outcome& outcome) {
-  if (outcome.ok) {
-    send_json(res, {{"ok", true}});
-  } else {
-    send_error(res, 422, outcome.message);
-  }
-}
-
-// The request's body as a JSON object; nullopt after a 400 when it is not one. The parser is
-// iterative, but copying or destroying a value recurses: a body nested deeper than any request
-// needs is refused while it is parsed, before a value of that depth exists.
-std::optional<nlohmann::json> json_body(const httplib::Request& req, httplib::Response& res) {
-  constexpr int kMostDepth = 16;
-  bool too_deep = false;
-  const nlohmann::json::parser_callback_t within_depth =
-      [&too_deep](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
-        too_deep = too_deep || depth > kMostDepth;
-        return !too_deep;
-      };
-  nlohmann::json body = nlohmann::json::parse(req.body, within_depth, false);
-  if (too_deep) {
-    send_error(res, 400, fmt::format("the request's body nests deeper than {} levels", kMostDepth));
-    return std::nullopt;
-  }
-  if (body.is_discarded() || !body.is_object()) {
-    send_error(res, 400, "the request's body is not a JSON object");
-    return std::nullopt;
-  }
-  return body;
-}
-
-std::optional<Eigen::Vector3d> vec3(const nlohmann::json& value) {
-  if (!value.is_array() || value.size() != 3) return std::nullopt;
-  Eigen::Vector3d v;
-  for (int i = 0; i < 3; ++i) {
-    if (!value[i].is_number()) return std::nullopt;
-    v[i] = value[i].get<double>();
-  }
-  return v;
 }
 
 std::string read_file(const std::string& path) {
@@ -318,104 +278,19 @@ void StudioServer::add_page_routes() {
 }
 
 void StudioServer::add_edit_routes() {
-  // {"path": "camera.lens.focal_length", "value": "35mm"}, or {"changes": [such, ...]} for
-  // several values in one change.
-  server_->Post("/api/set", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto body = json_body(req, res);
-    if (!body) return;
-    const nlohmann::json changes =
-        body->contains("changes") ? (*body)["changes"] : nlohmann::json::array({*body});
-    std::vector<std::pair<ScenePath, std::string>> values;
-    for (const auto& change : changes) {
-      if (!change.is_object() || !change.contains("path") || !change["path"].is_string() ||
-          !change.contains("value") || !change["value"].is_string() || changes.size() > 8) {
-        return send_error(res, 400,
-                          "set takes {\"path\": \"camera.lens.focal_length\", "
-                          "\"value\": \"35mm\"} or {\"changes\": [such, ...]} (at most 8)");
-      }
-      ScenePath path;
-      std::stringstream parts(change["path"].get<std::string>());
-      for (std::string part; std::getline(parts, part, '.');) path.push_back(part);
-      values.emplace_back(std::move(path), change["value"].get<std::string>());
-    }
-    if (values.empty()) return send_error(res, 400, "set takes at least one change");
-    send_outcome(res, session_.set_values(values));
-  });
-  server_->Post("/api/view", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto body = json_body(req, res);
-    if (!body) return;
-    const auto position = vec3(body->value("position", nlohmann::json()));
-    const auto look_at = vec3(body->value("look_at", nlohmann::json()));
-    const nlohmann::json angle = body->value("turntable_deg", nlohmann::json(0.0));
-    if (!position || !look_at || !angle.is_number()) {
-      return send_error(res, 400,
-                        "view takes position and look_at ([x, y, z] in metres) and "
-                        "turntable_deg");
-    }
-    send_outcome(res, session_.set_view(
-                          {*position, *look_at, angle.get<double>() * std::numbers::pi / 180}));
-  });
-  server_->Post("/api/lights/add", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto body = json_body(req, res);
-    if (!body) return;
-    std::string entry;
-    for (const auto& [key, value] : body->items()) {
-      const bool word =
-          !key.empty() && key.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") == std::string::npos;
-      if (!word || !value.is_string() || !is_safe_value_text(value.get<std::string>())) {
-        return send_error(res, 400, "a light is a map of scene-language values");
-      }
-      entry += (entry.empty() ? "" : ", ") + key + ": " + value.get<std::string>();
-    }
-    send_outcome(res, session_.add_light("{" + entry + "}"));
-  });
-  server_->Post("/api/lights/remove", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto body = json_body(req, res);
-    if (!body) return;
-    if (!body->contains("index") || !(*body)["index"].is_number_unsigned()) {
-      return send_error(res, 400, "remove takes {\"index\": N}");
-    }
-    send_outcome(res, session_.remove_light((*body)["index"].get<size_t>()));
-  });
-  auto action = [this](const char* route, Outcome (Session::*method)()) {
-    server_->Post(route, [this, method](const httplib::Request&, httplib::Response& res) {
-      send_outcome(res, (session_.*method)());
-    });
-  };
-  server_->Post("/api/suggest", [this](const httplib::Request&, httplib::Response& res) {
-    Suggestion suggestion;
-    const Outcome outcome = session_.suggest_next_shot(&suggestion);
-    if (!outcome.ok) return send_error(res, 422, outcome.message);
-    send_json(res, {{"ok", true},
-                    {"gain", suggestion.gain},
-                    {"reconstructable", suggestion.reconstructable},
-                    {"entry", suggestion.entry}});
-  });
+  for (const std::string_view route : edit_routes()) {
+    server_->Post(std::string(route),
+                  [this, route](const httplib::Request& req, httplib::Response& res) {
+                    const EditAnswer answer = answer_edit(session_, route, req.body);
+                    res.status = answer.status;
+                    res.set_content(json_text(answer.body), kJson);
+                  });
+  }
   add_reference_routes();
-  action("/api/capture", &Session::capture);
-  action("/api/undo", &Session::undo);
-  action("/api/save", &Session::save);
 }
 
-// The reference check: start {backend, width, samples}, its status, cancel, and the two images.
+// The reference check (started through edit_routes): its status, cancel, and the two images.
 void StudioServer::add_reference_routes() {
-  server_->Post("/api/reference", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto body = json_body(req, res);
-    if (!body) return;
-    ReferenceRequest request;
-    const nlohmann::json backend = body->value("backend", nlohmann::json(request.backend));
-    const nlohmann::json width = body->value("width", nlohmann::json(request.width));
-    const nlohmann::json samples = body->value("samples", nlohmann::json(request.samples));
-    if (!backend.is_string() || !width.is_number_integer() || !samples.is_number_integer()) {
-      return send_error(res, 400,
-                        "reference takes {\"backend\": \"povray\", \"width\": 640, "
-                        "\"samples\": 0}");
-    }
-    request.backend = backend.get<std::string>();
-    request.width = width.get<int>();
-    request.samples = samples.get<int>();
-    send_outcome(res, session_.start_reference(request));
-  });
   server_->Get("/api/reference", [this](const httplib::Request&, httplib::Response& res) {
     send_json(res, session_.reference().status());
   });
