@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 build=build-fuzz
-harnesses=(${RIGC_FUZZ_ONLY:-scene ply obj stl gltf texture colmap_cameras colmap_images colmap_points manifest})
+harnesses=(${RIGC_FUZZ_ONLY:-scene ply obj stl gltf texture colmap_cameras colmap_images colmap_points manifest studio_edits})
 
 launcher=()
 if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
