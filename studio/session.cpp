@@ -280,11 +280,16 @@ Outcome Session::remove_light(size_t index) {
   return push_text(*text, Change::kAnything);
 }
 
+void Session::remember_for_undo(std::string text, Change change) {
+  undo_.push_back({std::move(text), change});
+  if (undo_.size() > kMostUndoSteps) undo_.pop_front();
+}
+
 // A change the user can undo.
 Outcome Session::push_text(const std::string& text, Change change) {
   std::string before = text_;
   const Outcome outcome = apply_text(text, change);
-  if (outcome.ok) undo_.push_back({std::move(before), change});
+  if (outcome.ok) remember_for_undo(std::move(before), change);
   return outcome;
 }
 
@@ -386,7 +391,7 @@ void Session::reload_if_changed() {
   file_error_ = outcome.ok ? "" : outcome.message;
   ++revision_;
   ++reloads_;
-  if (outcome.ok && before != text) undo_.push_back({before, Change::kAnything});
+  if (outcome.ok && before != text) remember_for_undo(before, Change::kAnything);
 }
 
 namespace {

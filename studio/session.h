@@ -174,7 +174,10 @@ class Session {
     std::string text;
     Change change;
   };
-  std::vector<UndoEntry> undo_;
+  // The last kMostUndoSteps changes: an hour of slider turns would otherwise keep every text.
+  static constexpr size_t kMostUndoSteps = 500;
+  std::deque<UndoEntry> undo_;
+  void remember_for_undo(std::string text, Change change);
   std::string file_error_;                  // the file on disk does not compile: its diagnostics
   std::shared_ptr<const ir::Scene> scene_;  // text_ compiled, with every shot
   std::shared_ptr<const scene::StudioScene> studio_;
