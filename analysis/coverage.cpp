@@ -605,6 +605,10 @@ void IncrementalCoverage::add_shot(const ir::Shot& shot) {
   analysis_->add_shot(shot);
 }
 
+void IncrementalCoverage::forget_undo() {
+  before_.clear();
+}
+
 bool IncrementalCoverage::remove_last_shot() {
   if (before_.empty()) return false;
   analysis_ = std::move(before_.back());

@@ -98,11 +98,14 @@ class IncrementalCoverage {
   void add_shot(const ir::Shot& shot);
   // Takes the last shot back; false when it is not kept (more than kUndoDepth shots back).
   bool remove_last_shot();
+  // Drops the kept states, so that remove_last_shot() returns false until shots are added again:
+  // an analysis kept for a scene that may come back need not keep its undo too.
+  void forget_undo();
   int shot_count() const;
   const std::vector<ir::Shot>& shots() const { return shots_; }
   CoverageResult result() const;
 
-  static constexpr size_t kUndoDepth = 32;
+  static constexpr size_t kUndoDepth = 16;
 
  private:
   std::shared_ptr<const ir::Scene> scene_;

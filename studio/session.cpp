@@ -611,6 +611,10 @@ std::optional<analysis::CoverageResult> Session::analyse(std::deque<AnalysisCach
     if (caches.size() > kKeptAnalyses) caches.pop_back();
     hit = caches.begin();
   }
+  // Each kept state is a copy of the whole analysis: only the scene in use keeps its undo.
+  for (auto& other : caches) {
+    if (&other != &*hit && other.run) other.run->forget_undo();
+  }
   AnalysisCache& cache = *hit;
   if (cache.run) {
     const auto& kept = cache.run->shots();
