@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
+#include "io/allocator.h"
 #include "studio/server.h"
 
 namespace rigc::cli {
@@ -45,6 +46,7 @@ int run_studio_command(std::vector<std::string> args) {
   // Before any thread starts (the compiler's and the renderer's workers inherit the mask).
   const sigset_t signals = block_stop_signals();
 
+  share_heap_arenas();  // before the workers start
   // Each camera move and setting is a compile of the scene: its mesh is loaded once.
   keep_loaded_models(true);
   std::string error;
