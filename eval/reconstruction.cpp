@@ -107,18 +107,6 @@ bool load_gltf(const fs::path& path, ReconstructionGeometry& g, std::string* err
   return true;
 }
 
-// A PLY property's size in bytes, 0 for a type PLY does not have.
-int ply_type_size(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
-      type == "float32") {
-    return 4;
-  }
-  if (type == "double" || type == "float64") return 8;
-  return 0;
-}
-
 // The layout of a binary little-endian PLY cloud: its only non-empty element is `vertex`, of
 // scalar properties with float or double x, y, z.
 struct PlyCloudLayout {
@@ -154,7 +142,7 @@ std::optional<PlyCloudLayout> ply_cloud_layout(std::istream& in) {
     } else if (word == "property" && element == "vertex") {
       std::string type, name;
       words >> type >> name;
-      const int size = ply_type_size(type);
+      const int size = ply_type_bytes(type);
       if (size == 0) return std::nullopt;  // a list
       const int axis = name == "x" ? 0 : name == "y" ? 1 : name == "z" ? 2 : -1;
       if (axis >= 0) {

@@ -52,17 +52,6 @@ std::vector<std::string> header_lines(std::istream& in, const std::string& last,
   return {};
 }
 
-int ply_scalar_bytes(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
-      type == "float32") {
-    return 4;
-  }
-  if (type == "double" || type == "float64") return 8;
-  return 1;
-}
-
 // PLY: each element at least its scalar properties' bytes and its lists' counts (binary), or two
 // characters a property (ASCII).
 std::string ply_overclaims(std::istream& in, Bytes size) {
@@ -86,7 +75,7 @@ std::string ply_overclaims(std::istream& in, Bytes size) {
     } else if (keyword == "property" && !elements.empty()) {
       words >> type;
       if (type == "list") words >> count_type;
-      elements.back().each += ascii ? 2 : ply_scalar_bytes(type == "list" ? count_type : type);
+      elements.back().each += ascii ? 2 : ply_type_bytes(type == "list" ? count_type : type);
     }
   }
   Bytes least = 0;
@@ -166,6 +155,17 @@ std::string pts_overclaims(std::istream& in, Bytes size) {
 }
 
 }  // namespace
+
+int ply_type_bytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32") {
+    return 4;
+  }
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
 
 std::string header_overclaims(const fs::path& path, const std::string& ext) {
   std::error_code ec;

@@ -8,6 +8,9 @@
 
 namespace rigc::eval {
 
+// A PLY property's size in bytes, 0 for a type PLY does not have.
+int ply_type_bytes(const std::string& type);
+
 // Empty when the header of the file at `path` (its format from `ext`, lower case with the dot)
 // states nothing the file cannot hold; otherwise why, worded to follow the file's name ("announces
 // 100000000 points (at least 1600000000 bytes) but holds 40 bytes after its header").

@@ -399,32 +399,24 @@ TEST_F(StudioApi, ASceneWithABrokenByteIsAFileErrorAndTheStateStaysJson) {
 }
 
 // Listening on every interface, the server answers to the machine's own names and addresses.
-TEST(StudioServerHosts, OnEveryInterfaceTheMachinesOwnNamesAreAccepted) {
-  testing::TempDir dir;
-  const auto scene_file = dir.path() / "scene.yaml";
-  std::ofstream(scene_file) << kStudioTestScene;
-  std::string error;
-  const auto session = Session::open(scene_file, &error, dir.path() / "run");
-  ASSERT_TRUE(session) << error;
-  ServerOptions options;
-  options.host = "0.0.0.0";
-  StudioServer server(*session, options);
-  const int port = server.bind(&error);
-  ASSERT_GT(port, 0) << error;
-  std::thread thread([&] { server.run(); });
-  while (!server.is_running()) std::this_thread::yield();
-  httplib::Client client("127.0.0.1", port);
-  client.set_default_headers({{"X-Rigc-Token", server.token()}});
+class StudioOnEveryInterface : public StudioServerTest {
+ protected:
+  ServerOptions server_options() const override {
+    ServerOptions options;
+    options.host = "0.0.0.0";
+    return options;
+  }
+};
+
+TEST_F(StudioOnEveryInterface, TheMachinesOwnNamesAreAccepted) {
   char hostname[256] = {};
   gethostname(hostname, sizeof hostname - 1);
-  const std::string suffix = ":" + std::to_string(port);
+  const std::string suffix = ":" + std::to_string(server_->port());
   for (const std::string& name : std::vector<std::string>{"127.0.0.1", "localhost", hostname}) {
-    EXPECT_EQ(client.Get("/api/state", {{"Host", name + suffix}})->status, 200) << name;
+    EXPECT_EQ(client_->Get("/api/state", {{"Host", name + suffix}})->status, 200) << name;
   }
-  EXPECT_EQ(client.Get("/api/state", {{"Host", "evil.example" + suffix}})->status, 403);
-  EXPECT_EQ(client.Get("/api/state", {{"Host", "0.0.0.0" + suffix}})->status, 403);
-  server.stop();
-  thread.join();
+  EXPECT_EQ(client_->Get("/api/state", {{"Host", "evil.example" + suffix}})->status, 403);
+  EXPECT_EQ(client_->Get("/api/state", {{"Host", "0.0.0.0" + suffix}})->status, 403);
 }
 
 // Connects to 127.0.0.1:port; -1 when it cannot.
@@ -441,26 +433,23 @@ int connect_to(int port) {
   return sock;
 }
 
+// A short deadline and fewer workers than slow clients.
+class StudioWithADeadline : public StudioServerTest {
+ protected:
+  ServerOptions server_options() const override {
+    ServerOptions options;
+    options.request_deadline = std::chrono::milliseconds(500);
+    options.workers = 4;
+    return options;
+  }
+};
+
 // Slow clients, more than there are workers, each sending its request's header a byte at a
 // time: the server closes each when its request is late, and answers a quick client meanwhile.
-TEST(StudioServerDeadline, ClientsTricklingTheirHeadersAreClosedAndOthersServed) {
-  testing::TempDir dir;
-  const auto scene_file = dir.path() / "scene.yaml";
-  std::ofstream(scene_file) << kStudioTestScene;
-  std::string error;
-  const auto session = Session::open(scene_file, &error, dir.path() / "run");
-  ASSERT_TRUE(session) << error;
-  ServerOptions options;
-  options.request_deadline = std::chrono::milliseconds(500);
-  options.workers = 4;
-  StudioServer server(*session, options);
-  const int port = server.bind(&error);
-  ASSERT_GT(port, 0) << error;
-  std::thread serving([&] { server.run(); });
-  while (!server.is_running()) std::this_thread::yield();
-
+TEST_F(StudioWithADeadline, ClientsTricklingTheirHeadersAreClosedAndOthersServed) {
+  const int port = server_->port();
   const std::string request = "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                              "\r\nX-Rigc-Token: " + server.token() + "\r\n\r\n";
+                              "\r\nX-Rigc-Token: " + server_->token() + "\r\n\r\n";
   constexpr int kSlowClients = 8;  // twice the workers
   std::vector<std::size_t> sent(kSlowClients, 0);
   std::vector<std::thread> slow;
@@ -479,17 +468,13 @@ TEST(StudioServerDeadline, ClientsTricklingTheirHeadersAreClosedAndOthersServed)
     });
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  httplib::Client quick("127.0.0.1", port);
-  quick.set_default_headers({{"X-Rigc-Token", server.token()}});
-  const auto res = quick.Get("/api/state");
+  const auto res = client_->Get("/api/state");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
   for (auto& t : slow) t.join();
   for (int c = 0; c < kSlowClients; ++c) {
     EXPECT_LT(sent[c], request.size()) << "slow client " << c << " sent its whole request";
   }
-  server.stop();
-  serving.join();
 }
 
 TEST_F(StudioApi, LightsAreAddedChangedAndRemoved) {

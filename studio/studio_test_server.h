@@ -26,7 +26,7 @@ class StudioServerTest : public ::testing::Test {
     std::string error;
     session_ = Session::open(scene_file_, &error, dir_.path() / "run");
     ASSERT_TRUE(session_) << error;
-    server_ = std::make_unique<StudioServer>(*session_, ServerOptions{});
+    server_ = std::make_unique<StudioServer>(*session_, server_options());
     const int port = server_->bind(&error);
     ASSERT_GT(port, 0) << error;
     thread_ = std::thread([this] { server_->run(); });
@@ -35,6 +35,9 @@ class StudioServerTest : public ::testing::Test {
     client_->set_read_timeout(60);
     client_->set_default_headers({{"X-Rigc-Token", server_->token()}});
   }
+  // The server's options: a test fixture of its own overrides them.
+  virtual ServerOptions server_options() const { return {}; }
+
   void TearDown() override {
     if (server_) server_->stop();
     if (thread_.joinable()) thread_.join();
