@@ -17,24 +17,30 @@ void set_error(std::string* error, std::string text) {
   if (error != nullptr) *error = std::move(text);
 }
 
+// A temporary's name, its writer's PID the first group. The suffix is atomic_file.cpp's
+// unique_suffix: ".tmp.PID.COUNTER.HEX".
+const std::regex& temporary_name_pattern() {
+  static const std::regex pattern(R"(\..+\.tmp\.([0-9]+)\.[0-9]+\.[0-9a-f]+)");
+  return pattern;
+}
+
 }  // namespace
 
-// The suffix is atomic_file.cpp's unique_suffix: ".tmp.PID.COUNTER.HEX".
 bool is_temporary_name(const std::string& filename) {
-  static const std::regex pattern(R"(\..+\.tmp\.[0-9]+\.[0-9]+\.[0-9a-f]+)");
-  return std::regex_match(filename, pattern);
+  return std::regex_match(filename, temporary_name_pattern());
 }
 
 int remove_abandoned_temporaries(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
-  static const std::regex pattern(R"(\..+\.tmp\.([0-9]+)\.[0-9]+\.[0-9a-f]+)");
   int removed = 0;
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     std::smatch match;
     std::error_code file_ec;
-    if (!std::regex_match(name, match, pattern) || !it->is_regular_file(file_ec)) continue;
+    if (!std::regex_match(name, match, temporary_name_pattern()) || !it->is_regular_file(file_ec)) {
+      continue;
+    }
     const long pid = std::strtol(match[1].str().c_str(), nullptr, 10);
     const bool writer_alive =
         pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
