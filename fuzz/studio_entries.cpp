@@ -45,7 +45,7 @@ void studio_edits(std::string_view input) {
     throw std::logic_error("a refused edit request says not why");
   }
   // Every answer is sent as JSON text: it must serialise.
-  (void)answer.body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  (void)studio::answer_text(answer.body);
 }
 
 }  // namespace rigc::fuzz

@@ -139,6 +139,10 @@ constexpr auto kRoutePaths = [] {
 
 }  // namespace
 
+std::string answer_text(const json& body) {
+  return body.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 std::span<const std::string_view> edit_routes() {
   return kRoutePaths;
 }

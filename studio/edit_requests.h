@@ -28,6 +28,10 @@ std::span<const std::string_view> edit_routes();
 // change the scene refuses, 404 for a route that is no edit route.
 EditAnswer answer_edit(Session& session, std::string_view route, const std::string& body);
 
+// The JSON text an answer is sent as: bytes that are not UTF-8 (a scene's broken line quoted in
+// its diagnostics) become U+FFFD instead of an exception and a 500 for every answer.
+std::string answer_text(const nlohmann::json& body);
+
 // `body` as a JSON object nested at most 16 levels deep, or nullopt and why in `answer`.
 std::optional<nlohmann::json> json_object_body(const std::string& body, EditAnswer* answer);
 

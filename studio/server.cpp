@@ -29,19 +29,13 @@ constexpr const char* kThreeDir = "/usr/share/javascript/three/";
 constexpr const char* kJson = "application/json; charset=utf-8";
 constexpr const char* kJavaScript = "application/javascript; charset=utf-8";
 
-// JSON text of `body`; bytes that are not UTF-8 (a scene's broken line quoted in its diagnostics)
-// become U+FFFD instead of an exception and a 500 for every answer.
-std::string json_text(const nlohmann::json& body) {
-  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 void send_error(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
-  res.set_content(json_text(nlohmann::json{{"error", message}}), kJson);
+  res.set_content(answer_text(nlohmann::json{{"error", message}}), kJson);
 }
 
 void send_json(httplib::Response& res, const nlohmann::json& body) {
-  res.set_content(json_text(body), kJson);
+  res.set_content(answer_text(body), kJson);
 }
 
 std::string read_file(const std::string& path) {
@@ -283,7 +277,7 @@ void StudioServer::add_edit_routes() {
                   [this, route](const httplib::Request& req, httplib::Response& res) {
                     const EditAnswer answer = answer_edit(session_, route, req.body);
                     res.status = answer.status;
-                    res.set_content(json_text(answer.body), kJson);
+                    res.set_content(answer_text(answer.body), kJson);
                   });
   }
   add_reference_routes();
