@@ -63,6 +63,29 @@ Cells cells_from(const std::array<float, 3>& first, const std::array<int, 3>& n)
   return cells;
 }
 
+// The dots of eight cells (a cell a lane): their centres' offsets within the cell and their radii.
+struct CellDots {
+  std::array<F32x8, kDotsPerCell> x, y, z, radius;
+};
+
+CellDots dots_of(F32x8 cx, F32x8 cy, F32x8 cz, float seed_offset) {
+  const F32x8 hx = perm(mod289(cx) + seed_offset);
+  const F32x8 hy = perm(hx + mod289(cy));
+  const F32x8 hash = perm(hy + mod289(cz));
+  CellDots dots;
+  for (int dot = 0; dot < kDotsPerCell; ++dot) {
+    const F32x8 g1 = perm(hash + kDotStarts[dot]);
+    const F32x8 g2 = perm(g1 + 1);
+    const F32x8 g3 = perm(g2 + 1);
+    const F32x8 g4 = perm(g3 + 1);
+    dots.x[dot] = g1 * (1 / kPrime);
+    dots.y[dot] = g2 * (1 / kPrime);
+    dots.z[dot] = g3 * (1 / kPrime);
+    dots.radius[dot] = kRadiusMin + g4 * (kRadiusSpan / (kPrime - 1));
+  }
+  return dots;
+}
+
 // The darkest of the dots of `cells` at eight points (a point a lane), for one edge half-width.
 // Each dot's darkness at a point comes from the same operations whichever other cells and points
 // the call holds, and a dot of a cell outside a point's own 2 x 2 x 2 lies more than half a cell
@@ -71,20 +94,8 @@ F32x8 darkness_among(F32x8 qx, F32x8 qy, F32x8 qz, const Cells& cells, float see
                      float edge) {
   F32x8 darkness{};
   for (int g = 0; g < cells.groups; ++g) {
-    const F32x8 hx = perm(mod289(cells.x[g]) + seed_offset);
-    const F32x8 hy = perm(hx + mod289(cells.y[g]));
-    const F32x8 hash = perm(hy + mod289(cells.z[g]));
-    std::array<F32x8, kDotsPerCell> gx, gy, gz, radius;
-    for (int dot = 0; dot < kDotsPerCell; ++dot) {
-      const F32x8 g1 = perm(hash + kDotStarts[dot]);
-      const F32x8 g2 = perm(g1 + 1);
-      const F32x8 g3 = perm(g2 + 1);
-      const F32x8 g4 = perm(g3 + 1);
-      gx[dot] = g1 * (1 / kPrime);
-      gy[dot] = g2 * (1 / kPrime);
-      gz[dot] = g3 * (1 / kPrime);
-      radius[dot] = kRadiusMin + g4 * (kRadiusSpan / (kPrime - 1));
-    }
+    const CellDots dots = dots_of(cells.x[g], cells.y[g], cells.z[g], seed_offset);
+    const auto &gx = dots.x, &gy = dots.y, &gz = dots.z, &radius = dots.radius;
     for (int c = 0; c < 8; ++c) {
       const F32x8 dx = qx - cells.x[g][c], dy = qy - cells.y[g][c], dz = qz - cells.z[g][c];
       for (int dot = 0; dot < kDotsPerCell; ++dot) {
@@ -160,6 +171,186 @@ double darkness_reference(double qx, double qy, double qz, double seed_offset, d
       const double t = std::clamp((radius + w - dist) / (2 * w), 0.0, 1.0);
       darkness = std::max(darkness, t * t * (3 - 2 * t));
     }
+  }
+  return darkness;
+}
+
+namespace {
+
+// What dots_over8 keeps of each lane: whether a dot covers all of its pixel, and the dots whose
+// edges reach into it (their count past CrossingDots::kMost still counted).
+struct LaneDots {
+  explicit LaneDots(std::array<CrossingDots, 8>& crossing) : crossing(crossing) {
+    for (CrossingDots& dots : crossing) dots.count = 0;
+  }
+  simd::I32x8 full{};
+  std::array<CrossingDots, 8>& crossing;
+};
+
+// Calls visit(x, y, z, count) for the cells of the n[0] x n[1] x n[2] box from `first` that
+// `wanted(x, y, z)` keeps, eight at a time, lanes [0, count) of x, y and z holding their
+// coordinates.
+template <typename Wanted, typename Visit>
+void for_each_cell_group(const std::array<float, 3>& first, const std::array<int, 3>& n,
+                         const Wanted& wanted, const Visit& visit) {
+  F32x8 x{}, y{}, z{};
+  int lane = 0;
+  for (int k = 0; k < n[2]; ++k) {
+    const float cz = first[2] + static_cast<float>(k);
+    for (int j = 0; j < n[1]; ++j) {
+      const float cy = first[1] + static_cast<float>(j);
+      for (int i = 0; i < n[0]; ++i) {
+        const float cx = first[0] + static_cast<float>(i);
+        if (!wanted(cx, cy, cz)) continue;
+        x[lane] = cx;
+        y[lane] = cy;
+        z[lane] = cz;
+        if (++lane == 8) {
+          visit(x, y, z, 8);
+          lane = 0;
+        }
+      }
+    }
+  }
+  if (lane > 0) visit(x, y, z, lane);
+}
+
+// What dots_over8 derives of each footprint: its sides' squared lengths and their dot product,
+// and its reach, half the sum of the sides' lengths (no point of the pixel lies farther from its
+// centre).
+struct FootprintShape {
+  explicit FootprintShape(const Footprints8& p)
+      : dx_squared(p.dxx * p.dxx + p.dxy * p.dxy + p.dxz * p.dxz),
+        dy_squared(p.dyx * p.dyx + p.dyy * p.dyy + p.dyz * p.dyz),
+        sides_dot(p.dxx * p.dyx + p.dxy * p.dyy + p.dxz * p.dyz),
+        reach(0.5f * (simd::sqrt(dx_squared) + simd::sqrt(dy_squared))) {}
+  F32x8 dx_squared, dy_squared, sides_dot, reach;
+};
+
+F32x8 abs8(F32x8 v) {
+  return v < 0 ? -v : v;
+}
+F32x8 max8(F32x8 a, F32x8 b) {
+  return a > b ? a : b;
+}
+
+// Adds the dots of cells (x, y, z) [0, count) to the lanes of `lanes` that `active` selects.
+void gather_dots(const Footprints8& p, const FootprintShape& shape, simd::I32x8 active, F32x8 x,
+                 F32x8 y, F32x8 z, int count, float seed_offset, LaneDots& lanes) {
+  const F32x8 &dx_squared = shape.dx_squared, &dy_squared = shape.dy_squared, &reach = shape.reach;
+  const CellDots dots_here = dots_of(x, y, z, seed_offset);
+  for (int c = 0; c < count; ++c) {
+    for (int dot = 0; dot < kDotsPerCell; ++dot) {
+      const float r = dots_here.radius[dot][c];
+      const float w = std::min(kEdge, 0.5f - r);
+      const F32x8 ex = p.qx - (x[c] + dots_here.x[dot][c]),
+                  ey = p.qy - (y[c] + dots_here.y[dot][c]),
+                  ez = p.qz - (z[c] + dots_here.z[dot][c]);
+      const F32x8 squared = ex * ex + ey * ey + ez * ez;
+      const F32x8 reach_of_dot = r + w + reach;
+      const simd::I32x8 maybe = active & (squared < reach_of_dot * reach_of_dot);
+      if (!simd::any(maybe)) continue;
+      const F32x8 d = simd::sqrt(squared);
+      const F32x8 inverse = 1.0f / (d > 1e-12f ? d : F32x8{} + 1e-12f);
+      const F32x8 along_x = p.dxx * ex + p.dxy * ey + p.dxz * ez;
+      const F32x8 along_y = p.dyx * ex + p.dyy * ey + p.dyz * ez;
+      const F32x8 half = 0.5f * (abs8(along_x) + abs8(along_y)) * inverse;
+      // The distance over the pixel is at least d - half (its projection on the direction to the
+      // point), and at most its largest at a corner: |e + s dx + t dy|^2 for s, t = +-1/2.
+      const simd::I32x8 near = maybe & (d - half < r + w);
+      const F32x8 corners = max8(abs8(along_x + along_y) + 0.5f * shape.sides_dot,
+                                 abs8(along_x - along_y) - 0.5f * shape.sides_dot);
+      const F32x8 farthest = squared + 0.25f * (dx_squared + dy_squared) + corners;
+      const simd::I32x8 full = near & (farthest <= (r - w) * (r - w));
+      lanes.full |= full;
+      const simd::I32x8 crossing = near & ~full;
+      if (!simd::any(crossing)) continue;
+      for (int k = 0; k < 8; ++k) {
+        if (!crossing[k]) continue;
+        CrossingDots& dots = lanes.crossing[k];
+        if (dots.count < CrossingDots::kMost) {
+          dots.x[dots.count] = x[c] + dots_here.x[dot][c];
+          dots.y[dots.count] = y[c] + dots_here.y[dot][c];
+          dots.z[dots.count] = z[c] + dots_here.z[dot][c];
+          dots.radius[dots.count] = r;
+          dots.edge[dots.count] = w;
+        }
+        ++dots.count;
+      }
+    }
+  }
+}
+
+// The cells from floor(v - 0.5 - reach) to floor(v - 0.5 + reach) + 1 of the lanes `active`
+// selects, as the first and the count along one axis.
+std::pair<float, int> cell_range(F32x8 v, F32x8 reach, simd::I32x8 active) {
+  const F32x8 low = simd::floor(v - 0.5f - reach), high = simd::floor(v - 0.5f + reach) + 1;
+  float first = 0, last = 0;
+  bool any = false;
+  for (int k = 0; k < 8; ++k) {
+    if (!active[k]) continue;
+    first = any ? std::min(first, low[k]) : low[k];
+    last = any ? std::max(last, high[k]) : high[k];
+    any = true;
+  }
+  return {first, static_cast<int>(last - first) + 1};
+}
+
+}  // namespace
+
+unsigned dots_over8(const Footprints8& p, float seed_offset,
+                    std::array<CrossingDots, 8>& crossing) {
+  const FootprintShape shape(p);
+  const F32x8& reach = shape.reach;
+  LaneDots lanes(crossing);
+  auto gather_for = [&](simd::I32x8 active) {
+    const auto [x0, nx] = cell_range(p.qx, reach, active);
+    const auto [y0, ny] = cell_range(p.qy, reach, active);
+    const auto [z0, nz] = cell_range(p.qz, reach, active);
+    // A cell's dots lie within half a cell of it: the cells no active pixel comes that near of
+    // are left undrawn (the pixels lie on a surface, the box of cells spans a volume).
+    const F32x8 low_x = p.qx - reach - 1.5f, high_x = p.qx + reach + 0.5f;
+    const F32x8 low_y = p.qy - reach - 1.5f, high_y = p.qy + reach + 0.5f;
+    const F32x8 low_z = p.qz - reach - 1.5f, high_z = p.qz + reach + 0.5f;
+    auto wanted = [&](float cx, float cy, float cz) {
+      return simd::any(active & (low_x < cx) & (cx < high_x) & (low_y < cy) & (cy < high_y) &
+                       (low_z < cz) & (cz < high_z));
+    };
+    auto visit = [&](F32x8 x, F32x8 y, F32x8 z, int count) {
+      gather_dots(p, shape, active, x, y, z, count, seed_offset, lanes);
+    };
+    for_each_cell_group({x0, y0, z0}, {nx, ny, nz}, wanted, visit);
+  };
+  // Pixels close together (as a rule) share their cells; scattered ones take theirs in turn.
+  const simd::I32x8 all = simd::I32x8{} - 1;
+  const auto [x0, nx] = cell_range(p.qx, reach, all);
+  const auto [y0, ny] = cell_range(p.qy, reach, all);
+  const auto [z0, nz] = cell_range(p.qz, reach, all);
+  if (nx * ny * nz <= 64) {
+    gather_for(all);
+  } else {
+    for (int k = 0; k < 8; ++k) {
+      simd::I32x8 one{};
+      one[k] = -1;
+      gather_for(one);
+    }
+  }
+  unsigned full = 0;
+  for (int k = 0; k < 8; ++k) {
+    if (lanes.full[k]) full |= 1u << k;
+    if (crossing[k].count > CrossingDots::kMost) crossing[k].count = -1;
+  }
+  return full;
+}
+
+F32x8 darkness_of8(F32x8 qx, F32x8 qy, F32x8 qz, const CrossingDots& dots) {
+  F32x8 darkness{};
+  for (int i = 0; i < dots.count; ++i) {
+    const F32x8 ex = qx - dots.x[i], ey = qy - dots.y[i], ez = qz - dots.z[i];
+    const float r = dots.radius[i], w = dots.edge[i];
+    const F32x8 value =
+        smoothstep01((r + w - simd::sqrt(ex * ex + ey * ey + ez * ez)) * (0.5f / w));
+    darkness = value > darkness ? value : darkness;
   }
   return darkness;
 }

@@ -57,6 +57,30 @@ simd::F32x8 darkness8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, float seed
 // literally, for tests of darkness8 and of the backends' transcriptions.
 double darkness_reference(double qx, double qy, double qz, double seed_offset, double edge);
 
+// Eight pixels' footprints on the surface, in cells: pixel k covers q + s dx + t dy, s and t in
+// [-1/2, 1/2], at lane k of each vector.
+struct Footprints8 {
+  simd::F32x8 qx, qy, qz, dxx, dxy, dxz, dyx, dyy, dyz;
+};
+
+// The dots whose soft edges reach into a footprint: centres (cells), radii and edge half-widths.
+struct CrossingDots {
+  static constexpr int kMost = 8;
+  int count = 0;
+  std::array<float, kMost> x, y, z, radius, edge;
+};
+
+// The dots over each of eight footprints (at edge kEdge), gathered once a pixel for its box
+// filter: bit k of the result is set where a dot covers all of pixel k (its darkness is 1);
+// otherwise crossing[k] holds the dots whose soft edges reach into it (none: its darkness is 0),
+// and its darkness at any point of it is theirs alone (darkness_of8). More than
+// CrossingDots::kMost such dots leave crossing[k].count at -1 (sample the pattern itself).
+unsigned dots_over8(const Footprints8& pixels, float seed_offset,
+                    std::array<CrossingDots, 8>& crossing);
+
+// The darkness at eight points where only `dots` can reach: the darkest of them.
+simd::F32x8 darkness_of8(simd::F32x8 qx, simd::F32x8 qy, simd::F32x8 qz, const CrossingDots& dots);
+
 }  // namespace rigc::scene::speckle
 
 // The `noise` pattern on the speckle's hash: three octaves of value noise, one function of the

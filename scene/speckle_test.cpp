@@ -125,3 +125,62 @@ TEST(Speckle, NoiseSimdMatchesTheReferenceDefinition) {
 
 }  // namespace
 }  // namespace rigc::scene::noise
+
+namespace rigc::scene::speckle {
+namespace {
+
+// The dots gathered over a pixel are all that darken it: at any point of the pixel the darkness
+// from them alone is the pattern's, a pixel called covered is dark all over, and one with no
+// dots is light all over.
+TEST(Speckle, DotsOverAPixelAreAllThatDarkenIt) {
+  std::mt19937 random(9);
+  std::uniform_real_distribution<float> coordinate(-60.0f, 60.0f), side(-0.35f, 0.35f),
+      offset(-0.5f, 0.5f), spread(0.0f, 0.4f);
+  int covered = 0, light = 0, crossed = 0;
+  for (int batch = 0; batch < 400; ++batch) {
+    Footprints8 pixels;
+    // Half the batches close together (one surface), half scattered.
+    const float x = coordinate(random), y = coordinate(random), z = coordinate(random);
+    const bool close = batch % 2 == 0;
+    for (int k = 0; k < 8; ++k) {
+      pixels.qx[k] = close ? x + spread(random) : coordinate(random);
+      pixels.qy[k] = close ? y + spread(random) : coordinate(random);
+      pixels.qz[k] = close ? z + spread(random) : coordinate(random);
+      for (simd::F32x8* v :
+           {&pixels.dxx, &pixels.dxy, &pixels.dxz, &pixels.dyx, &pixels.dyy, &pixels.dyz}) {
+        (*v)[k] = side(random);
+      }
+    }
+    std::array<CrossingDots, 8> crossing;
+    const unsigned full = dots_over8(pixels, seed_offset(5), crossing);
+    for (int k = 0; k < 8; ++k) {
+      ASSERT_GE(crossing[k].count, 0) << "more dots than kMost over a pixel of this size";
+      simd::F32x8 qx, qy, qz;
+      for (int m = 0; m < 8; ++m) {
+        const float s = offset(random), t = offset(random);
+        qx[m] = pixels.qx[k] + s * pixels.dxx[k] + t * pixels.dyx[k];
+        qy[m] = pixels.qy[k] + s * pixels.dxy[k] + t * pixels.dyy[k];
+        qz[m] = pixels.qz[k] + s * pixels.dxz[k] + t * pixels.dyz[k];
+      }
+      const simd::F32x8 want = darkness8(qx, qy, qz, seed_offset(5), simd::F32x8{} + kEdge);
+      const simd::F32x8 from_dots = darkness_of8(qx, qy, qz, crossing[k]);
+      for (int m = 0; m < 8; ++m) {
+        if (full >> k & 1u) {
+          EXPECT_EQ(want[m], 1.0f);
+        } else {
+          EXPECT_NEAR(from_dots[m], want[m], 1e-4);  // rounding: the centres are summed once
+        }
+      }
+      covered += (full >> k) & 1u;
+      light += !((full >> k) & 1u) && crossing[k].count == 0;
+      crossed += !((full >> k) & 1u) && crossing[k].count > 0;
+    }
+  }
+  // Every kind of pixel was met.
+  EXPECT_GT(covered, 10);
+  EXPECT_GT(light, 100);
+  EXPECT_GT(crossed, 100);
+}
+
+}  // namespace
+}  // namespace rigc::scene::speckle

@@ -319,6 +319,94 @@ class SampleStream {
   int lanes_ = 0;
 };
 
+// A pixel's footprint in cells for the pattern's box filter: its centre and sides, the pixel,
+// and its grid of point samples.
+struct PixelFootprint {
+  Vector3f at, dx, dy;
+  int pixel, nx, ny;
+};
+
+// The nx x ny grid of point samples over a pixel.
+void add_grid(SampleStream& stream, const PixelFootprint& part) {
+  for (int j = 0; j < part.ny; ++j) {
+    const float t = (j + 0.5f) / part.ny - 0.5f;
+    for (int k = 0; k < part.nx; ++k) {
+      stream.add(part.at + ((k + 0.5f) / part.nx - 0.5f) * part.dx + t * part.dy, part.pixel);
+    }
+  }
+}
+
+// The sum of the darknesses of a pixel's nx x ny grid of point samples, taken against the only
+// dots that reach it, eight samples at a time.
+float grid_darkness_sum(const PixelFootprint& pixel, const speckle::CrossingDots& dots) {
+  using simd::F32x8;
+  const int samples = pixel.nx * pixel.ny;
+  const float nx = static_cast<float>(pixel.nx), ny = static_cast<float>(pixel.ny);
+  const F32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+  F32x8 sum{};
+  for (int first = 0; first < samples; first += 8) {
+    const F32x8 index = lane + static_cast<float>(first);
+    const F32x8 row = simd::floor((index + 0.5f) / nx);
+    const F32x8 s = (index - row * nx + 0.5f) / nx - 0.5f, t = (row + 0.5f) / ny - 0.5f;
+    const F32x8 qx = pixel.at.x() + s * pixel.dx.x() + t * pixel.dy.x();
+    const F32x8 qy = pixel.at.y() + s * pixel.dx.y() + t * pixel.dy.y();
+    const F32x8 qz = pixel.at.z() + s * pixel.dx.z() + t * pixel.dy.z();
+    F32x8 darkness = speckle::darkness_of8(qx, qy, qz, dots);
+    darkness = darkness > 1 ? F32x8{} + 1 : darkness;
+    sum += index < static_cast<float>(samples) ? darkness : F32x8{};
+  }
+  return simd::sum(sum);
+}
+
+// The speckle's box filter, eight pixels at a time: the dots over each pixel are gathered once
+// (speckle::dots_over8), then its grid of samples is taken against those dots alone; a pixel
+// inside a dot is 1 and one that no dot reaches 0 without a sample.
+class SpeckleBoxFilter {
+ public:
+  SpeckleBoxFilter(const ir::SurfacePattern& pattern, SampleStream& stream, float* sums)
+      : seed_offset_(speckle::seed_offset(pattern.seed)), stream_(stream), sums_(sums) {}
+
+  void add(const PixelFootprint& part) {
+    parts_[count_++] = part;
+    if (count_ == 8) flush();
+  }
+
+  void flush() {
+    if (count_ == 0) return;
+    speckle::Footprints8 footprints{};
+    for (int k = 0; k < 8; ++k) {
+      const PixelFootprint& part = parts_[std::min(k, count_ - 1)];  // spare lanes: the last
+      footprints.qx[k] = part.at.x(), footprints.qy[k] = part.at.y(),
+      footprints.qz[k] = part.at.z();
+      footprints.dxx[k] = part.dx.x(), footprints.dxy[k] = part.dx.y(),
+      footprints.dxz[k] = part.dx.z();
+      footprints.dyx[k] = part.dy.x(), footprints.dyy[k] = part.dy.y(),
+      footprints.dyz[k] = part.dy.z();
+    }
+    const unsigned full = speckle::dots_over8(footprints, seed_offset_, crossing_);
+    for (int k = 0; k < count_; ++k) {
+      const PixelFootprint& part = parts_[k];
+      const int samples = part.nx * part.ny;
+      if (full >> k & 1u) {
+        sums_[part.pixel] += static_cast<float>(samples);
+      } else if (crossing_[k].count > 0) {
+        sums_[part.pixel] += grid_darkness_sum(part, crossing_[k]);
+      } else if (crossing_[k].count < 0) {
+        add_grid(stream_, part);
+      }
+    }
+    count_ = 0;
+  }
+
+ private:
+  float seed_offset_;
+  SampleStream& stream_;
+  float* sums_;
+  std::array<PixelFootprint, 8> parts_;
+  std::array<speckle::CrossingDots, 8> crossing_;
+  int count_ = 0;
+};
+
 }  // namespace
 
 bool has_pattern(const ir::SurfacePattern& pattern) {
@@ -336,17 +424,22 @@ void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface
   // out[i] first sums pixel i's sample darknesses, in units of the pattern's scale.
   std::fill_n(out, count, 0.0f);
   SampleStream stream(pattern, out);
+  SpeckleBoxFilter speckle_filter(pattern, stream, out);
+  const bool speckle = pattern.kind == ir::PatternKind::kSpeckle;
   for (int i = 0; i < count; ++i) {
     const PixelOnSurface& pixel = pixels[i];
     const float footprint = std::max(pixel.dx.norm(), pixel.dy.norm());
     if (pattern_resolve(scale, footprint) == 0) continue;
     const Vector3f at = pixel.at / scale, dx = pixel.dx / scale, dy = pixel.dy / scale;
     const int nx = filter_side(dx, max_side), ny = filter_side(dy, max_side);
-    for (int j = 0; j < ny; ++j) {
-      const float t = (j + 0.5f) / ny - 0.5f;
-      for (int k = 0; k < nx; ++k) stream.add(at + ((k + 0.5f) / nx - 0.5f) * dx + t * dy, i);
+    // A pixel of one sample is the pattern at its centre, whatever the filter.
+    if (speckle && nx * ny > 1) {
+      speckle_filter.add({at, dx, dy, i, nx, ny});
+    } else {
+      add_grid(stream, {at, dx, dy, i, nx, ny});
     }
   }
+  speckle_filter.flush();
   stream.flush();
   // An unresolved pixel took no samples: its sum of 0 is faded away to the mean entirely.
   for (int i = 0; i < count; ++i) {

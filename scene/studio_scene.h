@@ -104,7 +104,9 @@ struct PixelOnSurface {
 // The pattern's factor averaged over each pixel's area on the surface, a one-pixel box filter as
 // the reference renderers apply (their pixel filter): a grid of point samples about a twentieth
 // of the pattern's scale apart (at most max_side x max_side), the pattern still fading to its
-// mean where a pixel spans more than half its scale. out[i] for pixels[i], count of them.
+// mean where a pixel spans more than half its scale. The speckle's samples are taken against
+// the few dots that reach the pixel, gathered once (speckle::dots_over8). A pixel whose grid is
+// one sample is the pattern at its centre. out[i] for pixels[i], count of them.
 inline constexpr int kMaxPatternFilterSide = 8;
 void pattern_factors_box(const ir::SurfacePattern& pattern, const PixelOnSurface* pixels, int count,
                          float* out, int max_side = kMaxPatternFilterSide);
