@@ -117,7 +117,7 @@ void advise_aperture(const ir::Scene& scene, const CoverageResult& coverage,
                                "95% sharp (or focus nearer the object's front)",
                                n, 100 * seen.out_of_focus / seen.visible, max_blur_px,
                                next_standard_f_number(needed_n)),
-                   {{Setting::kFNumber, +1}}});
+                   {{Setting::kFNumber, +1, next_standard_f_number(needed_n)}}});
   }
   // An Airy disc wider than the blur budget.
   const double airy_px = 2.44 * kWavelengthM * n / pixel_pitch_m;
@@ -131,7 +131,8 @@ void advise_aperture(const ir::Scene& scene, const CoverageResult& coverage,
                      n, pixel_pitch_m * 1e6, airy_px,
                      next_standard_f_number(std::max(needed_n, limits::camera::kAperture.min)),
                      limit_n, max_blur_px),
-         {{Setting::kFNumber, -1}}});
+         {{Setting::kFNumber, -1,
+           next_standard_f_number(std::max(needed_n, limits::camera::kAperture.min))}}});
   }
 }
 
@@ -158,6 +159,29 @@ std::vector<SettingChange> light_changes(int direction, const std::vector<Advice
   return changes;
 }
 
+// Each change's value for `stops` more light (fewer where negative): the shutter, the ISO and
+// the light by 2^stops, the f-number (stopped down to take the light away) by 2^(-stops / 2),
+// to the next standard one.
+void set_exposure_values(const ir::Camera& camera, double stops,
+                         std::vector<SettingChange>& changes) {
+  for (SettingChange& change : changes) {
+    switch (change.setting) {
+      case Setting::kShutter:
+        change.value = camera.shutter_s * std::exp2(stops);
+        break;
+      case Setting::kIso:
+        change.value = camera.iso * std::exp2(stops);
+        break;
+      case Setting::kLight:
+        change.value = std::exp2(stops);
+        break;
+      case Setting::kFNumber:
+        change.value = next_standard_f_number(camera.aperture_f_number * std::exp2(-stops / 2));
+        break;
+    }
+  }
+}
+
 bool offers(const std::vector<SettingChange>& changes, Setting setting) {
   return std::any_of(changes.begin(), changes.end(),
                      [&](const SettingChange& c) { return c.setting == setting; });
@@ -180,6 +204,7 @@ void advise_over_exposure(const ir::Scene& scene, const SeenSurface& seen,
     remedy = stop_down ? "stop down, lower the ISO or dim the lights"
                        : "lower the ISO or dim the lights";
   }
+  set_exposure_values(camera, -stops, changes);
   out.push_back({first_known(camera.shutter_loc, camera.loc),
                  fmt::format("over-exposure: {:.0f}% of the seen surface clips at these settings "
                              "(EV100 {:.1f}); {} less light: {}",
@@ -198,6 +223,7 @@ void advise_under_exposure(const ir::Scene& scene, const SeenSurface& seen,
   const double stops =
       std::max(1.0 / 3, stops_to_undarken(seen.signal_histogram, seen.visible, dark_stops));
   std::vector<SettingChange> changes = light_changes(+1, given);
+  set_exposure_values(camera, stops, changes);
   const std::string remedy = offers(changes, Setting::kShutter)
                                  ? "lengthen the shutter, raise the ISO or add light"
                                  : "raise the ISO or add light (a longer shutter would smear)";
@@ -291,16 +317,17 @@ void advise_motion_blur(const ir::Scene& scene, const scene::StudioScene& studio
         camera, 1.0, std::abs(shot.turntable_velocity_rad_s), radius, depth);
     if (!(blur_px > 1)) continue;
     last_line = shot.loc.line;
-    // A shutter that keeps the smear under a pixel, if the language has one.
-    const double fastest_denominator = 1 / limits::camera::kShutter.min;
-    const double needed_denominator = std::ceil(blur_px / camera.shutter_s);
-    const bool shutter_helps = needed_denominator <= fastest_denominator;
+    // A camera's shutter speed that keeps the smear under a pixel, if there is one (the smear
+    // grows with the exposure).
+    const double sharp_shutter = camera.shutter_s / blur_px;
+    const double shutter = next_faster_standard_shutter(sharp_shutter * 0.99);
+    const bool shutter_helps = shutter <= sharp_shutter * 0.99 + 1e-12;
     const std::string remedy =
-        shutter_helps ? fmt::format("stop the table for each shot or use 1/{:.0f} s or shorter",
-                                    needed_denominator)
+        shutter_helps ? fmt::format("stop the table for each shot or use {} or shorter",
+                                    shutter_text(shutter))
                       : std::string("stop the table for each shot (no shutter is fast enough)");
     std::vector<SettingChange> changes;
-    if (shutter_helps) changes.push_back({Setting::kShutter, -1});
+    if (shutter_helps) changes.push_back({Setting::kShutter, -1, shutter});
     out.push_back({shot.loc,
                    fmt::format("the turning table smears the object by up to {:.1f} px during "
                                "the {:g} s exposure; {}",
@@ -378,6 +405,20 @@ void advise_overlap_and_framing(const ir::Scene& scene, const CoverageResult& co
 
 }  // namespace
 
+double next_faster_standard_shutter(double seconds) {
+  // Cameras' third-stop speeds from 1/8000 s to 1 s, as denominators, fastest first.
+  static constexpr double kDenominators[] = {
+      8000, 6400, 5000, 4000, 3200, 2500, 2000, 1600, 1250, 1000, 800, 640, 500, 400,
+      320,  250,  200,  160,  125,  100,  80,   60,   50,   40,   30,  25,  20,  15,
+      13,   10,   8,    6,    5,    4,    3,    2.5,  2,    1.6,  1.3, 1};
+  double slowest = 1 / kDenominators[0];
+  for (const double denominator : kDenominators) {
+    if (1 / denominator > seconds * 1.001) break;
+    slowest = 1 / denominator;
+  }
+  return slowest;
+}
+
 double next_standard_f_number(double f_number) {
   for (double stop : kFNumberStops) {
     if (stop >= f_number * 0.999) return stop;
@@ -401,6 +442,20 @@ std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioSc
   advise_unseen_faces(scene, studio, coverage, out);
   advise_overlap_and_framing(scene, coverage, out);
   return out;
+}
+
+const char* setting_name(Setting setting) {
+  switch (setting) {
+    case Setting::kShutter:
+      return "shutter";
+    case Setting::kFNumber:
+      return "f-number";
+    case Setting::kIso:
+      return "iso";
+    case Setting::kLight:
+      return "light";
+  }
+  return "";
 }
 
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,

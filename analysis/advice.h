@@ -16,12 +16,21 @@ namespace rigc::analysis {
 enum class Setting { kShutter, kFNumber, kIso, kLight };
 
 // One suggested change: the setting's value up (+1: a longer shutter, a larger f-number, a
-// higher ISO, more light) or down (-1). An advice that offers alternatives lists each.
+// higher ISO, more light) or down (-1), and the value the advice works out for it where it
+// works one out (0 otherwise): the shutter in seconds, the f-number, the ISO, or the factor the
+// light is multiplied by. An advice that offers alternatives lists each.
 struct SettingChange {
   Setting setting;
   int direction;
-  bool operator==(const SettingChange&) const = default;
+  double value = 0;
+  // The same change, whatever value each names.
+  bool operator==(const SettingChange& other) const {
+    return setting == other.setting && direction == other.direction;
+  }
 };
+
+// "shutter", "f-number", "iso" or "light".
+const char* setting_name(Setting setting);
 
 // One warning: where, what it says, and the changes it suggests. No advice for a scene suggests
 // a change another one reverses (capture_advice holds to it).
@@ -39,6 +48,10 @@ std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioSc
 // capture_advice as warnings.
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag);
+
+// The slowest of cameras' third-stop shutter speeds (1/8000 s to 1 s) at or faster than
+// `seconds`; 1/8000 s where none is.
+double next_faster_standard_shutter(double seconds);
 
 // The next standard third-stop f-number at or above `f_number`.
 double next_standard_f_number(double f_number);

@@ -107,6 +107,37 @@ TEST(Advice, UnderExposureOnATurningTableDoesNotLengthenTheShutter) {
   EXPECT_FALSE(contradicts(a.advice, &why)) << why;
 }
 
+// The change an advice works out, by setting (a default one where it offers none).
+SettingChange change_of(const Advised& a, const std::string& message_part, Setting setting) {
+  for (const Advice& advice : a.advice) {
+    if (advice.message.find(message_part) == std::string::npos) continue;
+    for (const SettingChange& c : advice.changes) {
+      if (c.setting == setting) return c;
+    }
+  }
+  return {setting, 0, 0};
+}
+
+// The values the advice works out fix what it names: the shutter it gives stops the smear, and
+// the ISO it gives lifts the surface out of the dark.
+TEST(Advice, SuggestedValuesFixWhatTheyName) {
+  const Advised turning = advise(scene_text({400, 300, "1/60", "f/8", "10deg/s"}));
+  const SettingChange shutter = change_of(turning, "the turning table smears", Setting::kShutter);
+  ASSERT_GT(shutter.value, 0) << turning.text;
+  EXPECT_LT(shutter.value, 1.0 / 60);
+  const std::string faster = fmt::format("1/{:.0f}", 1 / shutter.value);
+  const Advised sharp = advise(scene_text({400, 300, faster, "f/8", "10deg/s"}));
+  EXPECT_EQ(sharp.text.find("the turning table smears"), std::string::npos) << sharp.text;
+
+  const Advised dark = advise(scene_text({20, 300, "1/250", "f/8", ""}));
+  const SettingChange iso = change_of(dark, "under-exposure", Setting::kIso);
+  ASSERT_GT(iso.value, 200) << dark.text;
+  std::string brighter = scene_text({20, 300, "1/250", "f/8", ""});
+  brighter.replace(brighter.find("iso: 200"), 8, fmt::format("iso: {:.0f}", iso.value));
+  const Advised lifted = advise(brighter);
+  EXPECT_EQ(lifted.text.find("under-exposure"), std::string::npos) << lifted.text;
+}
+
 // Over a family of scenes (light power, ambient light, shutter, aperture, table speed), no
 // advice suggests a change another reverses, and over- and under-exposure never come together.
 TEST(Advice, NoAdviceReversesAnotherOverAFamilyOfScenes) {
@@ -141,6 +172,19 @@ TEST(Advice, NoAdviceReversesAnotherOverAFamilyOfScenes) {
   EXPECT_GT(range, 0);
   EXPECT_GT(blur, 0);
   EXPECT_GT(diffraction, 0);
+}
+
+}  // namespace
+}  // namespace rigc::analysis
+
+namespace rigc::analysis {
+namespace {
+
+TEST(Advice, ShutterSuggestionsAreCamerasSpeeds) {
+  EXPECT_DOUBLE_EQ(next_faster_standard_shutter(1.0 / 250), 1.0 / 250);
+  EXPECT_DOUBLE_EQ(next_faster_standard_shutter(1.0 / 252), 1.0 / 320);
+  EXPECT_DOUBLE_EQ(next_faster_standard_shutter(0.7), 1.0 / 1.6);
+  EXPECT_DOUBLE_EQ(next_faster_standard_shutter(1.0 / 9000), 1.0 / 8000);
 }
 
 }  // namespace

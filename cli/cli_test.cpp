@@ -1,4 +1,5 @@
 #include <fcntl.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -65,6 +66,33 @@ TEST(Cli, CheckJsonListsDiagnostics) {
   EXPECT_FALSE(json["ok"].get<bool>());
   ASSERT_EQ(json["diagnostics"].size(), 3u);
   EXPECT_EQ(json["diagnostics"][0]["line"], 8);
+}
+
+// `--format json` is the editors' form: each advice carries the settings it suggests, with the
+// values it works out.
+TEST(Cli, CheckFormatJsonGivesTheAdvicesSuggestions) {
+  testing::TempDir dir;
+  std::string text = testing::read_text(source_path("scenes/paper-turntable.yaml"));
+  // Six stops more light than the paper's exposure.
+  text.replace(text.find("shutter: 1/125"), 14, "shutter: 1/2");
+  const std::string path = dir.file("slow.yaml");
+  std::ofstream(path) << text;
+  auto result = run_rigc({"check", "--format", "json", path});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto json = nlohmann::json::parse(result.out);
+  bool valued = false;
+  for (const auto& d : json["diagnostics"]) {
+    EXPECT_EQ(d["file"], path);
+    EXPECT_GT(d["line"].get<int>(), 0);
+    ASSERT_TRUE(d.contains("suggestions")) << d.dump();
+    for (const auto& change : d["suggestions"]) {
+      EXPECT_THAT(std::string(change["setting"]),
+                  ::testing::AnyOf("shutter", "f-number", "iso", "light"));
+      valued = valued || change.contains("value");
+    }
+  }
+  EXPECT_TRUE(valued) << result.out;
+  EXPECT_EQ(run_rigc({"check", "--format", "yaml", path}).exit_code, 1);
 }
 
 TEST(Cli, MissingSceneFileIsAUserError) {
