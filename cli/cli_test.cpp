@@ -274,5 +274,19 @@ TEST(Cli, RenderCommandRejectsBadShotSelection) {
   EXPECT_FALSE(std::filesystem::exists("/tmp/rigc-never-written"));
 }
 
+// `rigc` runs check and version itself and the other verbs in rigc-all beside it: without it,
+// those verbs say so, and check still works.
+TEST(Cli, TheCoreBinaryNamesAMissingRigcAll) {
+  testing::TempDir dir;
+  const std::string core = dir.file("rigc");
+  std::filesystem::copy_file(RIGC_BINARY, core);
+  const auto check =
+      testing::run_process({core, "check", source_path("scenes/paper-turntable.yaml")});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+  const auto render = testing::run_process({core, "render", "x.yaml"});
+  EXPECT_EQ(render.exit_code, 2);
+  EXPECT_THAT(render.err, ::testing::HasSubstr("cannot start " + dir.file("rigc-all")));
+}
+
 }  // namespace
 }  // namespace rigc

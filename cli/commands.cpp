@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 
@@ -13,7 +14,9 @@
 #include "analysis/coverage.h"
 #include "analysis/coverage_output.h"
 #include "backends/registry.h"
+#include "cli/dispatch.h"
 #include "cli/options.h"
+#include "cli/verb_list.h"
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "compiler/units.h"
@@ -33,95 +36,6 @@ namespace fs = std::filesystem;
 using cli::finite_number;
 using cli::non_negative_number;
 using cli::parse_options;
-
-// Each diagnostic as JSON; those from first_advice on are advice[i - first_advice], with the
-// settings it suggests changing and the values it works out.
-nlohmann::json diagnostics_json(const DiagnosticEngine& diag,
-                                const std::vector<analysis::Advice>& advice,
-                                std::size_t first_advice) {
-  nlohmann::json out = nlohmann::json::array();
-  for (std::size_t i = 0; i < diag.diagnostics().size(); ++i) {
-    const Diagnostic& d = diag.diagnostics()[i];
-    const char* severity = d.severity == Severity::kError     ? "error"
-                           : d.severity == Severity::kWarning ? "warning"
-                                                              : "note";
-    nlohmann::json entry{{"severity", severity},
-                         {"file", d.loc.file},
-                         {"line", d.loc.line},
-                         {"col", d.loc.col},
-                         {"message", d.message}};
-    if (i >= first_advice && i - first_advice < advice.size()) {
-      nlohmann::json changes = nlohmann::json::array();
-      for (const analysis::SettingChange& c : advice[i - first_advice].changes) {
-        nlohmann::json change{{"setting", analysis::setting_name(c.setting)},
-                              {"direction", c.direction > 0 ? "up" : "down"}};
-        if (c.value > 0) change["value"] = c.value;
-        changes.push_back(change);
-      }
-      entry["suggestions"] = changes;
-    }
-    out.push_back(entry);
-  }
-  return out;
-}
-
-int run_check(std::vector<std::string> args) {
-  CLI::App app{"Check a scene: report every error and capture warning, like a compiler."};
-  std::string scene_path, format = "text";
-  bool json = false;
-  app.add_option("scene", scene_path, "scene file (.yaml)")->required();
-  bool no_advice = false;
-  app.add_option("--format", format,
-                 "text (file:line:col: diagnostics and a summary line) or json (the diagnostics "
-                 "with file, line, column, severity, message and each advice's suggested "
-                 "settings, and the compiled scene)")
-      ->check(CLI::IsMember({"text", "json"}));
-  app.add_flag("--json", json, "the same as --format json");
-  app.add_flag("--no-advice", no_advice, "skip the capture advice (coverage, focus, exposure)");
-  if (auto code = parse_options(app, args)) return *code;
-  json = json || format == "json";
-
-  DiagnosticEngine diag;
-  if (json) diag.set_handler([](const Diagnostic&, const std::string&) {});
-  auto scene = compile_scene_file(scene_path, diag);
-  std::vector<analysis::Advice> advice;
-  const std::size_t first_advice = diag.diagnostics().size();
-  if (scene && !no_advice) {
-    // Capture advice from a coverage analysis at reduced resolution (about 700 px across).
-    const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
-    analysis::CoverageOptions options;
-    options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-    const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
-    advice = analysis::capture_advice(*scene, studio, coverage);
-    for (const analysis::Advice& a : advice) diag.warning(a.loc, a.message);
-  }
-  if (json) {
-    nlohmann::json out{{"ok", scene.has_value()},
-                       {"diagnostics", diagnostics_json(diag, advice, first_advice)}};
-    if (scene) out["scene"] = ir_to_json(*scene, false);
-    std::cout << out.dump(2) << '\n';
-    return scene ? kExitOk : kExitUserError;
-  }
-  if (!scene) {
-    std::cerr << fmt::format("{} error{} in {}\n", diag.error_count(),
-                             diag.error_count() == 1 ? "" : "s", scene_path);
-    return kExitUserError;
-  }
-  const ir::Camera& c = scene->camera;
-  std::cout << fmt::format(
-      "{}: ok: '{}', {} shots, object {} ({} triangles, {:.1f} x {:.1f} x {:.1f} cm), {} "
-      "{:.0f}mm {} {} ISO {:.0f}, {} lights, {} warning{}\n",
-      scene_path, scene->name, scene->shots.size(), scene->object.source,
-      scene->object.mesh.triangles.size(),
-      100 * (scene->object.bounds_max_object.x() - scene->object.bounds_min_object.x()),
-      100 * (scene->object.bounds_max_object.y() - scene->object.bounds_min_object.y()),
-      100 * (scene->object.bounds_max_object.z() - scene->object.bounds_min_object.z()),
-      c.model.rfind(c.make, 0) == 0 ? c.model : c.make + " " + c.model, c.focal_length_m * 1000,
-      format_quantity(c.aperture_f_number, QuantityKind::kFNumber),
-      format_quantity(c.shutter_s, QuantityKind::kTime), c.iso, scene->studio.lights.size(),
-      diag.warning_count(), diag.warning_count() == 1 ? "" : "s");
-  return kExitOk;
-}
 
 // `compile --target BACKEND`: the backend's scripts for the whole scene in `output`.
 int emit_scripts(const ir::Scene& scene, const std::string& target, const std::string& output,
@@ -293,80 +207,29 @@ int run_coverage(std::vector<std::string> args) {
   return kExitOk;
 }
 
-int run_version(std::vector<std::string> args) {
-  CLI::App app{"Print the version of rigc and of the scene language."};
-  if (auto code = parse_options(app, args)) return *code;
-  std::cout << fmt::format("rigc {} (scene language 1, IR 1)\n", RIGC_VERSION);
-  return kExitOk;
-}
-
 }  // namespace
 
 const std::vector<Command>& commands() {
-  static const std::vector<Command> table = {
-      {"check", "check a scene and report errors and capture warnings", run_check},
-      {"compile", "compile a scene to the IR or to a backend's scripts", run_compile},
-      {"render", "render every shot with a backend (rigc render --help lists them)", run_render},
-      {"coverage", "analyse which faces the shots see and what SfM can use", run_coverage},
-      {"eval", "reconstruct a run with COLMAP and measure it against the ground truth",
-       run_eval_command},
-      {"compare", "render with several backends and compare reconstruction accuracy",
-       run_compare_command},
-      {"plan", "plan the fewest shots that reach a coverage target", run_plan_command},
-      {"studio", "the interactive capture studio in a browser", run_studio_command},
-      {"sweep", "compare capture configurations: scene variants, locally or on Slurm",
-       run_sweep_command},
-      {"twin", "make a digital twin of a real capture (cameras, visual hull, photo colours)",
-       run_twin_command},
-      {"version", "print the version", run_version},
-  };
+  static const std::vector<Command> table = [] {
+    const std::map<std::string, std::function<int(std::vector<std::string>)>> runs = {
+        {"check", run_check_command},     {"compile", run_compile},
+        {"render", run_render},           {"coverage", run_coverage},
+        {"eval", run_eval_command},       {"compare", run_compare_command},
+        {"plan", run_plan_command},       {"studio", run_studio_command},
+        {"sweep", run_sweep_command},     {"twin", run_twin_command},
+        {"version", run_version_command},
+    };
+    std::vector<Command> out;
+    for (const VerbSummary& verb : verb_summaries()) {
+      out.push_back({verb.name, verb.summary, runs.at(verb.name)});
+    }
+    return out;
+  }();
   return table;
 }
 
 int run_main(std::vector<std::string> args) {
-  auto usage = [] {
-    std::string text = "usage: rigc <command> [options]\n\ncommands:\n";
-    for (const auto& c : commands()) text += fmt::format("  {:<10} {}\n", c.name, c.summary);
-    text += "\n`rigc <command> --help` describes a command's options.\n";
-    return text;
-  };
-  if (args.size() < 2) {
-    std::cerr << usage();
-    return kExitUserError;
-  }
-  const std::string verb = args[1];
-  if (verb == "-h" || verb == "--help" || verb == "help") {
-    std::cout << usage();
-    return kExitOk;
-  }
-  if (verb == "--version") return run_version({"rigc version"});
-  for (const auto& command : commands()) {
-    if (command.name != verb) continue;
-    std::vector<std::string> verb_args = {"rigc " + verb};
-    verb_args.insert(verb_args.end(), args.begin() + 2, args.end());
-    try {
-      return command.run(verb_args);
-    } catch (const fs::filesystem_error& e) {
-      // A path the user gave that cannot be followed (a symbolic link loop, no permission):
-      // their files, not a bug.
-      std::cerr << fmt::format("rigc: error: cannot use '{}': {}\n", e.path1().string(),
-                               e.code().message());
-      return kExitUserError;
-    } catch (const std::exception& e) {
-      // Libraries colour their messages (Open3D's errors come as "\e[1;31m[Open3D Error] ...");
-      // the terminal codes are dropped.
-      const std::string what = std::regex_replace(e.what(), std::regex("\x1b\\[[0-9;]*m"), "");
-      std::cerr << "rigc: internal error: " << what << '\n';
-      return kExitInternalError;
-    }
-  }
-  std::vector<std::string> names;
-  for (const auto& c : commands()) names.push_back(c.name);
-  std::string suggestion = closest_match(verb, names);
-  std::cerr << fmt::format(
-      "rigc: error: unknown command '{}'{}\n\n{}", verb,
-      suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion), usage());
-  return kExitUserError;
+  return dispatch(std::move(args), commands(), nullptr);
 }
 
 }  // namespace rigc::cli

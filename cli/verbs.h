@@ -10,6 +10,8 @@
 
 namespace rigc::cli {
 
+int run_check_command(std::vector<std::string> args);
+int run_version_command(std::vector<std::string> args);
 int run_eval_command(std::vector<std::string> args);
 int run_compare_command(std::vector<std::string> args);
 int run_plan_command(std::vector<std::string> args);

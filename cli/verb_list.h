@@ -1,0 +1,20 @@
+// The verbs of `rigc` by name, with a line on each: what both binaries print in their usage.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace rigc::cli {
+
+struct VerbSummary {
+  std::string name;
+  std::string summary;
+};
+
+// Every verb, in the order the usage lists them.
+const std::vector<VerbSummary>& verb_summaries();
+
+// "usage: rigc <command> [options]" and the verbs, one a line.
+std::string usage_text();
+
+}  // namespace rigc::cli
