@@ -319,9 +319,9 @@ void advise_motion_blur(const ir::Scene& scene, const scene::StudioScene& studio
     last_line = shot.loc.line;
     // A camera's shutter speed that keeps the smear under a pixel, if there is one (the smear
     // grows with the exposure).
-    const double sharp_shutter = camera.shutter_s / blur_px;
-    const double shutter = next_faster_standard_shutter(sharp_shutter * 0.99);
-    const bool shutter_helps = shutter <= sharp_shutter * 0.99 + 1e-12;
+    const double sharp_shutter = 0.99 * camera.shutter_s / blur_px;
+    const double shutter = next_faster_standard_shutter(sharp_shutter);
+    const bool shutter_helps = shutter <= sharp_shutter + 1e-12;
     const std::string remedy =
         shutter_helps ? fmt::format("stop the table for each shot or use {} or shorter",
                                     shutter_text(shutter))

@@ -174,12 +174,7 @@ TEST(Advice, NoAdviceReversesAnotherOverAFamilyOfScenes) {
   EXPECT_GT(diffraction, 0);
 }
 
-}  // namespace
-}  // namespace rigc::analysis
-
-namespace rigc::analysis {
-namespace {
-
+// Shutter suggestions are speeds a camera has.
 TEST(Advice, ShutterSuggestionsAreCamerasSpeeds) {
   EXPECT_DOUBLE_EQ(next_faster_standard_shutter(1.0 / 250), 1.0 / 250);
   EXPECT_DOUBLE_EQ(next_faster_standard_shutter(1.0 / 252), 1.0 / 320);

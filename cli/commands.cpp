@@ -6,7 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 
@@ -16,7 +15,6 @@
 #include "backends/registry.h"
 #include "cli/dispatch.h"
 #include "cli/options.h"
-#include "cli/verb_list.h"
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "compiler/units.h"
@@ -210,21 +208,19 @@ int run_coverage(std::vector<std::string> args) {
 }  // namespace
 
 const std::vector<Command>& commands() {
-  static const std::vector<Command> table = [] {
-    const std::map<std::string, std::function<int(std::vector<std::string>)>> runs = {
-        {"check", run_check_command},     {"compile", run_compile},
-        {"render", run_render},           {"coverage", run_coverage},
-        {"eval", run_eval_command},       {"compare", run_compare_command},
-        {"plan", run_plan_command},       {"studio", run_studio_command},
-        {"sweep", run_sweep_command},     {"twin", run_twin_command},
-        {"version", run_version_command},
-    };
-    std::vector<Command> out;
-    for (const VerbSummary& verb : verb_summaries()) {
-      out.push_back({verb.name, verb.summary, runs.at(verb.name)});
-    }
-    return out;
-  }();
+  static const std::vector<Command> table = table_of({
+      {"check", run_check_command},
+      {"compile", run_compile},
+      {"render", run_render},
+      {"coverage", run_coverage},
+      {"eval", run_eval_command},
+      {"compare", run_compare_command},
+      {"plan", run_plan_command},
+      {"studio", run_studio_command},
+      {"sweep", run_sweep_command},
+      {"twin", run_twin_command},
+      {"version", run_version_command},
+  });
   return table;
 }
 

@@ -11,27 +11,9 @@
 
 #include "cli/dispatch.h"
 #include "cli/standard_streams.h"
-#include "cli/verb_list.h"
 #include "cli/verbs.h"
 #include "io/allocator.h"
 #include "io/input_files.h"
-
-namespace {
-
-// The core's verbs, with the usage's summaries.
-std::vector<rigc::cli::Command> core_commands() {
-  std::vector<rigc::cli::Command> out;
-  for (const rigc::cli::VerbSummary& verb : rigc::cli::verb_summaries()) {
-    if (verb.name == "check")
-      out.push_back({verb.name, verb.summary, rigc::cli::run_check_command});
-    if (verb.name == "version") {
-      out.push_back({verb.name, verb.summary, rigc::cli::run_version_command});
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   rigc::cli::guard_standard_streams();
@@ -47,7 +29,9 @@ int main(int argc, char** argv) {
                              std::strerror(errno));
     return rigc::cli::kExitInternalError;
   };
-  const int code = rigc::cli::dispatch(std::vector<std::string>(argv, argv + argc), core_commands(),
-                                       run_in_rigc_all);
+  const std::vector<rigc::cli::Command> core = rigc::cli::table_of(
+      {{"check", rigc::cli::run_check_command}, {"version", rigc::cli::run_version_command}});
+  const int code =
+      rigc::cli::dispatch(std::vector<std::string>(argv, argv + argc), core, run_in_rigc_all);
   return rigc::cli::finish_standard_output(code);
 }

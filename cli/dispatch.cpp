@@ -15,16 +15,25 @@ namespace rigc::cli {
 
 namespace fs = std::filesystem;
 
+std::vector<Command> table_of(
+    const std::map<std::string, std::function<int(std::vector<std::string>)>>& runs) {
+  std::vector<Command> out;
+  for (const VerbSummary& verb : verb_summaries()) {
+    const auto run = runs.find(verb.name);
+    if (run != runs.end()) out.push_back({verb.name, verb.summary, run->second});
+  }
+  return out;
+}
+
 int dispatch(std::vector<std::string> args, const std::vector<Command>& table,
              const OtherVerbs& other_verbs) {
-  auto usage = [] { return usage_text(); };
   if (args.size() < 2) {
-    std::cerr << usage();
+    std::cerr << usage_text();
     return kExitUserError;
   }
   const std::string verb = args[1];
   if (verb == "-h" || verb == "--help" || verb == "help") {
-    std::cout << usage();
+    std::cout << usage_text();
     return kExitOk;
   }
   if (verb == "--version") return run_version_command({"rigc version"});
@@ -56,7 +65,7 @@ int dispatch(std::vector<std::string> args, const std::vector<Command>& table,
   std::string suggestion = closest_match(verb, names);
   std::cerr << fmt::format(
       "rigc: error: unknown command '{}'{}\n\n{}", verb,
-      suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion), usage());
+      suggestion.empty() ? "" : fmt::format("; did you mean '{}'?", suggestion), usage_text());
   return kExitUserError;
 }
 

@@ -2,12 +2,17 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
 
 namespace rigc::cli {
+
+// The verbs of verb_summaries() that `runs` holds, in the usage's order, with its summaries.
+std::vector<Command> table_of(
+    const std::map<std::string, std::function<int(std::vector<std::string>)>>& runs);
 
 // Runs a verb of verb_summaries() that `table` does not hold (the whole argument list).
 using OtherVerbs = std::function<int(const std::vector<std::string>& args)>;

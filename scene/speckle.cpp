@@ -31,6 +31,16 @@ F32x8 smoothstep01(F32x8 t) {
   return t * t * (3 - 2 * t);
 }
 
+// A dot's edge half-width: `edge`, narrowed where the dot would reach past half a cell.
+float dot_edge(float radius, float edge) {
+  return std::min(edge, 0.5f - radius);
+}
+
+// A dot's darkness at points `squared` (distance squared) from its centre.
+F32x8 dot_darkness(F32x8 squared, float radius, float edge) {
+  return smoothstep01((radius + edge - simd::sqrt(squared)) * (0.5f / edge));
+}
+
 // Cells with integer coordinates, eight a group (a cell a lane); the last group's spare lanes
 // repeat its last cell.
 struct Cells {
@@ -102,10 +112,10 @@ F32x8 darkness_among(F32x8 qx, F32x8 qy, F32x8 qz, const Cells& cells, float see
         const F32x8 ex = dx - gx[dot][c], ey = dy - gy[dot][c], ez = dz - gz[dot][c];
         const F32x8 squared = ex * ex + ey * ey + ez * ez;
         const float r = radius[dot][c];
-        const float w = std::min(edge, 0.5f - r);
+        const float w = dot_edge(r, edge);
         // Most dots reach none of the points: their darkness there is 0.
         if (!simd::any(squared < (r + w) * (r + w))) continue;
-        const F32x8 value = smoothstep01((r + w - simd::sqrt(squared)) * (0.5f / w));
+        const F32x8 value = dot_darkness(squared, r, w);
         darkness = value > darkness ? value : darkness;
       }
     }
@@ -242,7 +252,7 @@ void gather_dots(const Footprints8& p, const FootprintShape& shape, simd::I32x8 
   for (int c = 0; c < count; ++c) {
     for (int dot = 0; dot < kDotsPerCell; ++dot) {
       const float r = dots_here.radius[dot][c];
-      const float w = std::min(kEdge, 0.5f - r);
+      const float w = dot_edge(r, kEdge);
       const F32x8 ex = p.qx - (x[c] + dots_here.x[dot][c]),
                   ey = p.qy - (y[c] + dots_here.y[dot][c]),
                   ez = p.qz - (z[c] + dots_here.z[dot][c]);
@@ -347,9 +357,7 @@ F32x8 darkness_of8(F32x8 qx, F32x8 qy, F32x8 qz, const CrossingDots& dots) {
   F32x8 darkness{};
   for (int i = 0; i < dots.count; ++i) {
     const F32x8 ex = qx - dots.x[i], ey = qy - dots.y[i], ez = qz - dots.z[i];
-    const float r = dots.radius[i], w = dots.edge[i];
-    const F32x8 value =
-        smoothstep01((r + w - simd::sqrt(ex * ex + ey * ey + ez * ez)) * (0.5f / w));
+    const F32x8 value = dot_darkness(ex * ex + ey * ey + ez * ez, dots.radius[i], dots.edge[i]);
     darkness = value > darkness ? value : darkness;
   }
   return darkness;

@@ -87,48 +87,6 @@ TEST(Speckle, IsotropicAcrossCells) {
   EXPECT_NEAR(mean / kPoints, kMeanDarkness, 0.02);
 }
 
-}  // namespace
-}  // namespace rigc::scene::speckle
-
-namespace rigc::scene::noise {
-namespace {
-
-// The noise pattern's SIMD form is its definition read in double (speckle.h), with smooth
-// values over [0, 1] averaging a half.
-TEST(Speckle, NoiseSimdMatchesTheReferenceDefinition) {
-  std::mt19937 random(5);
-  std::uniform_real_distribution<float> coordinate(-200.0f, 200.0f);
-  double worst = 0, mean = 0, lowest = 1, highest = 0;
-  constexpr int kBatches = 2000;
-  for (int batch = 0; batch < kBatches; ++batch) {
-    simd::F32x8 qx, qy, qz;
-    for (int k = 0; k < 8; ++k) {
-      qx[k] = coordinate(random);
-      qy[k] = coordinate(random);
-      qz[k] = coordinate(random);
-    }
-    const simd::F32x8 d = darkness8(qx, qy, qz, 11);
-    for (int k = 0; k < 8; ++k) {
-      const double want = darkness_reference(qx[k], qy[k], qz[k], 11);
-      worst = std::max(worst, std::abs(d[k] - want));
-      mean += want / (8 * kBatches);
-      lowest = std::min(lowest, want);
-      highest = std::max(highest, want);
-    }
-  }
-  EXPECT_LT(worst, 1e-3);
-  EXPECT_NEAR(mean, kMeanDarkness, 0.02);
-  EXPECT_GE(lowest, 0);
-  EXPECT_LE(highest, 1);
-  EXPECT_GT(highest - lowest, 0.6);
-}
-
-}  // namespace
-}  // namespace rigc::scene::noise
-
-namespace rigc::scene::speckle {
-namespace {
-
 // The dots gathered over a pixel are all that darken it: at any point of the pixel the darkness
 // from them alone is the pattern's, a pixel called covered is dark all over, and one with no
 // dots is light all over.
@@ -184,3 +142,39 @@ TEST(Speckle, DotsOverAPixelAreAllThatDarkenIt) {
 
 }  // namespace
 }  // namespace rigc::scene::speckle
+
+namespace rigc::scene::noise {
+namespace {
+
+// The noise pattern's SIMD form is its definition read in double (speckle.h), with smooth
+// values over [0, 1] averaging a half.
+TEST(Speckle, NoiseSimdMatchesTheReferenceDefinition) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-200.0f, 200.0f);
+  double worst = 0, mean = 0, lowest = 1, highest = 0;
+  constexpr int kBatches = 2000;
+  for (int batch = 0; batch < kBatches; ++batch) {
+    simd::F32x8 qx, qy, qz;
+    for (int k = 0; k < 8; ++k) {
+      qx[k] = coordinate(random);
+      qy[k] = coordinate(random);
+      qz[k] = coordinate(random);
+    }
+    const simd::F32x8 d = darkness8(qx, qy, qz, 11);
+    for (int k = 0; k < 8; ++k) {
+      const double want = darkness_reference(qx[k], qy[k], qz[k], 11);
+      worst = std::max(worst, std::abs(d[k] - want));
+      mean += want / (8 * kBatches);
+      lowest = std::min(lowest, want);
+      highest = std::max(highest, want);
+    }
+  }
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_NEAR(mean, kMeanDarkness, 0.02);
+  EXPECT_GE(lowest, 0);
+  EXPECT_LE(highest, 1);
+  EXPECT_GT(highest - lowest, 0.6);
+}
+
+}  // namespace
+}  // namespace rigc::scene::noise

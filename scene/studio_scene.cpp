@@ -351,8 +351,7 @@ float grid_darkness_sum(const PixelFootprint& pixel, const speckle::CrossingDots
     const F32x8 qx = pixel.at.x() + s * pixel.dx.x() + t * pixel.dy.x();
     const F32x8 qy = pixel.at.y() + s * pixel.dx.y() + t * pixel.dy.y();
     const F32x8 qz = pixel.at.z() + s * pixel.dx.z() + t * pixel.dy.z();
-    F32x8 darkness = speckle::darkness_of8(qx, qy, qz, dots);
-    darkness = darkness > 1 ? F32x8{} + 1 : darkness;
+    const F32x8 darkness = speckle::darkness_of8(qx, qy, qz, dots);  // in [0, 1]
     sum += index < static_cast<float>(samples) ? darkness : F32x8{};
   }
   return simd::sum(sum);
