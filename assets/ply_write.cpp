@@ -124,32 +124,30 @@ bool write_ply_body(const ir::Mesh& mesh, ChunkedWriter* out) {
 
 }  // namespace
 
-// Writes a temporary file beside `path` and renames it, so a reader never sees half a file.
+// Writes the whole file or nothing (io/atomic_file.h), so a reader never sees half a file.
 bool write_ply(const std::string& path, const ir::Mesh& mesh, std::string* error) {
-  auto failed = [&](const std::string& message) {
-    if (error) *error = fmt::format("{}: {}", path, message);
+  if (const std::optional<std::string> problem = unwritable(mesh)) {
+    if (error) *error = fmt::format("{}: {}", path, *problem);
     return false;
-  };
-  if (const std::optional<std::string> problem = unwritable(mesh)) return failed(*problem);
+  }
   const std::string header = ply_header(mesh);
-  const std::string tmp = temporary_path_beside(path).string();
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) return failed(fmt::format("cannot write: {}", std::strerror(errno)));
-  ChunkedWriter out(file, std::fwrite(header.data(), 1, header.size(), file) == header.size());
-  bool ok = write_ply_body(mesh, &out);
-  ok = (std::fflush(file) == 0) && ok;
-  ok = (std::fclose(file) == 0) && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    return failed("write failed (disk full?)");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    return failed(fmt::format("cannot rename {}: {}", tmp, ec.message()));
-  }
-  return true;
+  return write_atomically(
+      path,
+      [&](const fs::path& temporary, std::string* reason) {
+        std::FILE* file = std::fopen(temporary.c_str(), "wb");
+        if (!file) {
+          *reason = std::strerror(errno);
+          return false;
+        }
+        ChunkedWriter out(file,
+                          std::fwrite(header.data(), 1, header.size(), file) == header.size());
+        bool ok = write_ply_body(mesh, &out);
+        ok = (std::fflush(file) == 0) && ok;
+        ok = (std::fclose(file) == 0) && ok;
+        if (!ok) *reason = "write failed (disk full?)";
+        return ok;
+      },
+      error);
 }
 
 }  // namespace rigc

@@ -50,6 +50,18 @@ bool write_pixels(const fs::path& path, const OIIO::ImageSpec& spec, const void*
       path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), error);
 }
 
+bool write_image_buffer(const fs::path& path, const OIIO::ImageBuf& image, std::string* error) {
+  OIIO::ImageSpec spec = image.spec();
+  spec.set_format(OIIO::TypeDesc::UINT8);
+  spec.erase_attribute("oiio:BitsPerSample");  // a 16-bit source's depth
+  std::vector<std::uint8_t> pixels(spec.image_bytes());
+  if (!image.get_pixels(image.roi(), OIIO::TypeDesc::UINT8, pixels.data())) {
+    set_error(error, "cannot write " + path.string() + ": " + image.geterror());
+    return false;
+  }
+  return write_pixels(path, spec, pixels.data(), error);
+}
+
 namespace {
 
 // ".jpg" for "shot.JPG": the file type the name asks for.

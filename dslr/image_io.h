@@ -2,6 +2,7 @@
 // rename), with the EXIF a photogrammetry tool reads. Errors are returned, never thrown.
 #pragma once
 
+#include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cstdint>
@@ -21,6 +22,11 @@ namespace rigc::dslr {
 // final name and no temporary; false with *error set ("cannot write PATH: WHY").
 bool write_pixels(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
                   const void* pixels, std::string* error);
+
+// Writes `image` at 8 bits a channel with its metadata, encoded like write_pixels in the format
+// the path's extension asks for.
+bool write_image_buffer(const std::filesystem::path& path, const OIIO::ImageBuf& image,
+                        std::string* error);
 
 // Writes result.encoded (or result.encoded_bytes when that holds the codes); the file type follows
 // the path's extension (.jpg, .png, .tif). JPEG uses camera.jpeg_quality and is always 8-bit.

@@ -1,5 +1,6 @@
 #include "dslr/image_io.h"
 
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -144,6 +145,27 @@ TEST(DslrWrite, MaskIsAnEightBitPng) {
   std::vector<std::uint8_t> pixels(image.mask.size());
   ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, pixels.data()));
   EXPECT_EQ(pixels, image.mask);
+}
+
+TEST(DslrWrite, ABufferIsWrittenAtEightBitsWithItsMetadata) {
+  rigc::testing::TempDir dir;
+  OIIO::ImageBuf image(OIIO::ImageSpec(4, 2, 3, OIIO::TypeDesc::FLOAT));
+  const float grey[3] = {0.5f, 0.5f, 0.5f};
+  OIIO::ImageBufAlgo::fill(image, grey);
+  image.specmod().attribute("Software", "a test");
+  const std::string path = dir.file("sheet.png");
+  std::string error;
+  ASSERT_TRUE(write_image_buffer(path, image, &error)) << error;
+  auto in = OIIO::ImageInput::open(path);
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT8);
+  EXPECT_EQ(in->spec().get_string_attribute("Software"), "a test");
+  std::vector<std::uint8_t> pixels(4 * 2 * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+  EXPECT_EQ(pixels, std::vector<std::uint8_t>(4 * 2 * 3, 128));
+  // A format OpenImageIO cannot encode in memory is refused before anything is written.
+  EXPECT_FALSE(write_image_buffer(dir.file("sheet.unknown-format"), image, &error));
+  EXPECT_EQ(folder_entries(dir.path()), std::vector<std::string>{"sheet.png"});
 }
 
 TEST(DslrWrite, UnwritablePlacesGiveAnErrorAndLeaveNothing) {

@@ -12,6 +12,7 @@
 #include <regex>
 #include <sstream>
 
+#include "dslr/image_io.h"
 #include "io/child_processes.h"
 #include "io/files.h"
 #include "io/output_paths.h"
@@ -276,11 +277,7 @@ bool write_eight_bit_copies(const ImageSet& set, const fs::path& to, bool* input
           fmt::format("cannot read the pixels of {}: {}", (from / name).string(), image.geterror());
       return false;
     }
-    if (!image.write((to / name).string(), OIIO::TypeDesc::UINT8)) {
-      *error = fmt::format("cannot write an 8-bit copy of {} for COLMAP: {}",
-                           (from / name).string(), image.geterror());
-      return false;
-    }
+    if (!dslr::write_image_buffer(to / name, image, error)) return false;
   }
   return true;
 }

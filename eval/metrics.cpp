@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 
+#include "dslr/image_io.h"
 #include "io/atomic_file.h"
 #include "io/files.h"
 
@@ -36,7 +37,7 @@ double percentile(std::vector<double>& values, double q) {
   return at_lo * (1 - f) + at_hi * f;
 }
 
-// 8-bit RGB canvas written through OpenImageIO (temporary file, then rename).
+// 8-bit RGB canvas, written as a PNG through OpenImageIO.
 struct Canvas {
   int width, height;
   std::vector<std::uint8_t> rgb;
@@ -71,22 +72,7 @@ bool write_canvas(const fs::path& path, const Canvas& canvas, const std::vector<
     // Needs a font (fonts-dejavu); without one the picture just has no text.
     OIIO::ImageBufAlgo::render_text(copy, l.x, l.y, l.text, l.size, "DejaVuSans", colour, l.align);
   }
-  // PNG named explicitly: the temporary name's suffix does not say it.
-  const fs::path temporary = temporary_path_beside(path);
-  if (!copy.write(temporary.string(), OIIO::TypeDesc::UINT8, "png")) {
-    *error = fmt::format("cannot write {}: {}", path.string(), copy.geterror());
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    return false;
-  }
-  std::error_code ec;
-  fs::rename(temporary, path, ec);
-  if (ec) {
-    *error = fmt::format("cannot write {}: {}", path.string(), ec.message());
-    fs::remove(temporary, ec);
-    return false;
-  }
-  return true;
+  return dslr::write_image_buffer(path, copy, error);
 }
 
 }  // namespace

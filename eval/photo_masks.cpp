@@ -9,7 +9,6 @@
 
 #include "dslr/image_io.h"
 #include "eval/chroma_key.h"
-#include "io/atomic_file.h"
 #include "io/input_files.h"
 #include "io/output_paths.h"
 
@@ -282,20 +281,7 @@ bool write_contact_sheet(const ImageSet& images, const fs::path& masks_dir, cons
     OIIO::ImageBufAlgo::paste(sheet, x, y, 0, 0, pair->first);
     OIIO::ImageBufAlgo::paste(sheet, x + cell_w + kGap, y, 0, 0, pair->second);
   }
-  const fs::path tmp = rigc::temporary_path_beside(path);
-  if (!sheet.write(tmp.string(), OIIO::TypeDesc::UINT8, "png")) {
-    *error = fmt::format("cannot write {}: {}", path.string(), sheet.geterror());
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    return false;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    *error = fmt::format("cannot write {}: {}", path.string(), ec.message());
-    return false;
-  }
-  return true;
+  return dslr::write_image_buffer(path, sheet, error);
 }
 
 }  // namespace rigc::eval

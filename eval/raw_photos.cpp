@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <set>
 
-#include "io/atomic_file.h"
+#include "dslr/image_io.h"
 #include "io/input_files.h"
 
 namespace rigc::eval {
@@ -58,18 +58,7 @@ bool develop_raw(const fs::path& raw, const fs::path& to, bool* cached, std::str
   OIIO::ImageSpec& spec = srgb.specmod();
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute("Compression", "jpeg:95");
-  const fs::path tmp = rigc::temporary_path_beside(to);
-  if (!srgb.write(tmp.string(), OIIO::TypeDesc::UINT8, "jpeg")) {
-    *error = fmt::format("cannot write {}: {}", to.string(), srgb.geterror());
-    fs::remove(tmp, ec);
-    return false;
-  }
-  fs::rename(tmp, to, ec);
-  if (ec) {
-    *error = fmt::format("cannot write {}: {}", to.string(), ec.message());
-    return false;
-  }
-  return true;
+  return dslr::write_image_buffer(to, srgb, error);
 }
 
 bool develop_raw_photos(ImageSet& images, const fs::path& out, std::ostream& log, bool quiet,

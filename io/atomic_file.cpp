@@ -94,8 +94,9 @@ std::filesystem::path file_to_replace(const std::filesystem::path& path, std::st
   return target;
 }
 
-bool write_file_atomically(const std::filesystem::path& requested, std::string_view bytes,
-                           std::string* error) {
+bool write_atomically(const std::filesystem::path& requested, const FileWriter& write,
+                      std::string* error) {
+  std::filesystem::path temporary;
   try {
     if (requested.filename().empty()) {
       set_error(error, fmt::format("cannot write '{}': not a file name", requested.string()));
@@ -103,29 +104,42 @@ bool write_file_atomically(const std::filesystem::path& requested, std::string_v
     }
     const std::filesystem::path path = file_to_replace(requested, error);
     if (path.empty()) return false;
-    std::string temp;
-    int fd = -1;
-    for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-      temp = temporary_path_beside(path).string();
-      fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      if (fd < 0 && errno != EEXIST) break;
+    temporary = temporary_path_beside(path);
+    std::string reason;
+    bool written = write(temporary, &reason);
+    if (written && std::rename(temporary.c_str(), path.c_str()) != 0) {
+      reason = errno_text(errno);
+      written = false;
     }
-    if (fd < 0) {
-      set_error(error, fmt::format("cannot write {}: {}", path.string(), errno_text(errno)));
-      return false;
-    }
-    const bool written = write_all(fd, bytes);
-    int code = written ? 0 : errno;
-    if (::close(fd) != 0 && code == 0) code = errno;
-    if (written && code == 0 && std::rename(temp.c_str(), path.c_str()) == 0) return true;
-    if (code == 0) code = errno;
-    ::unlink(temp.c_str());
-    set_error(error, fmt::format("cannot write {}: {}", path.string(), errno_text(code)));
+    if (written) return true;
+    ::unlink(temporary.c_str());
+    set_error(error, fmt::format("cannot write {}: {}", path.string(),
+                                 reason.empty() ? "the writer failed" : reason));
     return false;
   } catch (const std::exception& e) {
+    if (!temporary.empty()) ::unlink(temporary.c_str());
     set_error(error, fmt::format("cannot write {}: {}", requested.string(), e.what()));
     return false;
   }
+}
+
+bool write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           std::string* error) {
+  return write_atomically(
+      path,
+      [bytes](const std::filesystem::path& temporary, std::string* reason) {
+        const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0) {
+          *reason = errno_text(errno);
+          return false;
+        }
+        const bool written = write_all(fd, bytes);
+        int code = written ? 0 : errno;
+        if (::close(fd) != 0 && code == 0) code = errno;
+        if (code != 0) *reason = errno_text(code);
+        return code == 0;
+      },
+      error);
 }
 
 }  // namespace rigc

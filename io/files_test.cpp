@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <stdexcept>
 #include <string>
 
 #include "tests/test_support.h"
@@ -108,6 +109,42 @@ TEST(BackendFiles, WriteAtomicallyOverAFolderFailsAndCleansUp) {
   int entries = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir.path())) ++entries;
   EXPECT_EQ(entries, 1) << "the temporary file was not removed";
+}
+
+TEST(BackendFiles, AFailingWriterLeavesTheOldFileAndNoTemporary) {
+  rigc::testing::TempDir dir;
+  const fs::path path = dir.path() / "out.txt";
+  ASSERT_TRUE(write_file_atomically(path, "old", nullptr));
+  std::string error;
+  const bool written = write_atomically(
+      path,
+      [](const fs::path& temporary, std::string* reason) {
+        rigc::testing::write_text(temporary, "half");
+        *reason = "the encoder failed";
+        return false;
+      },
+      &error);
+  EXPECT_FALSE(written);
+  EXPECT_EQ(error, "cannot write " + path.string() + ": the encoder failed");
+  EXPECT_EQ(rigc::testing::read_text(path), "old");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1)
+      << "a temporary file was left behind";
+}
+
+TEST(BackendFiles, AWriterThatThrowsIsAnErrorAndCleansUp) {
+  rigc::testing::TempDir dir;
+  const fs::path path = dir.path() / "out.txt";
+  std::string error;
+  const bool written = write_atomically(
+      path,
+      [](const fs::path& temporary, std::string*) -> bool {
+        rigc::testing::write_text(temporary, "half");
+        throw std::runtime_error("out of memory");
+      },
+      &error);
+  EXPECT_FALSE(written);
+  EXPECT_NE(error.find("out of memory"), std::string::npos) << error;
+  EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "io/atomic_file.h"
+#include "dslr/image_io.h"
 #include "sweep/results.h"
 
 namespace rigc::sweep {
@@ -75,15 +75,7 @@ bool draw_plot(const fs::path& path, const std::string& title, const Axis& axis,
   for (const Point& p : points) dot(image, px(p.x_index), py(p.y), blue);
   text(image, kWidth / 2, 30, title, 18);
   text(image, kLeft + plot_w / 2, kHeight - 18, axis.path + "   (dots: variants, line: mean)", 14);
-  const fs::path temporary = temporary_path_beside(path);
-  if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8, "png")) {
-    *error = fmt::format("cannot write {}: {}", path.string(), image.geterror());
-    return false;
-  }
-  std::error_code ec;
-  fs::rename(temporary, path, ec);
-  if (ec) *error = fmt::format("cannot write {}: {}", path.string(), ec.message());
-  return !ec;
+  return dslr::write_image_buffer(path, image, error);
 }
 
 }  // namespace

@@ -77,10 +77,16 @@ bool merge_part(const fs::path& part, const fs::path& run_dir, const std::string
   for (const std::string& file : record->files) {
     std::error_code ec;
     fs::create_directories((run_dir / file).parent_path(), ec);
-    const fs::path temporary = temporary_path_beside(run_dir / file);
-    fs::copy_file(part / file, temporary, fs::copy_options::overwrite_existing, ec);
-    if (!ec) fs::rename(temporary, run_dir / file, ec);
-    if (ec) return false;
+    const bool copied = write_atomically(
+        run_dir / file,
+        [&](const fs::path& temporary, std::string* reason) {
+          std::error_code copy_ec;
+          fs::copy_file(part / file, temporary, fs::copy_options::overwrite_existing, copy_ec);
+          if (copy_ec) *reason = copy_ec.message();
+          return !copy_ec;
+        },
+        nullptr);
+    if (!copied) return false;
   }
   manifest.set_inputs(part_manifest.inputs());
   manifest.set_backend(part_manifest.backend());
