@@ -1,6 +1,7 @@
 #include "analysis/coverage.h"
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,9 @@
 #include "assets/mesh_io.h"
 #include "compiler/frontend.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::analysis {
 namespace {
@@ -126,7 +130,7 @@ TEST(Coverage, AnOutOfFocusCaptureReconstructsNothing) {
                                   kGoodShots, "  focus: 5m\n"));
   EXPECT_GT(a.coverage.shots.back().seen_2, 0.9);
   EXPECT_EQ(a.coverage.shots.back().reconstructable, 0.0);
-  EXPECT_NE(a.warnings.find("warning: depth of field at f/1.4"), std::string::npos) << a.warnings;
+  EXPECT_THAT(a.warnings, HasSubstr("warning: depth of field at f/1.4"));
 }
 
 struct WarningCase {
@@ -169,7 +173,7 @@ TEST(Coverage, EachWarningFiresOnItsCraftedScene) {
   };
   for (const auto& c : cases) {
     Analysed a = analyse(scene_text(kStatue, c.exposure, c.shots, c.extra_camera));
-    EXPECT_NE(a.warnings.find(c.expected), std::string::npos) << c.name << ":\n" << a.warnings;
+    EXPECT_THAT(a.warnings, HasSubstr(c.expected)) << c.name << ":\n" << a.warnings;
   }
 }
 
@@ -223,10 +227,9 @@ TEST(Coverage, ADistortionBeyondTheCanvasIsPointedOut) {
   const std::string expected = "the distortion draws part of the frame from beyond the canvas";
   const Analysed strong =
       analyse(with_lens("{k1: 0.056, k2: -0.0025, p1: -0.027, p2: -0.24, k3: 0.046}"));
-  EXPECT_NE(strong.warnings.find("test.yaml:14:42: warning: " + expected), std::string::npos)
-      << strong.warnings;
+  EXPECT_THAT(strong.warnings, HasSubstr("test.yaml:14:42: warning: " + expected));
   const Analysed usual = analyse(with_lens("{k1: -0.05, k2: 0.01, p1: 0.001, p2: -0.002}"));
-  EXPECT_EQ(usual.warnings.find(expected), std::string::npos) << usual.warnings;
+  EXPECT_THAT(usual.warnings, Not(HasSubstr(expected)));
 }
 
 // The over-exposure advice names a shutter; taking it, the warning goes, however many stops over
@@ -241,10 +244,10 @@ TEST(Coverage, TheSuggestedShutterEndsTheOverExposure) {
     const std::string suggested = match[1].str() + match[2].str();
     Analysed after = analyse(scene_text(
         kStatue, fmt::format("{{aperture: f/13, shutter: {}, iso: 200}}", suggested), kGoodShots));
-    EXPECT_EQ(after.warnings.find("over-exposure"), std::string::npos)
+    EXPECT_THAT(after.warnings, Not(HasSubstr("over-exposure")))
         << shutter << " -> " << suggested << ":\n"
         << after.warnings;
-    EXPECT_EQ(after.warnings.find("under-exposure"), std::string::npos) << after.warnings;
+    EXPECT_THAT(after.warnings, Not(HasSubstr("under-exposure")));
   }
 }
 
@@ -259,7 +262,7 @@ TEST(Coverage, OptionsCheckTheVisibilityScale) {
     options.visibility_scale = scale;
     std::string error;
     EXPECT_FALSE(options.check(&error)) << scale;
-    EXPECT_NE(error.find("visibility_scale"), std::string::npos) << error;
+    EXPECT_THAT(error, HasSubstr("visibility_scale"));
   }
   CoverageOptions bad;
   bad.visibility_scale = 2;
@@ -286,7 +289,7 @@ TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
   ASSERT_TRUE(glb) << error;
   EXPECT_EQ(glb->mesh.triangles.size(), a.coverage.face_area_m2.size());
   const std::string ply = testing::read_text((dir.path() / "coverage.ply").string());
-  EXPECT_NE(ply.find("property uchar red"), std::string::npos);
+  EXPECT_THAT(ply, HasSubstr("property uchar red"));
   EXPECT_EQ(paper_color(0), Eigen::Vector3f(1, 1, 1));
   EXPECT_GT(paper_color(1).x(), 0.5f);
   EXPECT_GT(paper_color(2).y(), 0.5f);

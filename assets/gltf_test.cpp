@@ -1,4 +1,5 @@
 // glTF through load_model (assets/gltf.cpp, gltf_schema.cpp).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -7,6 +8,8 @@
 
 #include "assets/model_test_support.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::model_testing {
 namespace {
@@ -64,7 +67,7 @@ TEST(MeshIoGltf, LoadsBoxTexturedWithTexture) {
   const ir::Texture& tex = m.textures[0];
   EXPECT_EQ(tex.width, 211);
   EXPECT_EQ(tex.height, 211);
-  EXPECT_NE(tex.source.find("CesiumLogoFlat.png"), std::string::npos) << tex.source;
+  EXPECT_THAT(tex.source, HasSubstr("CesiumLogoFlat.png"));
   // The logo is not a flat colour.
   EXPECT_NE(std::count(tex.pixels.begin(), tex.pixels.end(), tex.pixels[0]),
             static_cast<std::ptrdiff_t>(tex.pixels.size()));
@@ -81,7 +84,7 @@ TEST(MeshIoGltf, LoadsBinaryGlbAndEmbeddedImages) {
     expect_unit_box(m.mesh);
     ASSERT_EQ(m.textures.size(), 1u);
     EXPECT_EQ(m.textures[0].width, 211);
-    EXPECT_NE(m.textures[0].source.find("#image0"), std::string::npos) << m.textures[0].source;
+    EXPECT_THAT(m.textures[0].source, HasSubstr("#image0"));
   }
 }
 
@@ -185,8 +188,8 @@ TEST(MeshIoGltf, ErrorCutsALongDataUri) {
   std::string error;
   EXPECT_FALSE(load_model(dir.file("uri.gltf"), &error));
   EXPECT_LT(error.size(), 600u) << error.substr(0, 600);
-  EXPECT_NE(error.find("data:application/octet-stream;base64,AAAA"), std::string::npos) << error;
-  EXPECT_NE(error.find("... (400037 characters)"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("data:application/octet-stream;base64,AAAA"));
+  EXPECT_THAT(error, HasSubstr("... (400037 characters)"));
 }
 
 TEST(MeshIoGltf, ImageThatIsAFolderOrADeviceSaysSo) {

@@ -1,5 +1,6 @@
 #include "assets/model_cache.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -7,6 +8,8 @@
 
 #include "assets/model_test_support.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc {
 namespace {
@@ -54,7 +57,7 @@ TEST_F(ModelCache, AModelIsLoadedAgainOnlyWhenItsFileChanged) {
   // A file gone is an error again, not the kept model.
   fs::remove(path);
   EXPECT_FALSE(load_model_cached(path, &error));
-  EXPECT_NE(error.find("tri.ply"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("tri.ply"));
 }
 
 // A primitive is built once for the same arguments, and is the same mesh as built afresh.

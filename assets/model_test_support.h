@@ -2,6 +2,7 @@
 // mesh_io_test.cpp): the test models' folder, file writers and the checks of a loaded model.
 #pragma once
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -47,8 +48,8 @@ inline void expect_load_error(const std::string& path, const std::string& expect
   const std::optional<LoadedModel> model = load_model(path, &error);
   EXPECT_FALSE(model.has_value());
   EXPECT_EQ(error.rfind(path + ": ", 0), 0u) << error;
-  EXPECT_NE(error.find(expected), std::string::npos) << error;
-  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_THAT(error, ::testing::HasSubstr(expected));
+  EXPECT_THAT(error, ::testing::Not(::testing::HasSubstr("\n")));
 }
 
 // Structural invariants every loaded model satisfies.

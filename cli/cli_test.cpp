@@ -14,6 +14,8 @@
 
 #include "tests/test_support.h"
 
+using ::testing::HasSubstr;
+
 namespace rigc {
 namespace {
 
@@ -23,7 +25,7 @@ using testing::source_path;
 TEST(Cli, CheckAcceptsThePaperScene) {
   auto result = run_rigc({"check", source_path("scenes/paper-turntable.yaml")});
   EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_NE(result.out.find("ok: 'paper-turntable', 18 shots"), std::string::npos) << result.out;
+  EXPECT_THAT(result.out, HasSubstr("ok: 'paper-turntable', 18 shots"));
 }
 
 // The command itself (not only the libraries the tests link) reads meshes in every format:
@@ -33,10 +35,10 @@ TEST(Cli, CheckReadsGltfObjAndPlyMeshes) {
   const std::string gltf = "/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf";
   auto result = run_rigc({"check", source_path("scenes/orbit-textured.yaml")});
   EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_NE(result.out.find("(12 triangles"), std::string::npos) << result.out;
+  EXPECT_THAT(result.out, HasSubstr("(12 triangles"));
   std::ifstream in(source_path("scenes/orbit-textured.yaml"));
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ASSERT_NE(text.find(gltf), std::string::npos);
+  ASSERT_THAT(text, HasSubstr(gltf));
   testing::TempDir dir;
   for (const std::string mesh :
        {"/usr/share/assimp/models/OBJ/box.obj", "/usr/share/assimp/models/PLY/cube.ply"}) {
@@ -46,17 +48,15 @@ TEST(Cli, CheckReadsGltfObjAndPlyMeshes) {
     std::ofstream(path) << scene;
     result = run_rigc({"check", path});
     EXPECT_EQ(result.exit_code, 0) << mesh << ": " << result.err;
-    EXPECT_NE(result.out.find("triangles"), std::string::npos) << result.out;
+    EXPECT_THAT(result.out, HasSubstr("triangles"));
   }
 }
 
 TEST(Cli, CheckReportsErrorsWithExitCodeOne) {
   auto result = run_rigc({"check", source_path("tests/bad_scenes/out_of_range.yaml")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find(":8:24: error: aperture f/0.8 is outside f/1.2..f/64"),
-            std::string::npos)
-      << result.err;
-  EXPECT_NE(result.err.find("4 errors in"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr(":8:24: error: aperture f/0.8 is outside f/1.2..f/64"));
+  EXPECT_THAT(result.err, HasSubstr("4 errors in"));
 }
 
 TEST(Cli, CheckJsonListsDiagnostics) {
@@ -98,9 +98,7 @@ TEST(Cli, CheckFormatJsonGivesTheAdvicesSuggestions) {
 TEST(Cli, MissingSceneFileIsAUserError) {
   auto result = run_rigc({"check", "/nonexistent/rig.yaml"});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("/nonexistent/rig.yaml: error: cannot read the scene file"),
-            std::string::npos)
-      << result.err;
+  EXPECT_THAT(result.err, HasSubstr("/nonexistent/rig.yaml: error: cannot read the scene file"));
 }
 
 TEST(Cli, CompileEmitsIrJsonAtomically) {
@@ -123,7 +121,7 @@ TEST(Cli, CompileEmitsIrJsonAtomically) {
   auto bad = run_rigc({"compile", source_path("scenes/paper-turntable.yaml"), "-o",
                        dir.file("no/such/folder/ir.json")});
   EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_NE(bad.err.find("cannot write"), std::string::npos) << bad.err;
+  EXPECT_THAT(bad.err, HasSubstr("cannot write"));
 }
 
 TEST(Cli, CompileRefusesToOverwriteTheSceneItself) {
@@ -133,14 +131,14 @@ TEST(Cli, CompileRefusesToOverwriteTheSceneItself) {
   testing::write_text(scene, text);
   auto result = run_rigc({"compile", scene, "--target", "ir", "-o", dir.file("./scene.yaml")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("is the scene file itself"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("is the scene file itself"));
   EXPECT_EQ(testing::read_text(scene), text);
 }
 
 TEST(Cli, UnknownVerbAndTargetAreUserErrors) {
   auto verb = run_rigc({"chekc"});
   EXPECT_EQ(verb.exit_code, 1);
-  EXPECT_NE(verb.err.find("did you mean 'check'?"), std::string::npos) << verb.err;
+  EXPECT_THAT(verb.err, HasSubstr("did you mean 'check'?"));
   auto target =
       run_rigc({"compile", source_path("scenes/paper-turntable.yaml"), "--target", "vray"});
   EXPECT_EQ(target.exit_code, 1);
@@ -182,14 +180,14 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreUserErrors) {
   for (const Case& c : cases) {
     auto result = run_rigc(c.args);
     EXPECT_EQ(result.exit_code, 1) << c.args[0] << " " << c.message << "\n" << result.err;
-    EXPECT_NE(result.err.find(c.message), std::string::npos) << result.err;
+    EXPECT_THAT(result.err, HasSubstr(c.message));
     EXPECT_EQ(result.err.rfind("rigc: error: ", 0), 0u) << "like every error of rigc";
     EXPECT_FALSE(std::filesystem::exists(run)) << c.message;
   }
   // A backend named twice rendered and evaluated twice into one folder.
   auto twice = run_rigc({"compare", scene, "-o", run, "--backends", "preview,preview"});
   EXPECT_EQ(twice.exit_code, 1) << twice.err;
-  EXPECT_NE(twice.err.find("--backends names 'preview' twice"), std::string::npos) << twice.err;
+  EXPECT_THAT(twice.err, HasSubstr("--backends names 'preview' twice"));
   EXPECT_FALSE(std::filesystem::exists(run));
   // A seed of 0 and the largest one are seeds.
   auto largest = run_rigc({"render", scene, "-o", run, "--scale", "0.02", "--shots", "0", "--seed",
@@ -256,13 +254,13 @@ TEST(Cli, StoppingRigcStopsTheRendererItStarted) {
 TEST(Cli, VersionAndHelp) {
   auto version = run_rigc({"version"});
   EXPECT_EQ(version.exit_code, 0);
-  EXPECT_NE(version.out.find("rigc "), std::string::npos);
+  EXPECT_THAT(version.out, HasSubstr("rigc "));
   auto help = run_rigc({"check", "--help"});
   EXPECT_EQ(help.exit_code, 0);
-  EXPECT_NE(help.out.find("--json"), std::string::npos);
+  EXPECT_THAT(help.out, HasSubstr("--json"));
   auto top = run_rigc({"--help"});
   EXPECT_EQ(top.exit_code, 0);
-  EXPECT_NE(top.out.find("compile"), std::string::npos);
+  EXPECT_THAT(top.out, HasSubstr("compile"));
 }
 
 TEST(Cli, RenderCommandRejectsBadShotSelection) {
@@ -270,7 +268,7 @@ TEST(Cli, RenderCommandRejectsBadShotSelection) {
       {"render", ::rigc::testing::source_path("scenes/paper-turntable.yaml"), "--shots", "3,40",
        "-o", "/tmp/rigc-never-written"});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("--shots"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("--shots"));
   EXPECT_FALSE(std::filesystem::exists("/tmp/rigc-never-written"));
 }
 

@@ -1,6 +1,7 @@
 // Tests of the `rigc eval` verb, and end-to-end evaluations of runs rendered with the preview
 // backend: they need a renderer or the command line, which eval/ does not depend on.
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,6 +20,8 @@
 #include "eval/eval_test_support.h"
 #include "run/run_loop.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -41,9 +44,7 @@ TEST(EvalCommand, NeverWritesOverItsInputs) {
   const auto result = rigc::testing::run_rigc(
       {"eval", "--photos", dir.file("photos"), "--ground-truth", dir.file("cube.ply"),
        "--reconstruction", cloud, "--no-align", "--mesh-samples", "1000", "-o", dir.file("eval")});
-  EXPECT_NE(result.err.find("it is the reconstruction, an input of this command"),
-            std::string::npos)
-      << result.err;
+  EXPECT_THAT(result.err, HasSubstr("it is the reconstruction, an input of this command"));
   EXPECT_EQ(rigc::testing::read_text(cloud), before);
 }
 
@@ -62,7 +63,7 @@ TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   std::ostringstream log;
   EvalSummary s;
   EXPECT_EQ(evaluate(o, log, &s), 2);
-  EXPECT_NE(log.str().find("COLMAP is not available"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("COLMAP is not available"));
   std::ifstream report(dir.file("run/eval/eval.json"));
   ASSERT_TRUE(report.good());
   EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");
@@ -245,7 +246,7 @@ shots:
   EvalSummary s;
   EXPECT_EQ(evaluate(o, log, &s), 2);
   EXPECT_FALSE(s.reconstructed);
-  EXPECT_NE(log.str().find("texture"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("texture"));
   std::ifstream report(run.run_dir / "eval" / "eval.json");
   ASSERT_TRUE(report.good());
   EXPECT_EQ(nlohmann::json::parse(report)["reconstruction"]["status"], "failed");

@@ -1,8 +1,11 @@
 #include "cli/options.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <sstream>
+
+using ::testing::HasSubstr;
 
 namespace rigc::cli {
 namespace {
@@ -42,8 +45,8 @@ TEST(CommandLine, AnythingElseIsNamed) {
   for (const auto& [text, message] : invalid) {
     double value = 0;
     const std::string error = parse_value(text, &value);
-    EXPECT_NE(error.find("rigc: error: "), std::string::npos) << text << ": " << error;
-    EXPECT_NE(error.find(message), std::string::npos) << text << ": " << error;
+    EXPECT_THAT(error, HasSubstr("rigc: error: ")) << text << ": " << error;
+    EXPECT_THAT(error, HasSubstr(message)) << text << ": " << error;
   }
 }
 
@@ -62,13 +65,12 @@ TEST(CommandLine, ASeedOutOfRangeIsAnError) {
   EXPECT_EQ(parse_seed("18446744073709551615", &seed), "");
   EXPECT_EQ(seed, 18446744073709551615u);
   EXPECT_EQ(parse_seed("0", &seed), "");
-  EXPECT_NE(parse_seed("99999999999999999999", &seed)
-                .find("'99999999999999999999' is out of range: give 0 to 18446744073709551615"),
-            std::string::npos);
-  EXPECT_NE(parse_seed("18446744073709551616", &seed).find("out of range"), std::string::npos);
-  EXPECT_NE(parse_seed("-1", &seed).find("'-1' is negative"), std::string::npos);
-  EXPECT_NE(parse_seed("1.5", &seed).find("not a whole number"), std::string::npos);
-  EXPECT_NE(parse_seed("0x10", &seed).find("not a whole number"), std::string::npos);
+  EXPECT_THAT(parse_seed("99999999999999999999", &seed),
+              HasSubstr("'99999999999999999999' is out of range: give 0 to 18446744073709551615"));
+  EXPECT_THAT(parse_seed("18446744073709551616", &seed), HasSubstr("out of range"));
+  EXPECT_THAT(parse_seed("-1", &seed), HasSubstr("'-1' is negative"));
+  EXPECT_THAT(parse_seed("1.5", &seed), HasSubstr("not a whole number"));
+  EXPECT_THAT(parse_seed("0x10", &seed), HasSubstr("not a whole number"));
 }
 
 }  // namespace

@@ -15,6 +15,8 @@
 
 #include "tests/test_support.h"
 
+using ::testing::Not;
+
 extern char** environ;
 
 namespace rigc {
@@ -126,14 +128,12 @@ TEST(CliOutputs, StandardOutputThatCannotBeWrittenIsAnError) {
         std::vector<std::string>{"version"}}) {
     const auto full = run_rigc_with_stdout(args, "/dev/full", dir);
     EXPECT_EQ(full.exit_code, 2) << args[0];
-    EXPECT_NE(full.err.find("rigc: error: cannot write to standard output: No space left on "
-                            "device"),
-              std::string::npos)
-        << full.err;
+    EXPECT_THAT(full.err,
+                HasSubstr("rigc: error: cannot write to standard output: No space left on "
+                          "device"));
     const auto closed = run_rigc_with_stdout(args, "", dir);
     EXPECT_EQ(closed.exit_code, 2) << args[0];
-    EXPECT_NE(closed.err.find("rigc: error: cannot write to standard output"), std::string::npos)
-        << closed.err;
+    EXPECT_THAT(closed.err, HasSubstr("rigc: error: cannot write to standard output"));
   }
 }
 
@@ -179,15 +179,13 @@ TEST(CliOutputs, NoCommandWritesOverItsInputs) {
   for (const auto& [output, what] : outputs) {
     const auto result = run_rigc({"compile", dir.file("s.yaml"), "-o", output});
     EXPECT_EQ(result.exit_code, 1) << output;
-    EXPECT_NE(result.err.find("rigc: error: cannot write " + output), std::string::npos)
-        << result.err;
-    EXPECT_NE(result.err.find("it is " + what + ", an input of this command"), std::string::npos)
-        << result.err;
+    EXPECT_THAT(result.err, HasSubstr("rigc: error: cannot write " + output));
+    EXPECT_THAT(result.err, HasSubstr("it is " + what + ", an input of this command"));
   }
   const auto cycles =
       run_rigc({"compile", dir.file("s.yaml"), "--target", "cycles", "-o", dir.path().string()});
   EXPECT_EQ(cycles.exit_code, 1) << cycles.err;
-  EXPECT_NE(cycles.err.find("it is a texture of the scene"), std::string::npos) << cycles.err;
+  EXPECT_THAT(cycles.err, HasSubstr("it is a texture of the scene"));
   EXPECT_EQ(read_text(dir.file("cube.obj")), mesh);
   EXPECT_EQ(read_text(dir.file("cube.mtl")), material);
   EXPECT_EQ(read_text(dir.file("texture_0.png")), texture);
@@ -210,10 +208,9 @@ TEST(CliOutputs, ARunFolderHoldsOneScale) {
   const std::string image = read_text(run + "/images/shot_001.jpg");
   const auto other = render("0.1", {"--shots", "0"});
   EXPECT_EQ(other.exit_code, 1);
-  EXPECT_NE(other.err.find("rigc: error: this run folder holds shot_001 and 1 more rendered at "
-                           "--scale 0.05, and a run folder holds one image size"),
-            std::string::npos)
-      << other.err;
+  EXPECT_THAT(other.err,
+              HasSubstr("rigc: error: this run folder holds shot_001 and 1 more rendered at "
+                        "--scale 0.05, and a run folder holds one image size"));
   EXPECT_EQ(read_text(run + "/images/shot_001.jpg"), image);
   EXPECT_EQ(render("0.1", {}).exit_code, 0);
   EXPECT_EQ(manifest_of(run)["shots"]["shot_002"]["scale"], 0.1);
@@ -241,10 +238,9 @@ TEST(CliOutputs, ARunFolderHoldsOneSceneAndOnlyRecordedImages) {
   write_text(run + "/manifest.json", manifest.dump());
   auto other = run_rigc({"render", dir.file("b.yaml"), "-o", run, "--scale", "0.05"});
   EXPECT_EQ(other.exit_code, 1);
-  EXPECT_NE(other.err.find("holds 2 shots of the scene 'first', not 'second'; choose another "
-                           "folder with -o, or pass --force"),
-            std::string::npos)
-      << other.err;
+  EXPECT_THAT(other.err,
+              HasSubstr("holds 2 shots of the scene 'first', not 'second'; choose another "
+                        "folder with -o, or pass --force"));
   EXPECT_EQ(files_in(run + "/images"),
             (std::vector<std::string>{"shot_000.jpg", "shot_001.jpg", "shot_002.jpg"}));
 
@@ -252,26 +248,23 @@ TEST(CliOutputs, ARunFolderHoldsOneSceneAndOnlyRecordedImages) {
   auto again =
       run_rigc({"render", dir.file("a.yaml"), "-o", run, "--scale", "0.05", "--shots", "0"});
   EXPECT_EQ(again.exit_code, 0) << again.err;
-  EXPECT_NE(again.err.find("rigc: deleted 2 files in '" + run +
-                           "' that the manifest does not list (images/shot_002.jpg and 1 more)"),
-            std::string::npos)
-      << again.err;
+  EXPECT_THAT(again.err,
+              HasSubstr("rigc: deleted 2 files in '" + run +
+                        "' that the manifest does not list (images/shot_002.jpg and 1 more)"));
   EXPECT_EQ(files_in(run + "/images"), (std::vector<std::string>{"shot_000.jpg", "shot_001.jpg"}));
 
   // A file that is no shot of the scene is named, and deleted only with --force.
   write_text(run + "/images/IMG_0001.jpg", "a photo");
   again = run_rigc({"render", dir.file("a.yaml"), "-o", run, "--scale", "0.05"});
   EXPECT_EQ(again.exit_code, 0) << again.err;
-  EXPECT_NE(again.err.find("rigc: warning: the run folder '" + run +
-                           "' holds 1 file that no shot of 'first' writes and its manifest does "
-                           "not list (images/IMG_0001.jpg)"),
-            std::string::npos)
-      << again.err;
+  EXPECT_THAT(again.err,
+              HasSubstr("rigc: warning: the run folder '" + run +
+                        "' holds 1 file that no shot of 'first' writes and its manifest does "
+                        "not list (images/IMG_0001.jpg)"));
   EXPECT_TRUE(fs::exists(run + "/images/IMG_0001.jpg"));
   other = run_rigc({"render", dir.file("b.yaml"), "-o", run, "--scale", "0.05", "--force"});
   EXPECT_EQ(other.exit_code, 0) << other.err;
-  EXPECT_NE(other.err.find("--force: deleted 6 files of the scene 'first'"), std::string::npos)
-      << other.err;
+  EXPECT_THAT(other.err, HasSubstr("--force: deleted 6 files of the scene 'first'"));
   EXPECT_EQ(files_in(run + "/images"), (std::vector<std::string>{"shot_000.jpg", "shot_001.jpg"}));
   EXPECT_EQ(manifest_of(run)["inputs"]["scene"], "second");
 }
@@ -343,27 +336,25 @@ TEST(CliOutputs, OutputPathsThatCannotBeFollowedAreUserErrors) {
                                  dir.file("loop")}}) {
     const auto result = run_rigc(args);
     EXPECT_EQ(result.exit_code, 1) << result.err;
-    EXPECT_NE(result.err.find("rigc: error:"), std::string::npos) << result.err;
-    EXPECT_EQ(result.err.find("internal error"), std::string::npos) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("rigc: error:"));
+    EXPECT_THAT(result.err, Not(HasSubstr("internal error")));
   }
   auto result =
       run_rigc({"render", dir.file("s.yaml"), "--scale", "0.05", "-o", dir.file("dangling")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("is a symbolic link to '" + dir.file("missing/x") +
-                            "', which does not exist"),
-            std::string::npos)
-      << result.err;
+  EXPECT_THAT(result.err, HasSubstr("is a symbolic link to '" + dir.file("missing/x") +
+                                    "', which does not exist"));
   result = run_rigc({"compile", dir.file("s.yaml"), "-o", dir.file("dangling")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("whose folder does not exist"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("whose folder does not exist"));
   EXPECT_TRUE(fs::is_symlink(dir.file("dangling")));
 
   fs::create_directories(dir.path() / "photos");
   fs::create_symlink("a.jpg", dir.path() / "photos" / "a.jpg");
   result = run_rigc({"eval", "--photos", (dir.path() / "photos").string()});
   EXPECT_EQ(result.exit_code, 1) << result.err;
-  EXPECT_NE(result.err.find("rigc: error: cannot use '"), std::string::npos) << result.err;
-  EXPECT_NE(result.err.find("Too many levels of symbolic links"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("rigc: error: cannot use '"));
+  EXPECT_THAT(result.err, HasSubstr("Too many levels of symbolic links"));
 }
 
 }  // namespace

@@ -1,7 +1,11 @@
 // `rigc plan` as a user runs it: the planned file, the report, the errors.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::cli {
 namespace {
@@ -25,12 +29,12 @@ TEST(CliPlan, WritesThePlannedSceneBesideTheScene) {
   const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--target", "85%",
                                 "--visibility-scale", "0.15", "--rings", "20,40deg"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_NE(result.out.find("the scene's 18 shots reach"), std::string::npos) << result.out;
+  EXPECT_THAT(result.out, HasSubstr("the scene's 18 shots reach"));
   const std::string planned = read_text(dir.file("paper-plan.yaml"));
   // Everything but the shots is the user's text, comments included.
-  EXPECT_NE(planned.find("# Elinchrom D-Lite RX4 softboxes"), std::string::npos);
-  EXPECT_NE(planned.find("# Planned by `rigc plan`"), std::string::npos);
-  EXPECT_EQ(planned.find("steps: 18"), std::string::npos);
+  EXPECT_THAT(planned, HasSubstr("# Elinchrom D-Lite RX4 softboxes"));
+  EXPECT_THAT(planned, HasSubstr("# Planned by `rigc plan`"));
+  EXPECT_THAT(planned, Not(HasSubstr("steps: 18")));
   const auto check = run_rigc({"check", dir.file("paper-plan.yaml"), "--no-advice"});
   EXPECT_EQ(check.exit_code, 0) << check.err;
 }
@@ -45,13 +49,12 @@ TEST(CliPlan, NeverWritesOverTheScenesMesh) {
   write_text(dir.file("cube.obj"), cube);
   std::string text = small_paper_scene();
   const std::string primitive = "primitive: {shape: statue, detail: 4, seed: 7}";
-  ASSERT_NE(text.find(primitive), std::string::npos);
+  ASSERT_THAT(text, HasSubstr(primitive));
   text.replace(text.find(primitive), primitive.size(), "mesh: cube.obj");
   write_text(dir.file("s.yaml"), text);
   const auto result = run_rigc({"plan", dir.file("s.yaml"), "-o", dir.file("cube.obj"),
                                 "--visibility-scale", "0.1", "--rings", "30deg"});
-  EXPECT_NE(result.err.find("it is the scene's mesh, an input of this command"), std::string::npos)
-      << result.err;
+  EXPECT_THAT(result.err, HasSubstr("it is the scene's mesh, an input of this command"));
   EXPECT_EQ(read_text(dir.file("cube.obj")), cube);
 }
 
@@ -73,7 +76,7 @@ TEST(CliPlan, BadRequestsAreUserErrors) {
   for (const auto& [args, message] : cases) {
     const auto result = run_rigc(args);
     EXPECT_EQ(result.exit_code, 1) << args.back() << result.err;
-    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+    EXPECT_THAT(result.err, HasSubstr(message));
   }
   EXPECT_EQ(read_text(scene), small_paper_scene());
 }
@@ -84,7 +87,7 @@ TEST(CliPlan, NextSuggestsOneShotAfterTheScenesOwn) {
   const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--next", "--visibility-scale",
                                 "0.15", "-o", dir.file("next.yaml")});
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_NE(result.out.find("the next shot:"), std::string::npos) << result.out;
+  EXPECT_THAT(result.out, HasSubstr("the next shot:"));
   const std::string planned = read_text(dir.file("next.yaml"));
   const size_t own = planned.find("  - turntable: {steps: 18, step: 20deg");
   const size_t suggested = planned.find("  # Suggested by `rigc plan --next`");
@@ -100,7 +103,7 @@ TEST(CliPlan, AnUnreachableTargetExitsOneAndExplains) {
   const auto result = run_rigc({"plan", dir.file("paper.yaml"), "--target", "99.5%",
                                 "--turntable-only", "--visibility-scale", "0.15"});
   EXPECT_EQ(result.exit_code, 1) << result.err;
-  EXPECT_NE(result.out.find("cannot be reached"), std::string::npos) << result.out;
+  EXPECT_THAT(result.out, HasSubstr("cannot be reached"));
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 // `rigc studio` from the command line: what it refuses before serving. The served page and
 // Ctrl-C are tested in a browser (StudioBrowser.*, tests/studio_browser.py).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "studio/studio_test_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::cli {
 namespace {
@@ -14,18 +17,17 @@ TEST(CliStudio, AMissingOrBrokenSceneOrABadPortIsAUserError) {
   testing::TempDir dir;
   auto result = run_rigc({"studio", dir.file("none.yaml")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.err.find("rigc: error: cannot read"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("rigc: error: cannot read"));
 
   std::string text = studio::kStudioTestScene;
   text.replace(text.find("iso: 200"), 8, "iso: 20");
   testing::write_text(dir.file("broken.yaml"), text);
   result = run_rigc({"studio", dir.file("broken.yaml")});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(
-      result.err.find("broken.yaml:" + std::to_string(studio::kStudioTestSceneExposureLine) + ":"),
-      std::string::npos)
-      << result.err;
-  EXPECT_NE(result.err.find("ISO 20 is outside"), std::string::npos) << result.err;
+  EXPECT_THAT(
+      result.err,
+      HasSubstr("broken.yaml:" + std::to_string(studio::kStudioTestSceneExposureLine) + ":"));
+  EXPECT_THAT(result.err, HasSubstr("ISO 20 is outside"));
 
   testing::write_text(dir.file("good.yaml"), studio::kStudioTestScene);
   result = run_rigc({"studio", dir.file("good.yaml"), "--port", "70000"});

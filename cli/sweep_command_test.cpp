@@ -1,4 +1,5 @@
 // `rigc sweep` as a user runs it, with the local executor: variants, results, reruns, failures.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <thread>
 
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::cli {
 namespace {
@@ -48,17 +51,17 @@ TEST(CliSweep, RunsEveryVariantAndRerunsOnlyWhatChanged) {
   const std::string out = dir.file("out");
   auto first = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
   ASSERT_EQ(first.exit_code, 0) << first.err;
-  EXPECT_NE(first.err.find("4 to run"), std::string::npos) << first.err;
-  EXPECT_NE(first.err.find("4/4 done"), std::string::npos) << first.err;
+  EXPECT_THAT(first.err, HasSubstr("4 to run"));
+  EXPECT_THAT(first.err, HasSubstr("4/4 done"));
   const std::string csv = read_text(out + "/results.csv");
   EXPECT_EQ(count_lines(csv), 5) << csv;
-  EXPECT_NE(csv.find("aperture-f-16_steps-4,f/16,4,ok,"), std::string::npos) << csv;
+  EXPECT_THAT(csv, HasSubstr("aperture-f-16_steps-4,f/16,4,ok,"));
   const std::string md = read_text(out + "/results.md");
-  EXPECT_NE(md.find("Best variant: **"), std::string::npos) << md;
+  EXPECT_THAT(md, HasSubstr("Best variant: **"));
   EXPECT_TRUE(fs::exists(out + "/plots/reconstructable_pct_vs_camera.exposure.aperture.png"));
   // Each variant is an ordinary scene file with its run outputs beside it.
   const std::string variant = out + "/aperture-f-16_steps-3";
-  EXPECT_NE(read_text(variant + "/scene.yaml").find("{aperture: f/16, shutter"), std::string::npos);
+  EXPECT_THAT(read_text(variant + "/scene.yaml"), HasSubstr("{aperture: f/16, shutter"));
   EXPECT_TRUE(fs::exists(variant + "/images/shot_002.jpg"));
   EXPECT_FALSE(fs::exists(variant + "/images/shot_003.jpg"));
   EXPECT_TRUE(fs::exists(variant + "/coverage/coverage.json"));
@@ -66,14 +69,14 @@ TEST(CliSweep, RunsEveryVariantAndRerunsOnlyWhatChanged) {
 
   auto again = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
   ASSERT_EQ(again.exit_code, 0) << again.err;
-  EXPECT_NE(again.err.find("0 to run (4 done already)"), std::string::npos) << again.err;
+  EXPECT_THAT(again.err, HasSubstr("0 to run (4 done already)"));
   EXPECT_EQ(read_text(out + "/results.csv"), csv);
 
   write_text(dir.file("s.yaml"), sweep_file("f/4, f/11"));
   auto changed = run_rigc({"sweep", dir.file("s.yaml"), "-o", out});
   ASSERT_EQ(changed.exit_code, 0) << changed.err;
-  EXPECT_NE(changed.err.find("2 to run (2 done already)"), std::string::npos) << changed.err;
-  EXPECT_NE(read_text(out + "/results.csv").find("f/11"), std::string::npos);
+  EXPECT_THAT(changed.err, HasSubstr("2 to run (2 done already)"));
+  EXPECT_THAT(read_text(out + "/results.csv"), HasSubstr("f/11"));
 }
 
 TEST(CliSweep, AFailingVariantIsReportedAndTheOthersComplete) {
@@ -86,16 +89,16 @@ TEST(CliSweep, AFailingVariantIsReportedAndTheOthersComplete) {
   auto result = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "shots[0].turntable.steps=3,4",
                           "--scale", "0.05", "-o", out});
   EXPECT_EQ(result.exit_code, 2) << result.err;
-  EXPECT_NE(result.err.find("variant steps-3 failed: "), std::string::npos) << result.err;
-  EXPECT_NE(result.err.find("(log: " + out + "/steps-3/log.txt)"), std::string::npos) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("variant steps-3 failed: "));
+  EXPECT_THAT(result.err, HasSubstr("(log: " + out + "/steps-3/log.txt)"));
   const std::string csv = read_text(out + "/results.csv");
-  EXPECT_NE(csv.find("steps-4,4,ok,"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("steps-3,3,failed,"), std::string::npos) << csv;
-  EXPECT_NE(read_text(out + "/results.md").find("## Failed variants"), std::string::npos);
+  EXPECT_THAT(csv, HasSubstr("steps-4,4,ok,"));
+  EXPECT_THAT(csv, HasSubstr("steps-3,3,failed,"));
+  EXPECT_THAT(read_text(out + "/results.md"), HasSubstr("## Failed variants"));
   auto status = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "shots[0].turntable.steps=3,4",
                           "--scale", "0.05", "-o", out, "--status"});
-  EXPECT_NE(status.out.find("steps-4"), std::string::npos);
-  EXPECT_NE(status.out.find("1/2 variants done"), std::string::npos) << status.out;
+  EXPECT_THAT(status.out, HasSubstr("steps-4"));
+  EXPECT_THAT(status.out, HasSubstr("1/2 variants done"));
 }
 
 // The sweep's samples reach each variant's render, which records them in its manifest (POV-Ray:
@@ -121,8 +124,7 @@ TEST(CliSweep, NeverWritesOverItsInputs) {
       run_rigc({"sweep", out + "/results.md", "--vary", "shots[0].turntable.steps=3,4", "--scale",
                 "0.05", "-o", out, "--status"});
   EXPECT_NE(status.exit_code, 0);
-  EXPECT_NE(status.err.find("it is the scene file, an input of this command"), std::string::npos)
-      << status.err;
+  EXPECT_THAT(status.err, HasSubstr("it is the scene file, an input of this command"));
   EXPECT_EQ(read_text(out + "/results.md"), small_scene());
 }
 
@@ -132,22 +134,20 @@ TEST(CliSweep, BadSweepsAreUserErrorsBeforeAnythingRuns) {
   write_text(dir.file("s.yaml"), sweep_file("f/4, f/99"));
   auto bad_value = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("out")});
   EXPECT_EQ(bad_value.exit_code, 1);
-  EXPECT_NE(bad_value.err.find(dir.file("s.yaml") + ":4:35: error: variant 'aperture-f-99_steps-3'"
-                                                    " does not compile"),
-            std::string::npos)
-      << bad_value.err;
-  EXPECT_NE(bad_value.err.find(dir.file("scene.yaml") + ":23:"), std::string::npos)
-      << bad_value.err;
+  EXPECT_THAT(bad_value.err,
+              HasSubstr(dir.file("s.yaml") + ":4:35: error: variant 'aperture-f-99_steps-3'"
+                                             " does not compile"));
+  EXPECT_THAT(bad_value.err, HasSubstr(dir.file("scene.yaml") + ":23:"));
   EXPECT_FALSE(fs::exists(dir.file("out")));
   auto bad_vary = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "camera.nope=1,2"});
   EXPECT_EQ(bad_vary.exit_code, 1);
-  EXPECT_NE(bad_vary.err.find("'camera' has no key 'nope'"), std::string::npos) << bad_vary.err;
+  EXPECT_THAT(bad_vary.err, HasSubstr("'camera' has no key 'nope'"));
   auto no_eq = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "camera.nope"});
   EXPECT_EQ(no_eq.exit_code, 1);
-  EXPECT_NE(no_eq.err.find("is not PATH=V1,V2"), std::string::npos) << no_eq.err;
+  EXPECT_THAT(no_eq.err, HasSubstr("is not PATH=V1,V2"));
   auto no_scene = run_rigc({"sweep", dir.file("missing.yaml"), "--vary", "a=1"});
   EXPECT_EQ(no_scene.exit_code, 1);
-  EXPECT_NE(no_scene.err.find("cannot read the scene file"), std::string::npos) << no_scene.err;
+  EXPECT_THAT(no_scene.err, HasSubstr("cannot read the scene file"));
 }
 
 // A sweep file named like a table the sweep writes at the end is refused before any variant runs.
@@ -163,8 +163,7 @@ TEST(CliSweep, ASweepFileInTheTablesPlaceIsRefusedBeforeAnythingRuns) {
   write_text(out + "/results.md", sweep);
   const auto r = run_rigc({"sweep", out + "/results.md", "-o", out});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("it is the sweep file, an input of this command"), std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("it is the sweep file, an input of this command"));
   EXPECT_EQ(read_text(out + "/results.md"), sweep);
   EXPECT_FALSE(fs::exists(out + "/steps-3"));
 }
@@ -179,17 +178,17 @@ TEST(CliSweep, AScenePastTheLanguagesBoundsIsRefusedAtItsLine) {
   };
   auto r = sweep_of("/dev/zero");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("is not a regular file"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("is not a regular file"));
   write_text(dir.file("big.yaml"), small_scene() + std::string(17 << 20, '#'));
   r = sweep_of(dir.file("big.yaml"));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("larger than 16 MB"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("larger than 16 MB"));
   write_text(dir.file("deep.yaml"), "rigc: 1\nname: deep\nobject: " + std::string(100000, '[') +
                                         std::string(100000, ']') + "\n");
   r = sweep_of(dir.file("deep.yaml"));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("deep.yaml:3:"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("nest deeper than"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("deep.yaml:3:"));
+  EXPECT_THAT(r.err, HasSubstr("nest deeper than"));
   EXPECT_FALSE(fs::exists(dir.file("out")));
 }
 
@@ -205,7 +204,7 @@ TEST(CliSweep, VaryingTheBackendIsTheBackendsAxis) {
   r = run_rigc({"sweep", dir.file("scene.yaml"), "--vary", "backend=preview,povray", "--backend",
                 "cycles", "-o", dir.file("out2"), "--status"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("the renderers are given twice"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("the renderers are given twice"));
 }
 
 // True when a Slurm cluster answers (scripts/slurm_cluster.sh start; its slurm.conf is used when
@@ -239,12 +238,12 @@ TEST(CliSweepSlurm, AJobArrayGivesTheSameResultsAsTheLocalExecutor) {
   auto slurm = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--executor",
                          "slurm", "--cpus-per-task", "1", "--time", "10:00"});
   ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
-  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
-  EXPECT_NE(slurm.err.find("4/4 tasks done"), std::string::npos) << slurm.err;
+  EXPECT_THAT(slurm.err, HasSubstr("submitted job array"));
+  EXPECT_THAT(slurm.err, HasSubstr("4/4 tasks done"));
   EXPECT_EQ(read_text(dir.file("slurm") + "/results.csv"),
             read_text(dir.file("local") + "/results.csv"));
   auto status = run_rigc({"sweep", dir.file("s.yaml"), "-o", dir.file("slurm"), "--status"});
-  EXPECT_NE(status.out.find("4/4 variants done"), std::string::npos) << status.out;
+  EXPECT_THAT(status.out, HasSubstr("4/4 variants done"));
 }
 
 TEST(CliSweepSlurm, AKilledTaskIsReportedAndRetryFailedCompletesIt) {
@@ -265,16 +264,15 @@ TEST(CliSweepSlurm, AKilledTaskIsReportedAndRetryFailedCompletesIt) {
   ASSERT_FALSE(task.empty()) << waiting.err;
   ASSERT_EQ(cancelled, 0);
   EXPECT_EQ(waiting.exit_code, 2) << waiting.err;
-  EXPECT_NE(waiting.err.find("failed (job " + task + "): Slurm: CANCELLED"), std::string::npos)
-      << waiting.err;
-  EXPECT_NE(waiting.err.find(dir.file("out") + "/slurm/" + task + ".log"), std::string::npos);
+  EXPECT_THAT(waiting.err, HasSubstr("failed (job " + task + "): Slurm: CANCELLED"));
+  EXPECT_THAT(waiting.err, HasSubstr(dir.file("out") + "/slurm/" + task + ".log"));
 
   std::vector<std::string> retry = sweep;
   retry.push_back("--retry-failed");
   auto retried = run_rigc(retry);
   ASSERT_EQ(retried.exit_code, 0) << retried.err;
-  EXPECT_NE(retried.err.find("1 to submit"), std::string::npos) << retried.err;
-  EXPECT_NE(retried.out.find("2/2 variants with results"), std::string::npos) << retried.out;
+  EXPECT_THAT(retried.err, HasSubstr("1 to submit"));
+  EXPECT_THAT(retried.out, HasSubstr("2/2 variants with results"));
 }
 
 TEST(CliSweepSlurm, ABadSbatchOptionIsAClearError) {
@@ -288,19 +286,18 @@ TEST(CliSweepSlurm, ABadSbatchOptionIsAClearError) {
   args.push_back("--sbatch=--no-such-option");
   auto bad = run_rigc(args);
   EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_NE(bad.err.find("rigc: error: sbatch refused the job array"), std::string::npos)
-      << bad.err;
-  EXPECT_NE(bad.err.find("no-such-option"), std::string::npos) << bad.err;
+  EXPECT_THAT(bad.err, HasSubstr("rigc: error: sbatch refused the job array"));
+  EXPECT_THAT(bad.err, HasSubstr("no-such-option"));
   args = sweep;
   args.insert(args.end(), {"--partition", "nosuch"});
   auto partition = run_rigc(args);
   EXPECT_EQ(partition.exit_code, 1);
-  EXPECT_NE(partition.err.find("nvalid partition"), std::string::npos) << partition.err;
+  EXPECT_THAT(partition.err, HasSubstr("nvalid partition"));
   args = sweep;
   args.push_back("--sbatch=--output=/tmp/x");
   auto own = run_rigc(args);
   EXPECT_EQ(own.exit_code, 1);
-  EXPECT_NE(own.err.find("is rigc's own"), std::string::npos) << own.err;
+  EXPECT_THAT(own.err, HasSubstr("is rigc's own"));
 }
 
 // A run's outputs (images, masks, ground truth), relative to it; not the renderer's own scripts
@@ -335,8 +332,8 @@ TEST(CliSweepSlurm, ACyclesRenderSplitOverSlurmIsByteIdenticalToALocalOne) {
   args.insert(args.end(), {"-o", dir.file("slurm"), "--executor", "slurm"});
   auto slurm = run_rigc(args);
   ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
-  EXPECT_NE(slurm.err.find("submitted job array"), std::string::npos) << slurm.err;
-  EXPECT_NE(slurm.err.find("6/6 shots done"), std::string::npos) << slurm.err;
+  EXPECT_THAT(slurm.err, HasSubstr("submitted job array"));
+  EXPECT_THAT(slurm.err, HasSubstr("6/6 shots done"));
   const auto files = run_files(dir.file("local"));
   ASSERT_EQ(files, run_files(dir.file("slurm")));
   EXPECT_GE(files.size(), 15u);  // 6 images, 6 masks, sparse/, transforms.json

@@ -1,5 +1,6 @@
 #include "compiler/frontend.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,9 @@
 
 #include "ir/ir_json.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc {
 namespace {
@@ -83,9 +87,9 @@ TEST(Frontend, BadScenesGiveTheirGoldenDiagnostics) {
 TEST(Frontend, AllErrorsOfAFileAreReported) {
   Compiled compiled = compile_repo_file("tests/bad_scenes/unknown_keys.yaml");
   EXPECT_EQ(compiled.errors, 3);
-  EXPECT_NE(compiled.diagnostics.find("did you mean 'aperture'?"), std::string::npos);
-  EXPECT_NE(compiled.diagnostics.find("did you mean 'height'?"), std::string::npos);
-  EXPECT_NE(compiled.diagnostics.find("did you mean 'studio'?"), std::string::npos);
+  EXPECT_THAT(compiled.diagnostics, HasSubstr("did you mean 'aperture'?"));
+  EXPECT_THAT(compiled.diagnostics, HasSubstr("did you mean 'height'?"));
+  EXPECT_THAT(compiled.diagnostics, HasSubstr("did you mean 'studio'?"));
 }
 
 TEST(Frontend, EveryExampleSceneCompiles) {
@@ -235,8 +239,7 @@ TEST(Frontend, DistortionThatFoldsTheFrameOverIsAnError) {
     Compiled compiled = compile_text(text);
     EXPECT_EQ(compiled.scene.has_value(), c.valid) << c.lens << "\n" << compiled.diagnostics;
     if (!c.valid) {
-      EXPECT_NE(compiled.diagnostics.find("the distortion folds the image over"), std::string::npos)
-          << compiled.diagnostics;
+      EXPECT_THAT(compiled.diagnostics, HasSubstr("the distortion folds the image over"));
     }
   }
 }
@@ -257,7 +260,7 @@ TEST(Frontend, UntexturedObjectGetsACaptureWarning) {
   Compiled compiled = compile_text(text);
   ASSERT_TRUE(compiled.scene);
   EXPECT_EQ(compiled.warnings, 1);
-  EXPECT_NE(compiled.diagnostics.find("warning: the object has no texture"), std::string::npos);
+  EXPECT_THAT(compiled.diagnostics, HasSubstr("warning: the object has no texture"));
 }
 
 // A scan's vertex colours are its base colour in the IR (red on the cube's top, blue below):
@@ -270,7 +273,7 @@ TEST(Frontend, VertexColoursReachTheIrUnlessTheSceneGivesAColour) {
   text.erase(text.find("  surface: {pattern: speckle}\n"), 30);
   Compiled coloured = compile_text(text);
   ASSERT_TRUE(coloured.scene) << coloured.diagnostics;
-  EXPECT_EQ(coloured.diagnostics.find("no texture"), std::string::npos) << coloured.diagnostics;
+  EXPECT_THAT(coloured.diagnostics, Not(HasSubstr("no texture")));
   const ir::Mesh& mesh = coloured.scene->object.mesh;
   ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
@@ -285,7 +288,7 @@ TEST(Frontend, VertexColoursReachTheIrUnlessTheSceneGivesAColour) {
   Compiled painted = compile_text(text);
   ASSERT_TRUE(painted.scene) << painted.diagnostics;
   EXPECT_TRUE(painted.scene->object.mesh.colors.empty());
-  EXPECT_NE(painted.diagnostics.find("no texture"), std::string::npos) << painted.diagnostics;
+  EXPECT_THAT(painted.diagnostics, HasSubstr("no texture"));
 }
 
 TEST(Frontend, ManualFocusAndEffectsReachTheIr) {

@@ -1,5 +1,6 @@
 // File, material and texture names that are not UTF-8: every JSON output stays valid JSON.
 #include <OpenImageIO/imageio.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +11,9 @@
 #include "compiler/frontend.h"
 #include "ir/utf8_text.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc {
 namespace {
@@ -92,8 +96,8 @@ shots:
   ASSERT_EQ(ir.exit_code, 0) << ir.err;
   const json document = parsed(ir.out);
   EXPECT_EQ(document.value("source_file", ""), dir.file("scene\xEF\xBF\xBD.yaml"));
-  EXPECT_NE(ir.out.find("mat\xEF\xBF\xBD"), std::string::npos);
-  EXPECT_NE(ir.out.find("tex\xEF\xBF\xBD.png"), std::string::npos);
+  EXPECT_THAT(ir.out, HasSubstr("mat\xEF\xBF\xBD"));
+  EXPECT_THAT(ir.out, HasSubstr("tex\xEF\xBF\xBD.png"));
 
   const std::string run = dir.file("run");
   const auto render = run_rigc({"render", scene, "-o", run, "--scale", "0.05"});
@@ -129,16 +133,15 @@ TEST(HostileNames, AnUnreadableSceneFileSaysWhy) {
   fs::create_directories(dir.path() / "folder.yaml");
   fs::create_symlink("loop.yaml", dir.path() / "loop.yaml");
   fs::create_symlink("gone.yaml", dir.path() / "dangling.yaml");
-  EXPECT_NE(compile_messages(dir.file("none.yaml"))
-                .find("cannot read the scene file: it does not "
-                      "exist"),
-            std::string::npos);
-  EXPECT_NE(compile_messages(dir.file("folder.yaml")).find(": it is a folder"), std::string::npos);
-  EXPECT_NE(compile_messages(dir.file("loop.yaml")).find(": it is a loop of symbolic links"),
-            std::string::npos);
-  EXPECT_NE(compile_messages(dir.file("dangling.yaml")).find(": it is a symbolic link to nothing"),
-            std::string::npos);
-  EXPECT_NE(compile_messages("/dev/null").find(": it is not a regular file"), std::string::npos);
+  EXPECT_THAT(compile_messages(dir.file("none.yaml")),
+              HasSubstr("cannot read the scene file: it does not "
+                        "exist"));
+  EXPECT_THAT(compile_messages(dir.file("folder.yaml")), HasSubstr(": it is a folder"));
+  EXPECT_THAT(compile_messages(dir.file("loop.yaml")),
+              HasSubstr(": it is a loop of symbolic links"));
+  EXPECT_THAT(compile_messages(dir.file("dangling.yaml")),
+              HasSubstr(": it is a symbolic link to nothing"));
+  EXPECT_THAT(compile_messages("/dev/null"), HasSubstr(": it is not a regular file"));
 }
 
 std::string text_messages(const std::string& text) {
@@ -163,11 +166,10 @@ TEST(HostileNames, AnUnreadableMeshSaysWhy) {
                                     "s.yaml", dir.path().string(), diag));
     return out;
   };
-  EXPECT_NE(messages("loop.obj").find("loop.obj' is a loop of symbolic links"), std::string::npos)
-      << messages("loop.obj");
-  EXPECT_NE(messages("folder.obj").find("folder.obj' is a folder"), std::string::npos);
-  EXPECT_NE(messages("zero.obj").find("zero.obj' is not a regular file"), std::string::npos);
-  EXPECT_NE(messages("gone.obj").find("gone.obj' does not exist"), std::string::npos);
+  EXPECT_THAT(messages("loop.obj"), HasSubstr("loop.obj' is a loop of symbolic links"));
+  EXPECT_THAT(messages("folder.obj"), HasSubstr("folder.obj' is a folder"));
+  EXPECT_THAT(messages("zero.obj"), HasSubstr("zero.obj' is not a regular file"));
+  EXPECT_THAT(messages("gone.obj"), HasSubstr("gone.obj' does not exist"));
 }
 
 // A NUL byte was "unknown escape character".
@@ -182,11 +184,9 @@ TEST(HostileNames, ControlAndBidiCharactersAreRefusedInTheName) {
                                  "b",
                                  "evil\xE2\x80\xAEgpj.exe", "x\xE2\x81\xA6y"}) {
     const std::string messages = text_messages("rigc: 1\nname: \"" + name + "\"\n");
-    EXPECT_NE(messages.find("the scene's name cannot name a folder (it holds a"), std::string::npos)
-        << messages;
+    EXPECT_THAT(messages, HasSubstr("the scene's name cannot name a folder (it holds a"));
   }
-  EXPECT_EQ(text_messages("rigc: 1\nname: \"caf\xC3\xA9\"\n").find("name cannot"),
-            std::string::npos);
+  EXPECT_THAT(text_messages("rigc: 1\nname: \"caf\xC3\xA9\"\n"), Not(HasSubstr("name cannot")));
 }
 
 }  // namespace

@@ -2,11 +2,14 @@
 // closest focus the lens allows, and errors at the offending value's line.
 #include "compiler/presets.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "compiler/frontend.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc {
 namespace {
@@ -84,20 +87,16 @@ TEST(LensPresets, AZoomTakesAFocalLengthInItsRange) {
 
   const Compiled none = compile_with("{preset: canon-ef-24-70mm-f2.8l-ii-usm}");
   EXPECT_FALSE(none.scene);
-  EXPECT_NE(none.diagnostics.find("lens.yaml:8:9: error: the zoom lens "
-                                  "canon-ef-24-70mm-f2.8l-ii-usm needs a 'focal_length' in "
-                                  "24mm-70mm"),
-            std::string::npos)
-      << none.diagnostics;
+  EXPECT_THAT(none.diagnostics, HasSubstr("lens.yaml:8:9: error: the zoom lens "
+                                          "canon-ef-24-70mm-f2.8l-ii-usm needs a 'focal_length' in "
+                                          "24mm-70mm"));
 
   const Compiled outside =
       compile_with("{preset: canon-ef-24-105mm-f4l-is-ii-usm, focal_length: 135mm}");
   EXPECT_FALSE(outside.scene);
-  EXPECT_NE(outside.diagnostics.find("lens.yaml:8:"), std::string::npos) << outside.diagnostics;
-  EXPECT_NE(outside.diagnostics.find("focal length 135mm is outside the lens "
-                                     "canon-ef-24-105mm-f4l-is-ii-usm's 24mm-105mm"),
-            std::string::npos)
-      << outside.diagnostics;
+  EXPECT_THAT(outside.diagnostics, HasSubstr("lens.yaml:8:"));
+  EXPECT_THAT(outside.diagnostics, HasSubstr("focal length 135mm is outside the lens "
+                                             "canon-ef-24-105mm-f4l-is-ii-usm's 24mm-105mm"));
   // A prime takes no other focal length.
   EXPECT_FALSE(compile_with("{preset: canon-ef-50mm-f1.8-stm, focal_length: 55mm}").scene);
 }
@@ -105,16 +104,13 @@ TEST(LensPresets, AZoomTakesAFocalLengthInItsRange) {
 TEST(LensPresets, ApertureOutsideTheLensIsAnErrorAtItsLine) {
   const Compiled wide = compile_with("{preset: canon-ef-50mm-f1.8-stm}", "f/1.4");
   EXPECT_FALSE(wide.scene);
-  EXPECT_NE(wide.diagnostics.find("lens.yaml:9:24: error: f/1.4 is wider than the lens "
-                                  "canon-ef-50mm-f1.8-stm opens (f/1.8 at the widest)"),
-            std::string::npos)
-      << wide.diagnostics;
+  EXPECT_THAT(wide.diagnostics, HasSubstr("lens.yaml:9:24: error: f/1.4 is wider than the lens "
+                                          "canon-ef-50mm-f1.8-stm opens (f/1.8 at the widest)"));
   const Compiled narrow = compile_with("{preset: sigma-35mm-f1.4-dg-hsm-art}", "f/22");
   EXPECT_FALSE(narrow.scene);
-  EXPECT_NE(narrow.diagnostics.find("lens.yaml:9:24: error: f/22 is narrower than the lens "
-                                    "sigma-35mm-f1.4-dg-hsm-art closes (f/16 at the narrowest)"),
-            std::string::npos)
-      << narrow.diagnostics;
+  EXPECT_THAT(narrow.diagnostics,
+              HasSubstr("lens.yaml:9:24: error: f/22 is narrower than the lens "
+                        "sigma-35mm-f1.4-dg-hsm-art closes (f/16 at the narrowest)"));
   EXPECT_TRUE(compile_with("{preset: canon-ef-50mm-f1.8-stm}", "f/1.8").scene);
   EXPECT_TRUE(compile_with("{preset: canon-ef-50mm-f1.8-stm}", "f/22").scene);
 }
@@ -122,10 +118,9 @@ TEST(LensPresets, ApertureOutsideTheLensIsAnErrorAtItsLine) {
 TEST(LensPresets, FocusCloserThanTheLensCanIsAnErrorAtItsLine) {
   const Compiled close = compile_with("{preset: canon-ef-85mm-f1.8-usm}", "f/8", "60cm");
   EXPECT_FALSE(close.scene);
-  EXPECT_NE(close.diagnostics.find("lens.yaml:10:10: error: focus at 0.6m is closer than the "
-                                   "lens canon-ef-85mm-f1.8-usm focuses (0.85m at the closest)"),
-            std::string::npos)
-      << close.diagnostics;
+  EXPECT_THAT(close.diagnostics,
+              HasSubstr("lens.yaml:10:10: error: focus at 0.6m is closer than the "
+                        "lens canon-ef-85mm-f1.8-usm focuses (0.85m at the closest)"));
   EXPECT_TRUE(compile_with("{preset: canon-ef-85mm-f1.8-usm}", "f/8", "90cm").scene);
 }
 
@@ -133,21 +128,19 @@ TEST(LensPresets, FocusCloserThanTheLensCanIsAnErrorAtItsLine) {
 TEST(LensPresets, AutofocusCloserThanTheLensCanIsAnErrorAtTheShot) {
   const Compiled close = compile_with("{preset: canon-ef-85mm-f1.8-usm}", "f/8", "auto", "80cm");
   EXPECT_FALSE(close.scene);
-  EXPECT_NE(close.diagnostics.find("lens.yaml:12:5: error: shot_000: the subject is 0.81 m away, "
-                                   "closer than the lens canon-ef-85mm-f1.8-usm focuses (0.85 m "
-                                   "at the closest); step back"),
-            std::string::npos)
-      << close.diagnostics;
+  EXPECT_THAT(close.diagnostics,
+              HasSubstr("lens.yaml:12:5: error: shot_000: the subject is 0.81 m away, "
+                        "closer than the lens canon-ef-85mm-f1.8-usm focuses (0.85 m "
+                        "at the closest); step back"));
   EXPECT_TRUE(compile_with("{preset: canon-ef-50mm-f1.8-stm}", "f/8", "auto", "80cm").scene);
 }
 
 TEST(LensPresets, UnknownPresetSaysWhichAreKnown) {
   const Compiled c = compile_with("{preset: canon-ef-50mm-f1.8-sm}");
   EXPECT_FALSE(c.scene);
-  EXPECT_NE(c.diagnostics.find("lens.yaml:8:18: error: unknown lens 'canon-ef-50mm-f1.8-sm'"),
-            std::string::npos)
-      << c.diagnostics;
-  EXPECT_NE(c.diagnostics.find("canon-ef-50mm-f1.8-stm"), std::string::npos) << c.diagnostics;
+  EXPECT_THAT(c.diagnostics,
+              HasSubstr("lens.yaml:8:18: error: unknown lens 'canon-ef-50mm-f1.8-sm'"));
+  EXPECT_THAT(c.diagnostics, HasSubstr("canon-ef-50mm-f1.8-stm"));
 }
 
 }  // namespace

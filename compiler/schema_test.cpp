@@ -1,12 +1,15 @@
 // The JSON Schema in schema/ and the compiler must accept the same language: every example scene
 // is validated by a real JSON Schema validator (python3-jsonschema) and compiled; a scene the
 // compiler rejects for its shape is rejected by the schema too.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "compiler/frontend.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc {
 namespace {
@@ -30,7 +33,7 @@ TEST(Schema, EveryExampleSceneIsValidAndCompiles) {
   testing::ProcessResult result = validate(scenes);
   EXPECT_EQ(result.exit_code, 0) << result.out << result.err;
   for (const auto& scene : scenes) {
-    EXPECT_NE(result.out.find(scene + ": valid"), std::string::npos) << result.out;
+    EXPECT_THAT(result.out, HasSubstr(scene + ": valid"));
     DiagnosticEngine diag;
     diag.set_handler([](const Diagnostic&, const std::string&) {});
     EXPECT_TRUE(compile_scene_file(scene, diag)) << scene;
@@ -50,7 +53,7 @@ TEST(Schema, RejectsWhatTheCompilerRejectsForItsShape) {
     const std::string path = testing::source_path("tests/bad_scenes/" + name);
     testing::ProcessResult result = validate({path});
     EXPECT_EQ(result.exit_code, 1) << name << ": " << result.out << result.err;
-    EXPECT_NE(result.out.find("invalid"), std::string::npos) << name;
+    EXPECT_THAT(result.out, HasSubstr("invalid")) << name;
   }
 }
 

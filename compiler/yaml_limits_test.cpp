@@ -1,11 +1,15 @@
 #include "compiler/yaml_limits.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <string>
 
 #include "compiler/frontend.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc {
 namespace {
@@ -20,7 +24,7 @@ TEST(YamlLimits, ARecursiveAliasIsAnErrorAtTheAlias) {
   const auto problem = yaml_shape_problem(text);
   ASSERT_TRUE(problem);
   EXPECT_EQ(problem->line, 2);
-  EXPECT_NE(problem->message.find("refers to a list or map that holds it"), std::string::npos);
+  EXPECT_THAT(problem->message, HasSubstr("refers to a list or map that holds it"));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
 }
 
@@ -35,7 +39,7 @@ TEST(YamlLimits, AliasesThatMultiplyAreCountedWrittenOut) {
   const auto problem = yaml_shape_problem(text);
   ASSERT_TRUE(problem);
   EXPECT_EQ(problem->line, 5);  // a5 is the first to pass kMostYamlNodes
-  EXPECT_NE(problem->message.find("once its aliases are written out"), std::string::npos);
+  EXPECT_THAT(problem->message, HasSubstr("once its aliases are written out"));
 }
 
 TEST(YamlLimits, ModestAliasesAndNestingPass) {
@@ -55,14 +59,14 @@ TEST(YamlLimits, DeepNestingIsALimitAtItsLine) {
     const auto problem = yaml_shape_problem(text + close + "\n");
     ASSERT_TRUE(problem) << open;
     EXPECT_EQ(problem->line, 2);
-    EXPECT_NE(problem->message.find("deeper than 100 levels"), std::string::npos);
+    EXPECT_THAT(problem->message, HasSubstr("deeper than 100 levels"));
   }
   // Block style too: each key one indent deeper.
   std::string text = "rigc: 1\nobject:\n";
   for (int i = 1; i < 2000; ++i) text += std::string(2 * i, ' ') + "k:\n";
   const auto problem = yaml_shape_problem(text);
   ASSERT_TRUE(problem);
-  EXPECT_NE(problem->message.find("deeper than"), std::string::npos);
+  EXPECT_THAT(problem->message, HasSubstr("deeper than"));
 }
 
 // Through the front end the problem is a diagnostic at file:line, not "bad file".
@@ -73,7 +77,7 @@ TEST(YamlLimits, TheFrontEndReportsTheProblemAtItsLine) {
   const std::string text = "rigc: 1\nobject: " + std::string(3000, '[') + std::string(3000, ']');
   EXPECT_FALSE(compile_scene_text(text, "deep.yaml", ".", diag));
   EXPECT_EQ(messages.rfind("deep.yaml:2:", 0), 0u) << messages;
-  EXPECT_EQ(messages.find("bad file"), std::string::npos) << messages;
+  EXPECT_THAT(messages, Not(HasSubstr("bad file")));
   // The echoed line is cut around the column rather than printed 6000 characters wide.
   EXPECT_LT(messages.size(), 600u) << messages;
 }

@@ -1,11 +1,15 @@
 #include "dslr/buffer_pool.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::dslr {
 namespace {
@@ -98,7 +102,7 @@ TEST(BufferPool, FreshBuffersStayOnSmallPages) {
   ASSERT_FALSE(fields.vm_flags.empty()) << "no mapping found in /proc/self/smaps";
   bool advised_against = false;
   for (const std::string& flags : fields.vm_flags) {
-    EXPECT_EQ(flags.find(" hg"), std::string::npos) << flags;
+    EXPECT_THAT(flags, Not(HasSubstr(" hg")));
     advised_against = advised_against || flags.find(" nh") != std::string::npos;
   }
   EXPECT_TRUE(advised_against);

@@ -1,10 +1,13 @@
 #include "dslr/develop.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "dslr/exposure.h"
 #include "dslr/pipeline.h"
 #include "dslr/test_helpers.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::dslr {
 namespace {
@@ -112,7 +115,7 @@ TEST(DslrDevelop, MalformedFrameIsAnError) {
   std::string error;
   const DevelopResult r = develop_frame(camera, frame, {}, 0.05, &error);
   EXPECT_TRUE(r.encoded.empty());
-  EXPECT_NE(error.find("depth"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("depth"));
 }
 
 }  // namespace

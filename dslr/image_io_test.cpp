@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -10,6 +11,8 @@
 #include "dslr/pipeline.h"
 #include "dslr/test_helpers.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::dslr {
 namespace {
@@ -175,7 +178,7 @@ TEST(DslrWrite, UnwritablePlacesGiveAnErrorAndLeaveNothing) {
   std::string error;
   // A folder that does not exist.
   EXPECT_FALSE(write_image(dir.path() / "missing" / "shot.jpg", image, camera, &error));
-  EXPECT_NE(error.find("missing"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("missing"));
   // A "folder" that is a file.
   rigc::testing::write_text(dir.file("file"), "x");
   error.clear();
@@ -242,8 +245,7 @@ TEST(DslrWrite, AWriteThatRunsOutOfSpaceFailsAndLeavesNothing) {
           write_image(dir.file(name), jpeg ? image : image16, jpeg ? camera : camera16, &error))
           << name;
     }
-    EXPECT_NE(error.find("cannot write " + dir.file(name) + ": File too large"), std::string::npos)
-        << error;
+    EXPECT_THAT(error, HasSubstr("cannot write " + dir.file(name) + ": File too large"));
     EXPECT_TRUE(folder_entries(dir.path()).empty()) << name;
   }
   std::string error;
@@ -251,7 +253,7 @@ TEST(DslrWrite, AWriteThatRunsOutOfSpaceFailsAndLeavesNothing) {
     const FileSizeLimit limit(20);
     EXPECT_FALSE(write_mask(dir.file("mask.png"), image.mask, image.width, image.height, &error));
   }
-  EXPECT_NE(error.find("File too large"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("File too large"));
   EXPECT_TRUE(folder_entries(dir.path()).empty());
 }
 

@@ -10,6 +10,8 @@
 
 #include "eval/reconstruction_test_support.h"
 
+using ::testing::HasSubstr;
+
 namespace rigc::eval {
 namespace {
 
@@ -59,19 +61,19 @@ TEST(CameraFiles, BrokenFilesAreNamed) {
   std::string error;
   rigc::testing::write_text(dir.file("a.sfm"), "{\"views\": []}");
   EXPECT_FALSE(read_camera_file(dir.file("a.sfm"), &error));
-  EXPECT_NE(error.find("a.sfm: is not a Meshroom SfMData"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("a.sfm: is not a Meshroom SfMData"));
   rigc::testing::write_text(dir.file("b.out"), "# Bundle file v0.3\n1 0\n");
   EXPECT_FALSE(read_camera_file(dir.file("b.out"), &error));
-  EXPECT_NE(error.find("no image list"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("no image list"));
   rigc::testing::write_text(dir.file("b.list.txt"), "x.jpg\n");
   EXPECT_FALSE(read_camera_file(dir.file("b.out"), &error));
-  EXPECT_NE(error.find("camera 0 is incomplete"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("camera 0 is incomplete"));
   rigc::testing::write_text(dir.file("images.bin"), "xx");
   rigc::testing::write_text(dir.file("cameras.bin"), "xx");
   EXPECT_FALSE(read_camera_file(dir.path(), &error));
-  EXPECT_NE(error.find("ends early"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("ends early"));
   EXPECT_FALSE(read_camera_file(dir.file("c.xyz"), &error));
-  EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("does not exist"));
 }
 
 // Neither read forever nor waited on: /dev/zero behind a Bundler .out (it read 4.4 GB), a pipe

@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,6 +26,9 @@
 #include "eval/reconstruction_test_support.h"
 #include "run/manifest.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::eval {
 namespace {
@@ -193,7 +197,7 @@ TEST(EvalColmap, ReadsPointsWithTracks) {
   EXPECT_DOUBLE_EQ(model.mean_reprojection_error(), (0.25 * 3 + 0.75 * 2) / 5);
   rigc::testing::write_text(dir.file("bad.txt"), "1 2 x\n");
   EXPECT_FALSE(read_colmap_points(dir.file("bad.txt"), &error).has_value());
-  EXPECT_NE(error.find("bad.txt:1"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("bad.txt:1"));
 }
 
 // Optical axis of a camera at azimuth `azimuth_deg` and elevation `elevation_deg` looking at the
@@ -351,7 +355,7 @@ TEST(EvalOptions, CheckRefusesFieldsOutOfRangeBeforeAnythingRuns) {
     return !bad.check(&error);
   };
   EXPECT_TRUE(refused([](EvalOptions& b) { b.matcher = "fastest"; }));
-  EXPECT_NE(error.find("unknown matcher 'fastest'"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("unknown matcher 'fastest'"));
   EXPECT_TRUE(refused([](EvalOptions& b) { b.colmap.clear(); }));
   EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = 0; }));
   EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = NAN; }));
@@ -366,8 +370,7 @@ TEST(EvalOptions, CheckRefusesFieldsOutOfRangeBeforeAnythingRuns) {
   bad.tau_mm = 0;
   std::ostringstream log;
   EXPECT_EQ(evaluate(bad, log, nullptr), 1);
-  EXPECT_NE(log.str().find("rigc eval: error: the F-score threshold is 0 mm"), std::string::npos)
-      << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("rigc eval: error: the F-score threshold is 0 mm"));
   EXPECT_FALSE(fs::exists(dir.path() / "run"));
 }
 
@@ -384,7 +387,7 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   o.colmap = dir.file("no-such-colmap");
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("planned pose"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("planned pose"));
 }
 
 // Options for evaluating dir/photos against a cube (written here) into dir/eval, with a COLMAP
@@ -459,9 +462,9 @@ TEST(EvalCommand, UnreadableImagesAreNamedBeforeColmapRuns) {
   const EvalOptions o = photos_without_colmap(dir);
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("1 of the 4 images cannot be read"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("c.jpg"), std::string::npos) << log.str();
-  EXPECT_EQ(log.str().find("d.png"), std::string::npos) << "a PNG is read too: " << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("1 of the 4 images cannot be read"));
+  EXPECT_THAT(log.str(), HasSubstr("c.jpg"));
+  EXPECT_THAT(log.str(), Not(HasSubstr("d.png"))) << "a PNG is read too: " << log.str();
   EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "nothing is written";
 }
 
@@ -483,14 +486,14 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
                             "1 OPENCV 64 3 80 80 32 32 0 0 0 0\n");
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("a.jpg is 64x64 pixels, but"), std::string::npos) << log.str();
-  EXPECT_NE(log.str().find("gives the camera as 64x3"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("a.jpg is 64x64 pixels, but"));
+  EXPECT_THAT(log.str(), HasSubstr("gives the camera as 64x3"));
   EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "a refused input leaves nothing behind";
   // An empty camera file is named (not a bare "rigc eval: error: ").
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"), "");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("cameras.txt lists no camera"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("cameras.txt lists no camera"));
   // Thumbnails are too small for SIFT: a user error, not COLMAP's failure.
   fs::create_directories(dir.path() / "tiny");
   for (const char* name : {"a.png", "b.png"}) write_small_image(dir.file("tiny/") + name, 1);
@@ -500,14 +503,14 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   o.colmap = dir.file("no-such-colmap");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("a.png is 1x1 pixels: too small"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("a.png is 1x1 pixels: too small"));
   // A photos folder that is not there is named as such.
   o = EvalOptions{};
   o.photos_dir = dir.file("nothere");
   o.ground_truth = dir.file("cube.ply");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("nothere does not exist"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("nothere does not exist"));
 }
 
 TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
@@ -521,7 +524,7 @@ TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
   std::ostringstream log;
   rigc::testing::write_text(dir.file("run/manifest.json"), "{");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
-  EXPECT_NE(log.str().find("manifest.json is not valid JSON"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("manifest.json is not valid JSON"));
   // Rendered from one object, measured against the paper scene's statue: said, then measured.
   o.scene = rigc::testing::source_path("scenes/paper-turntable.yaml");
   DiagnosticEngine diag;
@@ -565,7 +568,7 @@ TEST(EvalCommand, ASixteenBitPhotoWithBrokenPixelsIsAUserError) {
   EXPECT_EQ(evaluate(o, log, nullptr), 1) << log.str();
   // The pre-check reads each photo's end (and last row), so a photo cut short is named before any
   // conversion.
-  EXPECT_NE(log.str().find("b.png: is cut short"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("b.png: is cut short"));
 }
 
 }  // namespace

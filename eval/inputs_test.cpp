@@ -1,6 +1,7 @@
 // The checks eval makes on its inputs before COLMAP runs.
 #include "eval/inputs.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -11,6 +12,9 @@
 #include "eval/eval.h"
 #include "eval/eval_test_support.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::eval {
 namespace {
@@ -75,9 +79,8 @@ TEST(EvalInputs, APhotoWhoseHeaderClaimsGigapixelsIsRefused) {
   write_small_image(dir.file("photos/b.png"));
   testing::write_text(dir.file("photos/a.png"), png_without_data(60000, 60000));
   const std::string log = evaluate_photos(dir);
-  EXPECT_NE(log.find("a.png: its header says 60000 x 60000 pixels, more than the 250 megapixels"),
-            std::string::npos)
-      << log;
+  EXPECT_THAT(
+      log, HasSubstr("a.png: its header says 60000 x 60000 pixels, more than the 250 megapixels"));
 }
 
 // Within the size limit, a header without its pixel data cannot be decoded.
@@ -88,8 +91,8 @@ TEST(EvalInputs, APhotoWithoutItsPixelDataCannotBeDecoded) {
   write_small_image(dir.file("photos/c.jpg"));
   testing::write_text(dir.file("photos/a.png"), png_without_data(4000, 3000));
   const std::string log = evaluate_photos(dir);
-  EXPECT_NE(log.find("1 of the 3 images cannot be read"), std::string::npos) << log;
-  EXPECT_NE(log.find("a.png: cannot be decoded"), std::string::npos) << log;
+  EXPECT_THAT(log, HasSubstr("1 of the 3 images cannot be read"));
+  EXPECT_THAT(log, HasSubstr("a.png: cannot be decoded"));
 }
 
 // A JPEG cut short decodes (libjpeg warns and fills grey rows), and passed the check; a PNG
@@ -106,13 +109,11 @@ TEST(EvalInputs, APhotoCutShortIsNamed) {
   testing::write_text(dir.file("photos/b.png"), png.substr(0, png.size() - 12));
   testing::write_text(dir.file("photos/c.jpg"), jpeg + std::string(300, '\0'));
   const std::string log = evaluate_photos(dir);
-  EXPECT_NE(log.find("2 of the 3 images cannot be read"), std::string::npos) << log;
-  EXPECT_NE(log.find("a.jpg: is cut short (a JPEG ends with the end-of-image marker FF D9"),
-            std::string::npos)
-      << log;
-  EXPECT_NE(log.find("b.png: is cut short (a PNG ends with its IEND chunk"), std::string::npos)
-      << log;
-  EXPECT_EQ(log.find("c.jpg"), std::string::npos) << log;
+  EXPECT_THAT(log, HasSubstr("2 of the 3 images cannot be read"));
+  EXPECT_THAT(log,
+              HasSubstr("a.jpg: is cut short (a JPEG ends with the end-of-image marker FF D9"));
+  EXPECT_THAT(log, HasSubstr("b.png: is cut short (a PNG ends with its IEND chunk"));
+  EXPECT_THAT(log, Not(HasSubstr("c.jpg")));
 }
 
 }  // namespace

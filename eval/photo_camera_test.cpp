@@ -2,12 +2,15 @@
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <limits>
 
 #include "eval/colmap.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -47,9 +50,9 @@ TEST(PhotoCamera, TheStatementNamesABodyAndAFocalLength) {
   EXPECT_DOUBLE_EQ(s->focal_mm, 50);
   EXPECT_TRUE(parse_camera_statement("nikon-d850,35", &error).has_value());
   EXPECT_FALSE(parse_camera_statement("canon-6d", &error).has_value());
-  EXPECT_NE(error.find("BODY,FOCAL"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("BODY,FOCAL"));
   EXPECT_FALSE(parse_camera_statement("leica-m3,50mm", &error).has_value());
-  EXPECT_NE(error.find("canon-6d"), std::string::npos) << "the known bodies are listed";
+  EXPECT_THAT(error, HasSubstr("canon-6d")) << "the known bodies are listed";
   EXPECT_FALSE(parse_camera_statement("canon-6d,fiftymm", &error).has_value());
   EXPECT_FALSE(parse_camera_statement("canon-6d,-5mm", &error).has_value());
 }
@@ -90,7 +93,7 @@ TEST(PhotoCamera, EachBodyAndZoomGetsACameraAndTheStatementCoversMissingExif) {
   ASSERT_TRUE(stated.has_value()) << error;
   ASSERT_EQ(stated->size(), 1u);
   EXPECT_EQ((*stated)[0].images.size(), 5u);
-  EXPECT_NE((*stated)[0].source.find("--camera"), std::string::npos);
+  EXPECT_THAT((*stated)[0].source, HasSubstr("--camera"));
 }
 
 // EXIF's focal length 50/0 reads as inf: neither it, 0 nor 1e9 mm reaches COLMAP, and the body
@@ -109,9 +112,7 @@ TEST(PhotoCamera, AnExifFocalLengthThatIsNoneIsNamedAndNotUsed) {
   for (const auto& camera : *cameras) {
     EXPECT_EQ(camera.focal_px, 0) << camera.source;
     EXPECT_FALSE(camera.sensor_known);
-    EXPECT_NE(camera.source.find("is body preset canon-6d, but its EXIF focal length ("),
-              std::string::npos)
-        << camera.source;
+    EXPECT_THAT(camera.source, HasSubstr("is body preset canon-6d, but its EXIF focal length ("));
   }
   EXPECT_FALSE(is_focal_length_mm(std::numeric_limits<double>::infinity()));
   EXPECT_FALSE(is_focal_length_mm(1e9));

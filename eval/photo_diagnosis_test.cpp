@@ -1,8 +1,11 @@
 #include "eval/photo_diagnosis.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <random>
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -71,7 +74,7 @@ TEST(PhotoDiagnosis, EachUnregisteredImageGetsItsCauses) {
   in.masked = true;
   const auto masked = diagnose_unregistered(in);
   ASSERT_EQ(masked.at("p6").size(), 1u);
-  EXPECT_NE(masked.at("p6")[0].find("overlap"), std::string::npos);
+  EXPECT_THAT(masked.at("p6")[0], HasSubstr("overlap"));
   EXPECT_EQ(masked.at("p2").size(), 1u) << "dark only";
 }
 

@@ -2,11 +2,14 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <sstream>
 
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -92,11 +95,11 @@ TEST(PhotoMasks, MasksMadeElsewhereAreTakenInAnyFormatAndChecked) {
 
   write_picture(made / "a.tif", 32, 24, 1, {0}, {255});
   EXPECT_FALSE(make_photo_masks(set, o, dir.path() / "out", log, &error).has_value());
-  EXPECT_NE(error.find("32x24"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("32x24"));
   o.masks_dir = (dir.path() / "empty").string();
   fs::create_directories(o.masks_dir);
   EXPECT_FALSE(make_photo_masks(set, o, dir.path() / "out", log, &error).has_value());
-  EXPECT_NE(error.find("no mask for any"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("no mask for any"));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // Cycles, its images copied as a photographer's card would hold them (no sparse/, masks/ or
 // manifest), and evaluated like the run folder they came from. SLOW and EXTERNAL (COLMAP three
 // times a renderer, Blender).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -118,8 +121,7 @@ void expect_photos_register_like_the_run_folder(const std::vector<std::string>& 
     EXPECT_EQ(report["colmap"]["matching"]["matcher"], "sequential");
     const auto& camera = report["photos"]["cameras"][0];
     EXPECT_NEAR(camera["focal_length_px"].get<double>(), 50 / 35.8 * 821, 1e-6);
-    EXPECT_NE(camera["source"].get<std::string>().find(strip ? "--camera" : "EXIF"),
-              std::string::npos);
+    EXPECT_THAT(camera["source"].get<std::string>(), HasSubstr(strip ? "--camera" : "EXIF"));
     EXPECT_EQ(report["photos"]["masks"]["masked_photos"], 18);
     EXPECT_TRUE(fs::exists(out / "masks" / "shot_000.png"));
     EXPECT_TRUE(fs::exists(out / "masks_contact_sheet.png"));
@@ -160,8 +162,8 @@ TEST(EvalEndToEnd, SlowCompareWithPhotosGivesTheRendererAndThePhotosRows) {
   r = run_rigc({"compare", scene, "--backends", "preview", "--scale", "0.15", "--photos",
                 (dir.path() / "photos").string(), "-o", out.string(), "--samples", "20000"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| preview | 18 |"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("| photos | 18 |"), std::string::npos) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("| preview | 18 |"));
+  EXPECT_THAT(r.out, HasSubstr("| photos | 18 |"));
   const auto preview = eval_json(out / "preview" / "eval");
   const auto photos = eval_json(out / "photos_eval");
   EXPECT_EQ(preview["reconstruction"]["registered_images"], 18);
@@ -169,7 +171,7 @@ TEST(EvalEndToEnd, SlowCompareWithPhotosGivesTheRendererAndThePhotosRows) {
   EXPECT_LT(photos["signed_distance_mm"]["mean_abs"].get<double>(),
             1.15 * preview["signed_distance_mm"]["mean_abs"].get<double>());
   std::string markdown = rigc::testing::read_text((out / "compare.md").string());
-  EXPECT_NE(markdown.find("| photos |"), std::string::npos);
+  EXPECT_THAT(markdown, HasSubstr("| photos |"));
 }
 
 }  // namespace

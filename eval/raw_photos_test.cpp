@@ -3,6 +3,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -14,6 +15,8 @@
 
 #include "eval/photo_camera.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -185,7 +188,7 @@ TEST(RawPhotos, ARawAndItsJpegAreOnePhotoAndABrokenRawIsNamed) {
   set.dir = photos;
   set.names = {"IMG_0002.NEF"};
   EXPECT_FALSE(develop_raw_photos(set, dir.path() / "out", log, true, &error));
-  EXPECT_NE(error.find("IMG_0002.NEF"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("IMG_0002.NEF"));
 }
 
 // Photos in eval's own OUT/developed: the RAW's developed JPEG would replace the camera's JPEG
@@ -204,9 +207,7 @@ TEST(RawPhotos, PhotosInTheDevelopedFolderAreNeitherReplacedNorLinkedToThemselve
   const auto r = rigc::testing::run_rigc(
       {"eval", "--photos", developed.string(), "-o", (dir.path() / "out").string()});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("will not write " + (developed / "IMG_0001.jpg").string()),
-            std::string::npos)
-      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("will not write " + (developed / "IMG_0001.jpg").string()));
   EXPECT_EQ(rigc::testing::read_text((developed / "IMG_0001.jpg").string()), camera_jpeg);
   EXPECT_FALSE(fs::is_symlink(developed / "IMG_0002.jpg"));
 }

@@ -1,5 +1,6 @@
 #include "eval/reconstruction.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/geometry/TriangleMesh.h>
@@ -15,6 +16,8 @@
 #include "assets/primitives.h"
 #include "eval/align.h"
 #include "eval/reconstruction_test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::eval {
 namespace {
@@ -168,8 +171,7 @@ TEST(EvalReconstruction, ACloudOfAnotherObjectIsRefusedWithItsFitness) {
   std::ostringstream log;
   EvalSummary s;
   EXPECT_EQ(evaluate(o, log, &s), 2);
-  EXPECT_NE(log.str().find("the registration fits poorly (fitness 0."), std::string::npos)
-      << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("the registration fits poorly (fitness 0."));
   const auto report = nlohmann::json::parse(std::ifstream(dir.path() / "eval" / "eval.json"));
   EXPECT_EQ(report["alignment"]["status"], "failed");
   EXPECT_LT(report["alignment"]["fitness"]["value"].get<double>(), 0.5);
@@ -197,8 +199,7 @@ TEST(EvalReconstruction, PointsInTheScenesFrameNeedNoAlignment) {
   EXPECT_LT(s.report["signed_distance_mm"]["max"].get<double>(), 1e-3);
   EXPECT_NEAR(s.report["fscore"]["precision"].get<double>(), 1.0, 1e-12);
   EXPECT_EQ(s.report["reconstruction"]["colors"], true);
-  EXPECT_NE(s.report["alignment"]["method"].get<std::string>().find("--no-align"),
-            std::string::npos);
+  EXPECT_THAT(s.report["alignment"]["method"].get<std::string>(), HasSubstr("--no-align"));
 }
 
 // Every format a tool exports loads, mesh or cloud, binary or ASCII, with or without colours and
@@ -243,14 +244,14 @@ TEST(EvalReconstruction, LoadsMeshesAndCloudsInEveryFormat) {
   const std::string whole = rigc::testing::read_text(dir.file("rich_binary.ply"));
   rigc::testing::write_text(dir.file("cut.ply"), whole.substr(0, whole.size() - 100));
   EXPECT_FALSE(load_reconstruction(dir.file("cut.ply"), &error));
-  EXPECT_NE(error.find("cut.ply: announces 100 vertex elements"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("cut.ply: announces 100 vertex elements"));
   // A header that claims a trillion points is refused before anything is allocated for them.
   rigc::testing::write_text(dir.file("huge.ply"),
                             "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n"
                             "property float x\nproperty float y\nproperty float z\nend_header\n" +
                                 std::string(120, '\0'));
   EXPECT_FALSE(load_reconstruction(dir.file("huge.ply"), &error));
-  EXPECT_NE(error.find("announces 1000000000000 vertex elements"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("announces 1000000000000 vertex elements"));
   // Non-finite points are left out and counted.
   std::string nan_cloud =
       "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
@@ -267,11 +268,11 @@ TEST(EvalReconstruction, LoadsMeshesAndCloudsInEveryFormat) {
   // Bad files: named, never a crash.
   rigc::testing::write_text(dir.file("junk.ply"), "ply\nnot really\n");
   EXPECT_FALSE(load_reconstruction(dir.file("junk.ply"), &error));
-  EXPECT_NE(error.find("junk.ply"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("junk.ply"));
   EXPECT_FALSE(load_reconstruction(dir.file("m.fbx"), &error));
   rigc::testing::write_text(dir.file("m.las"), "x");
   EXPECT_FALSE(load_reconstruction(dir.file("m.las"), &error));
-  EXPECT_NE(error.find("unknown reconstruction format"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("unknown reconstruction format"));
 }
 
 // Headers are held to the file's size before any reader allocates (a 117-byte PCD claiming
@@ -297,8 +298,8 @@ TEST(EvalReconstruction, HeadersThatClaimMoreThanTheFileAndFlatMeshesAreNamed) {
   std::string error;
   for (const char* name : {"ascii.pcd", "binary.pcd", "big.ply", "big.stl", "big.pts"}) {
     EXPECT_FALSE(load_reconstruction(dir.file(name), &error)) << name;
-    EXPECT_NE(error.find(std::string(name) + ": announces "), std::string::npos) << error;
-    EXPECT_NE(error.find("bytes after its header"), std::string::npos) << error;
+    EXPECT_THAT(error, HasSubstr(std::string(name) + ": announces "));
+    EXPECT_THAT(error, HasSubstr("bytes after its header"));
   }
   rigc::testing::write_text(dir.file("flat.ply"),
                             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
@@ -306,7 +307,7 @@ TEST(EvalReconstruction, HeadersThatClaimMoreThanTheFileAndFlatMeshesAreNamed) {
                             "property list uchar int vertex_indices\nend_header\n"
                             "0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n");
   EXPECT_FALSE(load_reconstruction(dir.file("flat.ply"), &error));
-  EXPECT_NE(error.find("flat.ply: its 1 faces have no area"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("flat.ply: its 1 faces have no area"));
 }
 
 TEST(EvalReconstruction, OptionsThatGoTogether) {
@@ -315,11 +316,11 @@ TEST(EvalReconstruction, OptionsThatGoTogether) {
   std::string error;
   o.cameras = "c.out";
   EXPECT_FALSE(o.check(&error));
-  EXPECT_NE(error.find("go with --reconstruction"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("go with --reconstruction"));
   o.reconstruction = "r.ply";
   o.align = false;
   EXPECT_FALSE(o.check(&error));
-  EXPECT_NE(error.find("not both"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("not both"));
   o.cameras.clear();
   EXPECT_TRUE(o.check(&error)) << error;
   o.min_fitness = 1.5;
@@ -331,14 +332,14 @@ TEST(EvalReconstruction, CompareRefusesMalformedReconstructionRows) {
   using rigc::testing::run_rigc;
   auto r = run_rigc({"compare", "scene.yaml", "--reconstruction", "no-equals-sign"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("'no-equals-sign' is not NAME=FILE"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("'no-equals-sign' is not NAME=FILE"));
   r = run_rigc({"compare", "scene.yaml", "--reconstruction", "../x=a.ply"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("use letters, digits"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("use letters, digits"));
   r = run_rigc({"compare", "scene.yaml", "--reconstruction", "a=a.ply", "--reconstruction-cameras",
                 "b=b.out"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("which no --reconstruction does"), std::string::npos) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("which no --reconstruction does"));
 }
 
 }  // namespace

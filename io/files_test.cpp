@@ -1,5 +1,6 @@
 #include "io/files.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -7,6 +8,9 @@
 #include <string>
 
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc {
 namespace {
@@ -82,7 +86,7 @@ TEST(BackendFiles, WriteAtomicallyWritesThroughALinkAndRefusesAPipe) {
   const fs::path pipe = dir.path() / "pipe.json";
   ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
   EXPECT_FALSE(write_file_atomically(pipe, "bytes", &error));
-  EXPECT_NE(error.find("not a regular file"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("not a regular file"));
   EXPECT_TRUE(fs::is_fifo(pipe));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 3)
       << "a temporary file was left behind";
@@ -93,8 +97,8 @@ TEST(BackendFiles, WriteAtomicallyIntoMissingFolderFails) {
   const fs::path path = dir.path() / "missing" / "out.txt";
   std::string error;
   EXPECT_FALSE(write_file_atomically(path, "bytes", &error));
-  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
-  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr(path.string()));
+  EXPECT_THAT(error, Not(HasSubstr("\n")));
   EXPECT_TRUE(fs::is_empty(dir.path()));
   EXPECT_FALSE(write_file_atomically(path, "bytes", nullptr));  // a null error is allowed
 }
@@ -105,7 +109,7 @@ TEST(BackendFiles, WriteAtomicallyOverAFolderFailsAndCleansUp) {
   fs::create_directories(path / "child");
   std::string error;
   EXPECT_FALSE(write_file_atomically(path, "bytes", &error));
-  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr(path.string()));
   int entries = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir.path())) ++entries;
   EXPECT_EQ(entries, 1) << "the temporary file was not removed";
@@ -143,7 +147,7 @@ TEST(BackendFiles, AWriterThatThrowsIsAnErrorAndCleansUp) {
       },
       &error);
   EXPECT_FALSE(written);
-  EXPECT_NE(error.find("out of memory"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("out of memory"));
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 

@@ -1,10 +1,13 @@
 #include "plan/candidates.h"
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "compiler/check.h"
 #include "compiler/frontend.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::plan {
 namespace {
@@ -44,7 +47,7 @@ TEST(Candidates, RotationPoseIsWrittenBackExactly) {
   options.turntable_only = true;
   const CandidateSet set = make_candidates(*spec, *scene, options);
   const std::string planned = shots_yaml(set, all_candidates(set), true);
-  EXPECT_NE(planned.find("rotation: [["), std::string::npos) << planned;
+  EXPECT_THAT(planned, HasSubstr("rotation: [["));
   const auto again = compile_scene_text(scene_with(planned), "planned.yaml", ".", diag);
   ASSERT_TRUE(again) << messages << planned;
   ASSERT_EQ(again->shots.size(), 1u);

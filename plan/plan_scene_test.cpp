@@ -1,5 +1,6 @@
 #include "plan/plan_scene.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,8 @@
 #include "plan/report.h"
 #include "scene/studio_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::plan {
 namespace {
@@ -177,9 +180,9 @@ TEST(Plan, AnUnreachableTargetSaysWhatStaysUnseen) {
   EXPECT_FALSE(planned.outcome->plan.target_reached);
   std::ostringstream report;
   print_plan_report(*planned.outcome, report);
-  EXPECT_NE(report.str().find("cannot be reached"), std::string::npos) << report.str();
-  EXPECT_NE(report.str().find("rests on the turntable"), std::string::npos) << report.str();
-  EXPECT_NE(report.str().find("faces up, seen by no candidate"), std::string::npos) << report.str();
+  EXPECT_THAT(report.str(), HasSubstr("cannot be reached"));
+  EXPECT_THAT(report.str(), HasSubstr("rests on the turntable"));
+  EXPECT_THAT(report.str(), HasSubstr("faces up, seen by no candidate"));
 }
 
 TEST(Plan, ThePlannedSceneCompilesAndItsCoverageIsThePlans) {
@@ -197,7 +200,7 @@ TEST(Plan, ThePlannedSceneCompilesAndItsCoverageIsThePlans) {
     EXPECT_LE(outcome.plan.shots[i].step_rad, 30 * kDegree + 1e-9) << i;
   }
   // The file keeps the rest of the scene and compiles to the plan's shots and coverage.
-  EXPECT_NE(outcome.planned_text.find("fit: {height: 25cm}"), std::string::npos);
+  EXPECT_THAT(outcome.planned_text, HasSubstr("fit: {height: 25cm}"));
   DiagnosticEngine diag;
   const auto planned_scene =
       compile_scene_text(outcome.planned_text, request.output_path, dir.path().string(), diag);
@@ -241,8 +244,8 @@ TEST(Plan, KeptShotsComeFirstAndTheNextShotAddsMost) {
   }
   // The scene keeps its own shots entry; the suggestion is appended to it.
   const std::string& text = outcome.planned_text;
-  EXPECT_NE(text.find("steps: 4, step: 90deg"), std::string::npos);
-  EXPECT_NE(text.find("# Suggested by `rigc plan --next`"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("steps: 4, step: 90deg"));
+  EXPECT_THAT(text, HasSubstr("# Suggested by `rigc plan --next`"));
   DiagnosticEngine diag;
   const auto planned_scene =
       compile_scene_text(text, request.output_path, dir.path().string(), diag);

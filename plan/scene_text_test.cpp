@@ -1,6 +1,9 @@
 #include "plan/scene_text.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+using ::testing::HasSubstr;
 
 namespace rigc::plan {
 namespace {
@@ -44,7 +47,7 @@ TEST(PlanSceneText, ReplacesALastSectionToTheEnd) {
 TEST(PlanSceneText, RefusesTextWithoutABlockShotsKey) {
   std::string error;
   EXPECT_FALSE(replace_shots_section("rigc: 1\nname: s\n", "shots:\n", &error));
-  EXPECT_NE(error.find("shots"), std::string::npos);
+  EXPECT_THAT(error, HasSubstr("shots"));
   EXPECT_FALSE(replace_shots_section("{rigc: 1, shots: []}\n", "shots:\n", &error));
   EXPECT_FALSE(replace_shots_section("rigc: [1\n", "shots:\n", &error));
 }

@@ -1,11 +1,14 @@
 #include "run/bundler.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "eval/camera_files.h"
 #include "eval/reconstruction_test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::run {
 namespace {
@@ -59,7 +62,7 @@ TEST(Bundler, AListThatDoesNotMatchIsAnError) {
   rigc::testing::write_text(dir.file("b.list.txt"), "a.jpg\n");
   std::string error;
   EXPECT_FALSE(eval::read_bundler(dir.file("b.out"), dir.file("b.list.txt"), &error));
-  EXPECT_NE(error.find("lists 1 images"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("lists 1 images"));
 }
 
 // Bundler states one focal length and no principal point: a camera with fx != fy beyond a body's
@@ -74,12 +77,12 @@ TEST(Bundler, DescribesOnlyCamerasWithOneFocalLengthAndACentredPrincipalPoint) {
   camera.cy = 240;
   EXPECT_EQ(bundler_camera_problem(camera, 0.5), "");
   camera.fy = 1545.9;
-  EXPECT_NE(bundler_camera_problem(camera, 1).find("one focal length"), std::string::npos);
+  EXPECT_THAT(bundler_camera_problem(camera, 1), HasSubstr("one focal length"));
   camera.fy = 1520.4;
   camera.cx = 302.3;
-  EXPECT_NE(bundler_camera_problem(camera, 1).find("principal point at the image centre (320, "
-                                                   "240), this one at (302.3, 240)"),
-            std::string::npos);
+  EXPECT_THAT(bundler_camera_problem(camera, 1),
+              HasSubstr("principal point at the image centre (320, "
+                        "240), this one at (302.3, 240)"));
 }
 
 }  // namespace

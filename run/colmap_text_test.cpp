@@ -1,5 +1,6 @@
 #include "run/colmap_text.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +8,8 @@
 
 #include "tests/test_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::run {
 namespace {
@@ -106,7 +109,7 @@ TEST(BackendColmap, ScaledIntrinsicsFollowTheRoundedSize) {
   EXPECT_DOUBLE_EQ(camera->cy, 365 / 2.0);
 
   EXPECT_FALSE(output_camera(scene.camera, 0, &error).has_value());
-  EXPECT_NE(error.find("scale"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("scale"));
   EXPECT_FALSE(output_camera(scene.camera, std::nan(""), &error).has_value());
 }
 
@@ -137,9 +140,9 @@ TEST(BackendColmap, RejectsBadArguments) {
   TempDir dir;
   std::string error;
   EXPECT_FALSE(write_colmap_sparse(dir.path(), scene, {6}, 1, &error));
-  EXPECT_NE(error.find("0..5"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("0..5"));
   EXPECT_FALSE(write_colmap_sparse(dir.path(), scene, {1, 1}, 1, &error));
-  EXPECT_NE(error.find("repeated"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("repeated"));
   EXPECT_FALSE(write_colmap_sparse(dir.path(), scene, {0}, -1, &error));
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
@@ -149,10 +152,10 @@ TEST(BackendColmap, ReadersReportMalformedLines) {
   rigc::testing::write_text(dir.file("images.txt"), "# comment\n1 1 0 0 0 0 0 0 1\n\n");
   std::string error;
   EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
-  EXPECT_NE(error.find("images.txt:2:"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("images.txt:2:"));
   rigc::testing::write_text(dir.file("cameras.txt"), "1 OPENCV 10 ten 1 2 3 4\n");
   EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value());
-  EXPECT_NE(error.find("cameras.txt:1:"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("cameras.txt:1:"));
   EXPECT_FALSE(read_colmap_cameras(dir.path() / "missing.txt", &error).has_value());
 }
 
@@ -179,12 +182,12 @@ TEST(BackendColmap, CameraLinesCOLMAPCannotUseAreErrorsAtTheirLine) {
   for (const Case& c : cases) {
     rigc::testing::write_text(dir.file("cameras.txt"), "# header\n" + c.line + "\n");
     EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value()) << c.line;
-    EXPECT_NE(error.find("cameras.txt:2: "), std::string::npos) << error;
-    EXPECT_NE(error.find(c.message), std::string::npos) << error;
+    EXPECT_THAT(error, HasSubstr("cameras.txt:2: "));
+    EXPECT_THAT(error, HasSubstr(c.message));
   }
   rigc::testing::write_text(dir.file("cameras.txt"), "# only comments\n");
   EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value());
-  EXPECT_NE(error.find("lists no camera"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("lists no camera"));
   rigc::testing::write_text(dir.file("cameras.txt"), good + "\n2 PINHOLE 100 80 90 90 50 40\n");
   const auto cameras = read_colmap_cameras(dir.path() / "cameras.txt", &error);
   ASSERT_TRUE(cameras.has_value()) << error;
@@ -196,13 +199,11 @@ TEST(BackendColmap, ImagesWithNonFinitePosesOrRepeatedNamesAreErrors) {
   std::string error;
   rigc::testing::write_text(dir.file("images.txt"), "1 nan 0 0 0 0 0 0 1 a.jpg\n\n");
   EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
-  EXPECT_NE(error.find("images.txt:1: the pose holds a number that is not finite"),
-            std::string::npos)
-      << error;
+  EXPECT_THAT(error, HasSubstr("images.txt:1: the pose holds a number that is not finite"));
   rigc::testing::write_text(dir.file("images.txt"),
                             "1 1 0 0 0 0 0 0 1 a.jpg\n\n2 1 0 0 0 0 0 1 1 a.jpg\n\n");
   EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value());
-  EXPECT_NE(error.find("images.txt:3: image 'a.jpg' is listed twice"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("images.txt:3: image 'a.jpg' is listed twice"));
 }
 
 TEST(BackendColmap, RepeatedCameraIdsAreAnError) {
@@ -211,7 +212,7 @@ TEST(BackendColmap, RepeatedCameraIdsAreAnError) {
   rigc::testing::write_text(dir.file("cameras.txt"),
                             "1 PINHOLE 100 80 90 90 50 40\n1 PINHOLE 100 80 91 91 50 40\n");
   EXPECT_FALSE(read_colmap_cameras(dir.path() / "cameras.txt", &error).has_value());
-  EXPECT_NE(error.find("cameras.txt:2: camera 1 is listed twice"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("cameras.txt:2: camera 1 is listed twice"));
 }
 
 // A quaternion a little off unit length (few digits) is normalised; one far off is refused.
@@ -227,8 +228,7 @@ TEST(BackendColmap, NonUnitQuaternionsAreNormalisedNearOneAndRefusedFarFromIt) {
   for (const std::string q : {"2 0 0 0", "0.5 0 0 0", "0 0 0 0"}) {
     rigc::testing::write_text(dir.file("images.txt"), "# header\n1 " + q + " 0 0 0 1 a.jpg\n\n");
     EXPECT_FALSE(read_colmap_images(dir.path() / "images.txt", &error).has_value()) << q;
-    EXPECT_NE(error.find("images.txt:2: the quaternion QW QX QY QZ has length"), std::string::npos)
-        << error;
+    EXPECT_THAT(error, HasSubstr("images.txt:2: the quaternion QW QX QY QZ has length"));
   }
 }
 
@@ -242,10 +242,9 @@ TEST(BackendColmap, AnImageOfAnUndefinedCameraIsAnErrorAtItsLine) {
   const auto images = read_colmap_images(dir.path() / "images.txt", &error);
   ASSERT_TRUE(cameras && images) << error;
   EXPECT_FALSE(check_camera_ids(*images, *cameras, dir.path() / "images.txt", &error));
-  EXPECT_NE(error.find("images.txt:4: image 'b.jpg' uses camera 7, which the cameras file does "
-                       "not define"),
-            std::string::npos)
-      << error;
+  EXPECT_THAT(error,
+              HasSubstr("images.txt:4: image 'b.jpg' uses camera 7, which the cameras file does "
+                        "not define"));
   EXPECT_TRUE(check_camera_ids({(*images)[0]}, *cameras, dir.path() / "images.txt", &error));
 }
 

@@ -1,9 +1,12 @@
 #include "run/manifest.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "tests/test_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::run {
 namespace {
@@ -106,7 +109,7 @@ TEST(BackendManifest, SaveIntoMissingFolderFails) {
   Manifest manifest;
   std::string error;
   EXPECT_FALSE(manifest.save(run.path() / "nope" / "manifest.json", &error));
-  EXPECT_NE(error.find("manifest.json"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("manifest.json"));
 }
 
 TEST(BackendManifest, ShotKeysChangeOnlyWithTheirInputs) {

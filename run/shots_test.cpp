@@ -1,6 +1,10 @@
 #include "run/shots.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::run {
 namespace {
@@ -16,7 +20,7 @@ std::string parse_error(const std::string& text, int count) {
   std::string error;
   auto selection = parse_shot_selection(text, count, &error);
   EXPECT_FALSE(selection.has_value()) << text;
-  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_THAT(error, Not(HasSubstr("\n")));
   return error;
 }
 
@@ -34,25 +38,25 @@ TEST(BackendShots, AllSelectsEverythingAndEmptyIsAnError) {
   EXPECT_EQ(parse_ok("all", 0), (std::vector<int>{}));
   for (const char* text : {"", "  "}) {
     const std::string error = parse_error(text, 3);
-    EXPECT_NE(error.find("empty"), std::string::npos) << error;
-    EXPECT_NE(error.find("0..2"), std::string::npos) << error;
+    EXPECT_THAT(error, HasSubstr("empty"));
+    EXPECT_THAT(error, HasSubstr("0..2"));
   }
 }
 
 TEST(BackendShots, ReportsErrorsWithTheValidRange) {
   for (const char* text : {"10", "5-10", "99999999999999999999999"}) {
     const std::string error = parse_error(text, 10);
-    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
-    EXPECT_NE(error.find("0..9"), std::string::npos) << error;
+    EXPECT_THAT(error, HasSubstr("out of range"));
+    EXPECT_THAT(error, HasSubstr("0..9"));
   }
   const std::string reversed = parse_error("7-5", 10);
-  EXPECT_NE(reversed.find("reversed"), std::string::npos) << reversed;
-  EXPECT_NE(reversed.find("0..9"), std::string::npos) << reversed;
+  EXPECT_THAT(reversed, HasSubstr("reversed"));
+  EXPECT_THAT(reversed, HasSubstr("0..9"));
   for (const char* text : {"x", "1,,2", "1,", "-3", "3-", "1-2-3", "1.5", "0x3", "shot_001"}) {
     const std::string error = parse_error(text, 10);
-    EXPECT_NE(error.find("0..9"), std::string::npos) << text << ": " << error;
+    EXPECT_THAT(error, HasSubstr("0..9")) << text << ": " << error;
   }
-  EXPECT_NE(parse_error("0", 0).find("no shots"), std::string::npos);
+  EXPECT_THAT(parse_error("0", 0), HasSubstr("no shots"));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "run/transforms_json.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -7,6 +8,8 @@
 #include "run/colmap_text.h"
 #include "tests/test_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::run {
 namespace {
@@ -66,9 +69,9 @@ TEST(BackendTransforms, FailsOnBadShotOrMissingFolder) {
   rigc::testing::TempDir dir;
   std::string error;
   EXPECT_FALSE(write_transforms_json(dir.path() / "t.json", scene, {9}, 1, &error));
-  EXPECT_NE(error.find("0..5"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("0..5"));
   EXPECT_FALSE(write_transforms_json(dir.path() / "no" / "t.json", scene, {0}, 1, &error));
-  EXPECT_NE(error.find("t.json"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("t.json"));
 }
 
 }  // namespace

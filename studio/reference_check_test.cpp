@@ -3,6 +3,7 @@
 // a failing renderer is reported with its log.
 #include "studio/reference_check.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <stdlib.h>
@@ -15,6 +16,8 @@
 #include "studio/server.h"
 #include "studio/studio_test_server.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::studio {
 namespace {
@@ -92,9 +95,9 @@ TEST_F(StudioReference, AFailingRendererIsReportedWithItsLog) {
   ASSERT_EQ(res->status, 200) << res->body;
   EXPECT_EQ(status["state"], "failed") << status.dump(1);
   const std::string message = status["message"];
-  EXPECT_NE(message.find("failed with exit code 7"), std::string::npos) << message;
+  EXPECT_THAT(message, HasSubstr("failed with exit code 7"));
   const std::string log = status["log"];
-  EXPECT_NE(message.find(log), std::string::npos) << message;
+  EXPECT_THAT(message, HasSubstr(log));
   EXPECT_TRUE(fs::exists(log));
   EXPECT_EQ(start("nonesuch", 96)->status, 422);
   EXPECT_EQ(start("preview", 96)->status, 422);

@@ -1,6 +1,9 @@
 #include "studio/scene_edit.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+using ::testing::HasSubstr;
 
 namespace rigc::studio {
 namespace {
@@ -29,7 +32,7 @@ TEST(StudioSceneEdit, ReplacesAScalarInAFlowMapAndKeepsTheRest) {
   std::string error;
   const std::string text =
       edited(set_value(kText, {"camera", "exposure", "aperture"}, "f/8", &error), error);
-  EXPECT_NE(text.find("exposure: {aperture: f/8, shutter: 1/125, iso: 200}"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("exposure: {aperture: f/8, shutter: 1/125, iso: 200}"));
   std::string expected = kText;
   expected.replace(expected.find("f/13"), 4, "f/8");
   EXPECT_EQ(text, expected);
@@ -39,23 +42,22 @@ TEST(StudioSceneEdit, ReplacesABlockScalarAndKeepsItsComment) {
   std::string error;
   const std::string text =
       edited(set_value(kText, {"camera", "body"}, "nikon-d850", &error), error);
-  EXPECT_NE(text.find("  body: nikon-d850   # the body\n"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("  body: nikon-d850   # the body\n"));
 }
 
 TEST(StudioSceneEdit, ReplacesAFlowListAndAddsMissingKeys) {
   std::string error;
   std::string text = edited(
       set_value(kText, {"studio", "lights", "1", "position"}, "[0, -2m, 1m]", &error), error);
-  EXPECT_NE(text.find("{type: point, position: [0, -2m, 1m], power: 100W}"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("{type: point, position: [0, -2m, 1m], power: 100W}"));
   text = edited(set_value(text, {"studio", "lights", "1", "temperature"}, "3200K", &error), error);
-  EXPECT_NE(text.find("power: 100W, temperature: 3200K}"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("power: 100W, temperature: 3200K}"));
   text = edited(set_value(text, {"camera", "white_balance"}, "5600K", &error), error);
-  EXPECT_NE(text.find("  focus: auto\n  white_balance: 5600K\nstudio:"), std::string::npos);
+  EXPECT_THAT(text, HasSubstr("  focus: auto\n  white_balance: 5600K\nstudio:"));
   text = edited(set_value(text, {"studio", "turntable", "diameter"}, "50cm", &error), error);
-  EXPECT_NE(text.find("studio:\n  lights:"), std::string::npos);
-  EXPECT_NE(text.find("power: 100W, temperature: 3200K}\n  turntable: {diameter: 50cm}\nshots:"),
-            std::string::npos)
-      << text;
+  EXPECT_THAT(text, HasSubstr("studio:\n  lights:"));
+  EXPECT_THAT(text,
+              HasSubstr("power: 100W, temperature: 3200K}\n  turntable: {diameter: 50cm}\nshots:"));
 }
 
 TEST(StudioSceneEdit, AppendsAndRemovesListItems) {
@@ -63,11 +65,10 @@ TEST(StudioSceneEdit, AppendsAndRemovesListItems) {
   std::string text = edited(
       append_to_list(kText, {"shots"}, "pose: {position: [1, 0, 1], look_at: object}", &error),
       error);
-  EXPECT_NE(text.find("step: 20deg}\n  - pose: {position: [1, 0, 1], look_at: object}\n# the end"),
-            std::string::npos)
-      << text;
+  EXPECT_THAT(
+      text, HasSubstr("step: 20deg}\n  - pose: {position: [1, 0, 1], look_at: object}\n# the end"));
   text = edited(remove_from_list(text, {"studio", "lights"}, 0, &error), error);
-  EXPECT_NE(text.find("    # left\n    - {type: point"), std::string::npos) << text;
+  EXPECT_THAT(text, HasSubstr("    # left\n    - {type: point"));
 }
 
 TEST(StudioSceneEdit, RefusesTextThatCouldInjectStructure) {

@@ -121,10 +121,8 @@ TEST_F(StudioApi, ALensPresetIsSetWithAFocalLengthItTakesAndRefusedOtherwise) {
   ASSERT_TRUE(outside);
   EXPECT_EQ(outside->status, 422);
   const std::string message = nlohmann::json::parse(outside->body)["error"];
-  EXPECT_NE(message.find("scene.yaml:18:24:"), std::string::npos) << message;
-  EXPECT_NE(message.find("is outside the lens canon-ef-24-70mm-f2.8l-ii-usm's 24mm-70mm"),
-            std::string::npos)
-      << message;
+  EXPECT_THAT(message, HasSubstr("scene.yaml:18:24:"));
+  EXPECT_THAT(message, HasSubstr("is outside the lens canon-ef-24-70mm-f2.8l-ii-usm's 24mm-70mm"));
   EXPECT_NEAR(state()["camera"]["focal_length_mm"].get<double>(), 35, 1e-9);
 }
 
@@ -133,9 +131,9 @@ TEST_F(StudioApi, AnOutOfRangeValueIsRefusedWithTheCompilersMessage) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 422);
   const std::string message = nlohmann::json::parse(res->body)["error"];
-  EXPECT_NE(message.find("scene.yaml:"), std::string::npos) << message;
-  EXPECT_NE(message.find("error: aperture f/0.8 is outside"), std::string::npos) << message;
-  EXPECT_NE(message.find("aperture: f/0.8"), std::string::npos) << "the source line: " << message;
+  EXPECT_THAT(message, HasSubstr("scene.yaml:"));
+  EXPECT_THAT(message, HasSubstr("error: aperture f/0.8 is outside"));
+  EXPECT_THAT(message, HasSubstr("aperture: f/0.8")) << "the source line: " << message;
   EXPECT_DOUBLE_EQ(state()["camera"]["aperture"].get<double>(), 11);  // the last good scene
 }
 
@@ -143,10 +141,10 @@ TEST_F(StudioApi, ACameraBelowTheFloorOrInTheTableIsRefused) {
   auto res = post("/api/view", {{"position", {0.5, -0.5, -0.2}}, {"look_at", {0, 0, 0.8}}});
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 422);
-  EXPECT_NE(res->body.find("below the floor"), std::string::npos) << res->body;
+  EXPECT_THAT(res->body, HasSubstr("below the floor"));
   res = post("/api/view", {{"position", {0.05, 0, 0.74}}, {"look_at", {0, 0, 0.9}}});
   EXPECT_EQ(res->status, 422);
-  EXPECT_NE(res->body.find("inside the turntable"), std::string::npos) << res->body;
+  EXPECT_THAT(res->body, HasSubstr("inside the turntable"));
   res = post("/api/view",
              {{"position", {0.6, -0.6, 1.1}}, {"look_at", {0, 0, 0.85}}, {"turntable_deg", 30}});
   EXPECT_EQ(res->status, 200) << res->body;
@@ -165,7 +163,7 @@ TEST_F(StudioApi, CaptureAddsAShotToTheCoverageAndUndoTakesItBack) {
   coverage = nlohmann::json::parse(client_->Get("/api/coverage")->body);
   EXPECT_EQ(coverage["shots"].get<int>(), shots + 1);
   EXPECT_GT(coverage["seen_1"].get<double>(), seen_before + 0.1);
-  EXPECT_NE(coverage["table"].get<std::string>().find("shot_001"), std::string::npos);
+  EXPECT_THAT(coverage["table"].get<std::string>(), HasSubstr("shot_001"));
   ASSERT_EQ(post("/api/undo", {})->status, 200);
   EXPECT_EQ(state()["shots"].get<int>(), shots);
   EXPECT_EQ(post("/api/undo", {})->status, 422);  // nothing left to undo
@@ -237,8 +235,8 @@ TEST_F(StudioApi, SuggestMovesTheViewToThePlannersNextShot) {
   ASSERT_EQ(res->status, 200) << res->body;
   const auto suggestion = nlohmann::json::parse(res->body);
   EXPECT_GT(suggestion["gain"].get<double>(), 0.05);
-  EXPECT_NE(suggestion["entry"].get<std::string>().find("# Suggested by `rigc plan --next`"),
-            std::string::npos);
+  EXPECT_THAT(suggestion["entry"].get<std::string>(),
+              HasSubstr("# Suggested by `rigc plan --next`"));
   EXPECT_NE(state()["view"], view_before);
   // Captured, the suggestion brings the coverage the planner promised.
   ASSERT_EQ(post("/api/capture", {})->status, 200);
@@ -255,12 +253,10 @@ TEST_F(StudioApi, SaveWritesTheEditsAndCapturesAndKeepsTheComments) {
   EXPECT_EQ(read(scene_file_), kStudioTestScene);  // nothing written before the save
   ASSERT_EQ(post("/api/save", {})->status, 200);
   const std::string saved = read(scene_file_);
-  EXPECT_NE(saved.find("# The studio's test scene"), std::string::npos);
-  EXPECT_NE(saved.find("    # the key light, left of the camera\n"), std::string::npos);
-  EXPECT_NE(saved.find("exposure: {aperture: f/8, shutter: 1/125, iso: 200}  # daylight"),
-            std::string::npos)
-      << saved;
-  EXPECT_NE(saved.find("\n  - pose: {position: ["), std::string::npos) << saved;
+  EXPECT_THAT(saved, HasSubstr("# The studio's test scene"));
+  EXPECT_THAT(saved, HasSubstr("    # the key light, left of the camera\n"));
+  EXPECT_THAT(saved, HasSubstr("exposure: {aperture: f/8, shutter: 1/125, iso: 200}  # daylight"));
+  EXPECT_THAT(saved, HasSubstr("\n  - pose: {position: ["));
   DiagnosticEngine diag;
   diag.set_handler([](const Diagnostic&, const std::string&) {});
   const auto scene = compile_scene_file(scene_file_.string(), diag);
@@ -279,9 +275,9 @@ TEST_F(StudioApi, ReloadsTheFileAndShowsItsErrorsKeepingTheLastGoodScene) {
   std::ofstream(scene_file_) << text;
   const nlohmann::json broken = state();
   const std::string error = broken["file_error"];
-  EXPECT_NE(error.find("scene.yaml:"), std::string::npos) << error;
-  EXPECT_NE(error.find(": error: "), std::string::npos) << error;
-  EXPECT_NE(error.find("iso: -3"), std::string::npos) << "the source line: " << error;
+  EXPECT_THAT(error, HasSubstr("scene.yaml:"));
+  EXPECT_THAT(error, HasSubstr(": error: "));
+  EXPECT_THAT(error, HasSubstr("iso: -3")) << "the source line: " << error;
   EXPECT_DOUBLE_EQ(broken["camera"]["iso"].get<double>(), 400);
   EXPECT_EQ(client_->Get("/api/frame?width=200")->status, 200);
 }

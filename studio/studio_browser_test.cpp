@@ -1,11 +1,15 @@
 // rigc studio in a real headless browser: tests/studio_browser.py drives Chromium through
 // Selenium (Debian's chromium, chromium-driver, python3-selenium) against `rigc studio`.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "studio/studio_test_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::studio {
 namespace {
@@ -24,7 +28,7 @@ TEST(StudioBrowser, ExposureFocusCaptureCoverageSaveAndErrorsInThePage) {
       testing::run_process({"/usr/bin/python3", testing::source_path("tests/studio_browser.py"),
                             "--rigc", RIGC_BINARY, "--scene", scene});
   EXPECT_EQ(run.exit_code, 0) << run.out << run.err;
-  EXPECT_EQ(run.out.find("FAIL"), std::string::npos) << run.out;
+  EXPECT_THAT(run.out, Not(HasSubstr("FAIL")));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // The sweep's parts: value paths and spans in scene text, the sweep file and its errors, the
 // variants (grid, zip, names), compile errors at their lines, rank correlation, array lists.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "sweep/results.h"
@@ -8,6 +9,8 @@
 #include "sweep/sweep_spec.h"
 #include "sweep/variants.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::sweep {
 namespace {
@@ -64,7 +67,7 @@ TEST(SweepEdit, ReplacesOnlyTheValuesSpanInFlowAndBlockStyle) {
             "camera:\n  exposure: {aperture: f/4, shutter: 1/125}  # keep\n  focus: 1.2m # note\n"
             "shots:\n  - turntable: {steps: 36, step: 20deg}\n");
   EXPECT_FALSE(find_value_span(text, "camera.exposure.iso", &error));
-  EXPECT_NE(error.find("no key 'iso'"), std::string::npos) << error;
+  EXPECT_THAT(error, HasSubstr("no key 'iso'"));
   EXPECT_FALSE(find_value_span(text, "shots[3].turntable", &error));
   EXPECT_FALSE(find_value_span(text, "camera.exposure", &error));  // not a scalar
 }
@@ -110,17 +113,15 @@ TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
       "\nbackend: [preview, dali]\nmesure: [eval]\n",
       "s.yaml", diag));
   const std::string text = all_diagnostics(diag);
-  EXPECT_NE(text.find("s.yaml:8:1: unknown key 'mesure' in the sweep file; did you mean "
-                      "'measure'?"),
-            std::string::npos)
-      << text;
-  EXPECT_NE(text.find("s.yaml:7:20: unknown backend 'dali'"), std::string::npos) << text;
-  EXPECT_NE(text.find("s.yaml:4:35: 'f/4' is given twice"), std::string::npos) << text;
-  EXPECT_NE(text.find("zipped axes need as many values"), std::string::npos) << text;
+  EXPECT_THAT(text, HasSubstr("s.yaml:8:1: unknown key 'mesure' in the sweep file; did you mean "
+                              "'measure'?"));
+  EXPECT_THAT(text, HasSubstr("s.yaml:7:20: unknown backend 'dali'"));
+  EXPECT_THAT(text, HasSubstr("s.yaml:4:35: 'f/4' is given twice"));
+  EXPECT_THAT(text, HasSubstr("zipped axes need as many values"));
   DiagnosticEngine other;
   capture(other);
   EXPECT_FALSE(parse_sweep_text("rigc: 1\n", "s.yaml", other));
-  EXPECT_NE(all_diagnostics(other).find("starts with `rigc-sweep: 1`"), std::string::npos);
+  EXPECT_THAT(all_diagnostics(other), HasSubstr("starts with `rigc-sweep: 1`"));
 }
 
 // Six configurations that are no grid: the zipped axes repeat values, their tuples do not.
@@ -140,10 +141,8 @@ TEST(SweepFile, ZippedAxesMayRepeatAValueButNotAConfiguration) {
   DiagnosticEngine twice;
   capture(twice);
   EXPECT_FALSE(parse_sweep_text(head + "[18, 36, 36]" + zip, "s.yaml", twice));
-  EXPECT_NE(
-      all_diagnostics(twice).find("s.yaml:4:41: the zipped values (f/13, 36) are given twice"),
-      std::string::npos)
-      << all_diagnostics(twice);
+  EXPECT_THAT(all_diagnostics(twice),
+              HasSubstr("s.yaml:4:41: the zipped values (f/13, 36) are given twice"));
 }
 
 // A Cycles sweep at fewer samples than a final render: the count reaches every variant's render
@@ -170,8 +169,7 @@ TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
     DiagnosticEngine diag;
     capture(diag);
     EXPECT_FALSE(parse_sweep_text(text + bad, "s.yaml", diag));
-    EXPECT_NE(all_diagnostics(diag).find("s.yaml:5:10: samples: must be a whole number"),
-              std::string::npos)
+    EXPECT_THAT(all_diagnostics(diag), HasSubstr("s.yaml:5:10: samples: must be a whole number"))
         << bad << all_diagnostics(diag);
   }
 }
@@ -189,16 +187,14 @@ TEST(SweepFile, SamplesThePreviewCannotTakeAreRefusedAtTheirLine) {
   };
   const auto [square_ok, square] = diagnostics("backend: [preview, cycles]\nsamples: 32\n");
   EXPECT_FALSE(square_ok);
-  EXPECT_NE(square.find("s.yaml:6:10: samples: the preview takes a square number of samples per "
-                        "pixel (1, 4, 9, 16, ...), not 32 (backend preview)"),
-            std::string::npos)
-      << square;
+  EXPECT_THAT(square,
+              HasSubstr("s.yaml:6:10: samples: the preview takes a square number of samples per "
+                        "pixel (1, 4, 9, 16, ...), not 32 (backend preview)"));
   const auto [fine_ok, fine] = diagnostics("scale: 0.5\nsamples: 16\n");
   EXPECT_FALSE(fine_ok);
-  EXPECT_NE(fine.find("s.yaml:6:10: samples: 16 samples per pixel at scale 0.5 would render the "
-                      "preview larger than the sensor"),
-            std::string::npos)
-      << fine;
+  EXPECT_THAT(fine,
+              HasSubstr("s.yaml:6:10: samples: 16 samples per pixel at scale 0.5 would render the "
+                        "preview larger than the sensor"));
   EXPECT_TRUE(diagnostics("backend: cycles\nscale: 0.5\nsamples: 32\n").first);
 }
 
@@ -222,12 +218,11 @@ TEST(SweepVariants, AVariantThatDoesNotCompileIsAnErrorAtItsValueAndTheScenesLin
   std::vector<Variant> variants;
   EXPECT_FALSE(build_variants(*spec, read_text(scene), dir.path() / "out", variants, diag));
   const std::string text = all_diagnostics(diag);
-  EXPECT_NE(text.find(dir.file("s.yaml") + ":4:35: variant 'aperture-f-0.5' does not compile "
-                                           "(camera.exposure.aperture = f/0.5): aperture f/0.5"),
-            std::string::npos)
-      << text;
-  EXPECT_NE(text.find(scene + ":23:"), std::string::npos) << text;  // the scene's line
-  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));        // nothing ran
+  EXPECT_THAT(text,
+              HasSubstr(dir.file("s.yaml") + ":4:35: variant 'aperture-f-0.5' does not compile "
+                                             "(camera.exposure.aperture = f/0.5): aperture f/0.5"));
+  EXPECT_THAT(text, HasSubstr(scene + ":23:"));               // the scene's line
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));  // nothing ran
 }
 
 TEST(SweepVariants, AMissingPathIsAnErrorAtTheAxis) {
@@ -240,9 +235,7 @@ TEST(SweepVariants, AMissingPathIsAnErrorAtTheAxis) {
   ASSERT_TRUE(spec);
   std::vector<Variant> variants;
   EXPECT_FALSE(build_variants(*spec, read_text(scene), "/nonexistent", variants, diag));
-  EXPECT_NE(all_diagnostics(diag).find("s.yaml:4:3: 'camera.exposure' has no key 'isoo'"),
-            std::string::npos)
-      << all_diagnostics(diag);
+  EXPECT_THAT(all_diagnostics(diag), HasSubstr("s.yaml:4:3: 'camera.exposure' has no key 'isoo'"));
 }
 
 TEST(SweepVariants, AModelFileEditedInPlaceChangesTheVariantsKey) {

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +11,9 @@
 #include "scene/studio_scene.h"
 #include "tests/hostile_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::cycles {
 namespace {
@@ -41,7 +45,7 @@ TEST(CyclesEmit, ScriptCarriesUserTextOnlyAsEscapedData) {
   ASSERT_TRUE(emit(scene, dir.path() / "cycles", 0.02, &error)) << error;
   const std::string script = read_text((dir.path() / "cycles" / "scene.py").string());
   // The hostile text never appears verbatim, and the script is valid Python.
-  EXPECT_EQ(script.find("os.system(\"touch"), std::string::npos);
+  EXPECT_THAT(script, Not(HasSubstr("os.system(\"touch")));
   const auto python = external::find_executable("python3");
   if (python) {
     const auto result = rigc::testing::run_process(
@@ -65,8 +69,8 @@ TEST(CyclesEmit, MaxBouncesReachTheScriptAndTheShotKey) {
                           settings, &error))
       << error;
   const std::string script = read_text((dir.path() / "direct" / "scene.py").string());
-  EXPECT_NE(script.find(R"(\"max_bounces\":0)"), std::string::npos);
-  EXPECT_NE(script.find(R"(DATA["max_bounces"])"), std::string::npos);
+  EXPECT_THAT(script, HasSubstr(R"(\"max_bounces\":0)"));
+  EXPECT_THAT(script, HasSubstr(R"(DATA["max_bounces"])"));
   EXPECT_EQ(CyclesBackend().options_key(), "");
   EXPECT_EQ(direct.options_key(), "max_bounces=0");
 }
@@ -82,9 +86,9 @@ TEST(CyclesEmit, VertexColoursReachTheScript) {
   std::string error;
   ASSERT_TRUE(emit(scene, dir.path() / "cycles", 0.02, &error)) << error;
   const std::string script = read_text((dir.path() / "cycles" / "scene.py").string());
-  EXPECT_NE(script.find(R"(\"vertex_colors\":true)"), std::string::npos);
-  EXPECT_NE(script.find(R"(\"vertex_colors\":false)"), std::string::npos) << "the studio's";
-  EXPECT_NE(script.find(R"(attribute.attribute_name = "RigcColor")"), std::string::npos);
+  EXPECT_THAT(script, HasSubstr(R"(\"vertex_colors\":true)"));
+  EXPECT_THAT(script, HasSubstr(R"(\"vertex_colors\":false)")) << "the studio's";
+  EXPECT_THAT(script, HasSubstr(R"(attribute.attribute_name = "RigcColor")"));
   // Four floats a vertex more in the geometry than without the colours.
   ir::Scene plain = scene;
   plain.object.mesh.colors.clear();
@@ -106,7 +110,7 @@ TEST(CyclesRun, MissingExecutableNamesThePackage) {
   const int code = render_run(scene, options, log);
   setenv("PATH", saved.c_str(), 1);
   EXPECT_EQ(code, 2);
-  EXPECT_NE(log.str().find("apt-get install blender"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("apt-get install blender"));
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,6 +7,8 @@
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
 
 namespace rigc::external {
 namespace {
@@ -60,11 +63,11 @@ TEST(ReferenceProcess, RunsAnArgumentVectorWithoutAShell) {
 
   result = run_program({"sh", "-c", "pwd; exit 3"}, dir.path(), log);
   EXPECT_EQ(result.exit_code, 3);
-  EXPECT_NE(tail_of_file(log, 1).find(dir.path().filename().string()), std::string::npos);
+  EXPECT_THAT(tail_of_file(log, 1), HasSubstr(dir.path().filename().string()));
 
   result = run_program({"rigc-no-such-renderer"}, dir.path(), log);
   EXPECT_FALSE(result.started);
-  EXPECT_NE(result.error.find("not found"), std::string::npos);
+  EXPECT_THAT(result.error, HasSubstr("not found"));
   EXPECT_FALSE(find_executable("rigc-no-such-renderer"));
   EXPECT_TRUE(find_executable("sh"));
 }

@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -13,6 +14,9 @@
 #include "run/run_loop.h"
 #include "scene/studio_scene.h"
 #include "tests/test_support.h"
+
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace rigc::povray {
 namespace {
@@ -67,19 +71,19 @@ TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   std::string error;
   ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
   const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
-  EXPECT_NE(inc.find("#declare RigcObject = mesh2 {"), std::string::npos);
-  EXPECT_NE(inc.find("uv_vectors"), std::string::npos);
-  EXPECT_NE(inc.find("area_light"), std::string::npos);
-  EXPECT_NE(inc.find("rigc_speckle(x, y, z"), std::string::npos);  // the speckle pattern
+  EXPECT_THAT(inc, HasSubstr("#declare RigcObject = mesh2 {"));
+  EXPECT_THAT(inc, HasSubstr("uv_vectors"));
+  EXPECT_THAT(inc, HasSubstr("area_light"));
+  EXPECT_THAT(inc, HasSubstr("rigc_speckle(x, y, z"));  // the speckle pattern
   for (const auto& shot : scene.shots) {
     EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + ".pov")));
     EXPECT_TRUE(fs::exists(dir.path() / "pov" / (shot.name + "_mask.ini")));
     const std::string ini = read_text((dir.path() / "pov" / (shot.name + ".ini")).string());
-    EXPECT_NE(ini.find("Output_File_Type=E"), std::string::npos);
+    EXPECT_THAT(ini, HasSubstr("Output_File_Type=E"));
   }
   const std::string pov = read_text((dir.path() / "pov" / "shot_000.pov").string());
-  EXPECT_NE(pov.find("aperture"), std::string::npos);  // f-number mapped to focal blur
-  EXPECT_NE(pov.find("focal_point"), std::string::npos);
+  EXPECT_THAT(pov, HasSubstr("aperture"));  // f-number mapped to focal blur
+  EXPECT_THAT(pov, HasSubstr("focal_point"));
 }
 
 // The object's highlight peaks as the preview's GGX lobe does with light and view along the
@@ -97,9 +101,9 @@ TEST(PovrayEmit, HighlightPeaksAsThePreviewsGgxLobe) {
   const std::string finish =
       fmt::format("specular {} roughness {}", external::number_text(0.04 / (4 * alpha * alpha)),
                   external::number_text(1 / (2 / (alpha * alpha) - 2)));
-  EXPECT_NE(inc.find(finish), std::string::npos) << finish;
+  EXPECT_THAT(inc, HasSubstr(finish)) << finish;
   // The highlight of an area light comes from its whole panel, as Cycles' does.
-  EXPECT_NE(inc.find("area_illumination on"), std::string::npos);
+  EXPECT_THAT(inc, HasSubstr("area_illumination on"));
 }
 
 // Vertex colours become a texture per colour, made by the material's macro, and each face names
@@ -113,10 +117,10 @@ TEST(PovrayEmit, VertexColoursBecomeInterpolatedVertexTextures) {
   std::string error;
   ASSERT_TRUE(emit(scene, dir.path() / "pov", 0.05, &error)) << error;
   const std::string inc = read_text((dir.path() / "pov" / "scene.inc").string());
-  EXPECT_NE(inc.find("#macro RigcVertexTexture0(RigcColor)"), std::string::npos);
-  EXPECT_EQ(inc.find("#declare RigcMaterial0 ="), std::string::npos)
+  EXPECT_THAT(inc, HasSubstr("#macro RigcVertexTexture0(RigcColor)"));
+  EXPECT_THAT(inc, Not(HasSubstr("#declare RigcMaterial0 =")))
       << "the object's material is the macro alone";
-  EXPECT_NE(inc.find("#declare RigcMaterial1 ="), std::string::npos) << "the studio's stay";
+  EXPECT_THAT(inc, HasSubstr("#declare RigcMaterial1 =")) << "the studio's stay";
   const auto object = inc.find("#declare RigcObject = mesh2 {");
   ASSERT_NE(object, std::string::npos);
   EXPECT_NE(inc.find("texture_list { 3,\n    RigcVertexTexture0(<0.8, 0.1, 0.1>)", object),
@@ -171,10 +175,10 @@ shots:
   std::string error;
   ASSERT_TRUE(emit(*scene, dir.path(), 0.1, &error)) << error;
   const std::string ini = read_text((dir.path() / "shot_000.ini").string());
-  EXPECT_NE(ini.find("Initial_Frame=1"), std::string::npos) << ini;
-  EXPECT_NE(ini.find("Final_Frame="), std::string::npos);
+  EXPECT_THAT(ini, HasSubstr("Initial_Frame=1"));
+  EXPECT_THAT(ini, HasSubstr("Final_Frame="));
   const std::string pov = read_text((dir.path() / "shot_000.pov").string());
-  EXPECT_NE(pov.find("RigcDelta = 0.0349"), std::string::npos) << pov;  // 30 deg/s over 1/15 s
+  EXPECT_THAT(pov, HasSubstr("RigcDelta = 0.0349"));  // 30 deg/s over 1/15 s
 }
 
 TEST(PovrayRun, MissingExecutableNamesThePackage) {
@@ -186,7 +190,7 @@ TEST(PovrayRun, MissingExecutableNamesThePackage) {
   options.settings.scale = 0.01;
   std::ostringstream log;
   EXPECT_EQ(render_run(scene, options, log), 2);
-  EXPECT_NE(log.str().find("apt-get install povray"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("apt-get install povray"));
 }
 
 // A povray that fails for shot_001 (a wrapper in front of the real one): the run names the shot
@@ -213,10 +217,8 @@ TEST(PovrayRun, FailedShotIsNamedAndRerunRendersOnlyIt) {
     ScopedEnv path("PATH", (dir.path() / "bin").string() + ":" + std::getenv("PATH"));
     std::ostringstream log;
     EXPECT_EQ(render_run(scene, options, log), 2);
-    EXPECT_NE(log.str().find("shot_001: povray shot_001.ini failed with exit code 7"),
-              std::string::npos)
-        << log.str();
-    EXPECT_NE(log.str().find("render/shot_001.log"), std::string::npos) << log.str();
+    EXPECT_THAT(log.str(), HasSubstr("shot_001: povray shot_001.ini failed with exit code 7"));
+    EXPECT_THAT(log.str(), HasSubstr("render/shot_001.log"));
     EXPECT_TRUE(fs::exists(dir.path() / "out" / "images" / "shot_000.jpg"));
     EXPECT_FALSE(fs::exists(dir.path() / "out" / "images" / "shot_001.jpg"));
   }

@@ -26,6 +26,8 @@
 #include "tests/scene_fixtures.h"
 #include "tests/test_support.h"
 
+using ::testing::HasSubstr;
+
 namespace rigc::preview {
 namespace {
 
@@ -162,15 +164,14 @@ TEST(PreviewRun, SamplesAreASquareGridWithinTheSensor) {
     EXPECT_FALSE(fs::exists(other.path() / "manifest.json"));
     return message.str();
   };
-  EXPECT_NE(refused(5, 0.05).find("a square number of samples per pixel (1, 4, 9, 16, ...), "
-                                  "not 5"),
-            std::string::npos);
-  EXPECT_NE(refused(9, 0.5).find("larger than the sensor; at this scale it takes at most 4 (2 x "
-                                 "2)"),
-            std::string::npos);
-  EXPECT_NE(refused(4, 2.0).find("at most 1 (1 x 1)"), std::string::npos);
-  EXPECT_NE(refused(2147395600, 0.01).find("2147395600 samples per pixel at scale 0.01"),
-            std::string::npos)
+  EXPECT_THAT(refused(5, 0.05),
+              HasSubstr("a square number of samples per pixel (1, 4, 9, 16, ...), "
+                        "not 5"));
+  EXPECT_THAT(refused(9, 0.5),
+              HasSubstr("larger than the sensor; at this scale it takes at most 4 (2 x "
+                        "2)"));
+  EXPECT_THAT(refused(4, 2.0), HasSubstr("at most 1 (1 x 1)"));
+  EXPECT_THAT(refused(2147395600, 0.01), HasSubstr("2147395600 samples per pixel at scale 0.01"))
       << "46340 x 46340, the largest square an int holds";
 }
 
@@ -188,9 +189,8 @@ TEST(PreviewRun, RerunRemovesTheShotsAndFilesTheSceneNoLongerMakes) {
   testing::write_text((dir.path() / "images/mine.jpg").string(), "not the run's");
 
   ASSERT_EQ(run_preview(scene_with(2, "jpeg"), options, log), 0) << log.str();
-  EXPECT_NE(log.str().find("2 shots of an earlier run (shot_002 to shot_003) are no longer"),
-            std::string::npos)
-      << log.str();
+  EXPECT_THAT(log.str(),
+              HasSubstr("2 shots of an earlier run (shot_002 to shot_003) are no longer"));
   EXPECT_FALSE(fs::exists(dir.path() / "images/shot_002.jpg"));
   EXPECT_FALSE(fs::exists(dir.path() / "masks/shot_003.png"));
   EXPECT_TRUE(fs::exists(dir.path() / "images/shot_001.jpg"));
@@ -213,8 +213,7 @@ TEST(PreviewRun, ASecondRenderIntoABusyRunFolderIsRefused) {
     run::RunFolderLock other;  // as another rigc process would hold it
     ASSERT_TRUE(other.acquire(dir.path(), log)) << log.str();
     EXPECT_EQ(run_preview(scene, options, log), 1);
-    EXPECT_NE(log.str().find("another rigc is writing to the run folder"), std::string::npos)
-        << log.str();
+    EXPECT_THAT(log.str(), HasSubstr("another rigc is writing to the run folder"));
     EXPECT_FALSE(fs::exists(dir.path() / "manifest.json"));
   }
   EXPECT_EQ(run_preview(scene, options, log), 0) << log.str();
@@ -227,8 +226,7 @@ TEST(PreviewRun, AManifestThatIsNoFileStopsTheRunBeforeItRenders) {
   run::RunOptions options = small_run(dir.path());
   std::ostringstream log;
   EXPECT_EQ(run_preview(turntable_ball(1, "0deg"), options, log), 1);
-  EXPECT_NE(log.str().find("manifest.json: it is not a regular file"), std::string::npos)
-      << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("manifest.json: it is not a regular file"));
   EXPECT_FALSE(fs::exists(dir.path() / "images/shot_000.jpg"));
 }
 
@@ -243,7 +241,7 @@ TEST(PreviewRun, UnwritableOutputIsAUserError) {
   run::RunOptions options = small_run(dir.path() / "file" / "run");
   std::ostringstream log;
   EXPECT_EQ(run_preview(scene, options, log), 1);
-  EXPECT_NE(log.str().find("cannot create the output folder"), std::string::npos) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("cannot create the output folder"));
 }
 
 TEST(PreviewRun, ANonFiniteScaleIsRejectedBeforeAnythingIsWritten) {
@@ -255,7 +253,7 @@ TEST(PreviewRun, ANonFiniteScaleIsRejectedBeforeAnythingIsWritten) {
     options.settings.scale = scale;
     std::ostringstream log;
     EXPECT_EQ(run_preview(scene, options, log), 1) << scale;
-    EXPECT_NE(log.str().find("render scale"), std::string::npos) << log.str();
+    EXPECT_THAT(log.str(), HasSubstr("render scale"));
     // The run folder is not even made: a NaN scale used to render and record a shot first.
     EXPECT_FALSE(fs::exists(dir.path() / "run")) << scale;
   }
