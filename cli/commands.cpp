@@ -130,11 +130,9 @@ int run_render(std::vector<std::string> args) {
   app.add_flag("--force", force,
                "render into a run folder that holds another scene's shots or files no manifest "
                "lists, deleting them");
-  std::string executor = "local";
+  Executor executor = Executor::local;
   std::vector<std::string> sbatch;
-  app.add_option("--executor", executor, "local, or slurm: a Slurm array task per shot")
-      ->check(CLI::IsMember({"local", "slurm"}))
-      ->capture_default_str();
+  add_executor_option(app, executor, "local, or slurm: a Slurm array task per shot");
   app.add_option("--sbatch", sbatch, "slurm: an sbatch option, e.g. --sbatch=--time=1:00:00");
   if (auto code = parse_options(app, args)) return *code;
 
@@ -157,7 +155,7 @@ int run_render(std::vector<std::string> args) {
   options.progress_bar = isatty(STDERR_FILENO);
   options.force = force;
   const std::unique_ptr<run::Backend> renderer = backends::find_backend(backend)->make();
-  if (executor == "slurm") {
+  if (executor == Executor::slurm) {
     const sweep::SplitRender split{fs::read_symlink("/proc/self/exe"), scene_path, backend, sbatch};
     return sweep::render_on_slurm(*scene, *renderer, options, split, std::cerr);
   }

@@ -91,4 +91,17 @@ inline const CLI::Validator& positive_number() {
   return check;
 }
 
+// Where render and sweep run their work: here, or as Slurm array tasks.
+enum class Executor { local, slurm };
+
+// --executor local|slurm into `executor`; another name is an option error that lists the two.
+inline CLI::Option* add_executor_option(CLI::App& app, Executor& executor,
+                                        const std::string& description) {
+  static const std::vector<std::pair<std::string, Executor>> names = {{"local", Executor::local},
+                                                                      {"slurm", Executor::slurm}};
+  return app.add_option("--executor", executor, description)
+      ->transform(CLI::CheckedTransformer(names))
+      ->default_str("local");
+}
+
 }  // namespace rigc::cli

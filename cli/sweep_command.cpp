@@ -27,7 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SweepArguments {
-  std::string input, output, executor = "local", backend = "preview", measure = "coverage";
+  std::string input, output, backend = "preview", measure = "coverage";
+  Executor executor = Executor::local;
   std::vector<std::string> vary, sbatch;
   std::string partition, time, cpus_per_task, mem;
   double scale = 0.25;
@@ -54,9 +55,7 @@ void add_sweep_options(CLI::App& app, SweepArguments& a) {
   app.add_option("--measure", a.measure, "with --vary: coverage, eval or coverage,eval")
       ->capture_default_str();
   app.add_option("-o,--output", a.output, "sweep folder (default: out/<sweep>)");
-  app.add_option("--executor", a.executor, "where variants run")
-      ->check(CLI::IsMember({"local", "slurm"}))
-      ->capture_default_str();
+  add_executor_option(app, a.executor, "where variants run");
   app.add_option("--jobs", a.jobs, "local: variants at once (each uses every core already)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
@@ -199,7 +198,7 @@ int run_sweep_command(std::vector<std::string> args) {
     std::cout << sweep::status_text(out, *spec, variants);
     return write_and_summarise(out, *spec, variants);
   }
-  if (a.executor == "slurm") {
+  if (a.executor == Executor::slurm) {
     sweep::SlurmOptions slurm;
     slurm.rigc = rigc;
     slurm.wait = !a.no_wait;
