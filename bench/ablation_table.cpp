@@ -153,7 +153,7 @@ void print_eval_row(const std::string& name, double render_s, int run, const Arg
   options.run_dir = dir.string();
   options.scene = args.scene;
   options.output_dir = (dir / fmt::format("eval{}", run)).string();
-  options.reuse_colmap = true;
+  options.sfm.reuse_colmap = true;
   options.quiet = true;
   std::ofstream log(options.output_dir + ".log");
   rigc::eval::EvalSummary summary;

@@ -156,11 +156,12 @@ int main(int argc, char** argv) {
     rigc::eval::EvalOptions o;
     o.run_dir = run.string();
     o.scene = (dir / "scene.yaml").string();
-    o.reconstruction = (dir / "cloud.ply").string();
+    o.imported.reconstruction = (dir / "cloud.ply").string();
     o.output_dir = (dir / "eval").string();
     o.quiet = true;
-    if (std::string(how) == "--no-align") o.align = false;
-    if (std::string(how) == "--cameras bundle.out") o.cameras = (run / "bundle.out").string();
+    if (std::string(how) == "--no-align") o.imported.align = false;
+    if (std::string(how) == "--cameras bundle.out")
+      o.imported.cameras = (run / "bundle.out").string();
     std::ostringstream log;
     rigc::eval::EvalSummary s;
     t0 = Clock::now();

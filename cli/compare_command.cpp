@@ -108,8 +108,8 @@ Row evaluate_reconstruction(const ReconstructionArg& arg, const fs::path& run_di
   EvalOptions o = base;
   o.run_dir = run_dir.string();
   o.scene = scene_path;
-  o.reconstruction = arg.file;
-  o.cameras = arg.cameras;
+  o.imported.reconstruction = arg.file;
+  o.imported.cameras = arg.cameras;
   o.output_dir = (out / (arg.name + "_eval")).string();
   std::cerr << fmt::format("rigc compare: measuring {} ({}) ...\n", arg.name, arg.file);
   row.eval_status = eval::evaluate(o, std::cerr, &row.summary);
@@ -166,8 +166,8 @@ Row render_and_evaluate(const ir::Scene& scene, const std::string& scene_path,
   if (row.render_status == 0) {
     EvalOptions o = base;
     o.run_dir = row.run_dir.string();
-    o.masks_dir.clear();  // the photos' options
-    o.camera.clear();
+    o.photos.masks_dir.clear();  // the photos' options
+    o.photos.camera.clear();
     o.scene = scene_path;
     o.output_dir = (row.run_dir / "eval").string();
     row.eval_status = eval::evaluate(o, std::cerr, &row.summary);
@@ -250,7 +250,7 @@ std::string compare_markdown(const ir::Scene& scene, const std::string& scene_pa
       "Scene `{}`, render scale {}, COLMAP {} (CPU). Signed distance: reconstructed "
       "points to the scene's mesh in the object frame, after a similarity "
       "alignment on the camera centres and ICP.\n\n",
-      scene_path, scale, base.poisson ? "+ Poisson meshing" : "sparse points");
+      scene_path, scale, base.metrics.poisson ? "+ Poisson meshing" : "sparse points");
   md += table;
   md +=
       "\nThe paper's Table 1 for reference (Photoscan + CloudCompare, full resolution): real "
@@ -331,7 +331,7 @@ int run_compare_command(std::vector<std::string> args) {
   int worst = 0;
   for (const Row& r : rows) worst = std::max({worst, r.render_status, r.eval_status});
 
-  const std::string table = results_table(rows, base.tau_mm);
+  const std::string table = results_table(rows, base.metrics.tau_mm);
   std::cout << table;
   const std::string md = compare_markdown(*scene, scene_path, scale, base, rows, table, out);
   std::string error;

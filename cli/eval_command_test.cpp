@@ -58,7 +58,7 @@ TEST(EvalCommand, MissingRunIsUserErrorAndMissingColmapIsToolError) {
   EvalOptions o;
   o.run_dir = dir.file("run");
   o.ground_truth = dir.file("cube.ply");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   o.quiet = true;
   std::ostringstream log;
   EvalSummary s;
@@ -183,7 +183,7 @@ bool evaluate_small_run(const RenderedRun& run, EvalSummary* s) {
   EvalOptions o;
   o.run_dir = run.run_dir.string();
   o.quiet = true;
-  o.ground_truth_samples = 20000;
+  o.metrics.ground_truth_samples = 20000;
   std::ostringstream log;
   const int code = evaluate(o, log, s);
   if (code != 0) ADD_FAILURE() << "eval exited " << code << ":\n" << log.str();

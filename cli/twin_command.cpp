@@ -34,7 +34,8 @@ int run_twin_command(std::vector<std::string> args) {
   app.add_option("--colmap", o.colmap, "COLMAP executable")->capture_default_str();
   app.add_option("--matcher", o.matcher,
                  "a registration's matcher: auto, exhaustive, sequential (rigc eval --help)")
-      ->capture_default_str();
+      ->transform(CLI::CheckedTransformer(eval::matcher_names()))
+      ->default_str("auto");
   app.add_option("--ring-views", o.ring_views,
                  "also write ring_N.yaml: the twin with N views on the real cameras' ring")
       ->check(CLI::Range(0, 720));

@@ -165,7 +165,7 @@ class Aligner {
                         }
                       });
     sample_visible_surface();
-    if (o_.icp && method_ != AlignMethod::kNone) refine_with_icp();
+    if (o_.metrics.icp && method_ != AlignMethod::kNone) refine_with_icp();
     measure_fitness();
     a_.report["status"] = "ok";
     a_.report["reconstruction_to_ground_truth"] = similarity_json(a_.transform);
@@ -201,7 +201,7 @@ class Aligner {
     for (std::size_t i = 0; i < a_.points.size(); i += stride) {
       if (crop_.contains(a_.points[i])) inside.push_back(a_.points[i]);
     }
-    a_.fitness_distance = std::max(0.01 * diag_, 3e-3 * o_.tau_mm);
+    a_.fitness_distance = std::max(0.01 * diag_, 3e-3 * o_.metrics.tau_mm);
     std::size_t close = 0;
     for (double d : surface_.signed_distance(inside)) close += std::abs(d) <= a_.fitness_distance;
     a_.fitness = inside.empty() ? 0 : static_cast<double>(close) / inside.size();
@@ -396,7 +396,7 @@ class Aligner {
 
   void sample_visible_surface() {
     SurfaceSamples& s = a_.samples;
-    surface_.sample(o_.ground_truth_samples, 7, &s.all, &s.all_normals);
+    surface_.sample(o_.metrics.ground_truth_samples, 7, &s.all, &s.all_normals);
     for (int i : surface_.visible(s.all, s.all_normals, a_.views)) {
       s.visible.push_back(s.all[i]);
       s.visible_normals.push_back(s.all_normals[i]);

@@ -300,7 +300,7 @@ class ColmapPipeline {
         images_dir_(in.images.dir) {}
 
   ColmapRun run() {
-    if (o_.reuse_colmap && fs::exists(txt_ / "points3D.txt")) {
+    if (o_.sfm.reuse_colmap && fs::exists(txt_ / "points3D.txt")) {
       reuse_earlier_model();
       return r_;
     }
@@ -371,7 +371,7 @@ class ColmapPipeline {
 
   bool probe() {
     std::string error;
-    auto flags = probe_colmap(o_.colmap, logs_, &error);
+    auto flags = probe_colmap(o_.sfm.colmap, logs_, &error);
     if (!flags) {
       fail(2, error);
       return false;
@@ -381,8 +381,8 @@ class ColmapPipeline {
   }
 
   Argv feature_extractor_args(bool one_camera) {
-    Argv argv = {o_.colmap, "feature_extractor", "--database_path", db_.string(), "--image_path",
-                 images_dir_.string(), "--ImageReader.single_camera",
+    Argv argv = {o_.sfm.colmap, "feature_extractor", "--database_path", db_.string(),
+                 "--image_path", images_dir_.string(), "--ImageReader.single_camera",
                  // One camera for photos of one size; COLMAP refuses a single camera over
                  // images of different sizes.
                  one_camera ? "1" : "0"};
@@ -437,7 +437,7 @@ class ColmapPipeline {
     if (!camera.sensor_known) photo_focal_unknown_ = true;
     r_.prior["model"] = "SIMPLE_RADIAL";
     r_.prior["cameras"].push_back(entry);
-    r_.prior["refined_by_colmap"] = photo_focal_unknown_ || o_.refine_intrinsics
+    r_.prior["refined_by_colmap"] = photo_focal_unknown_ || o_.sfm.refine_intrinsics
                                         ? "focal length and k1"
                                         : "nothing (the focal length from the sensor is kept, "
                                           "k1 held at 0; --refine-intrinsics refines both)";
@@ -458,7 +458,7 @@ class ColmapPipeline {
       r_.prior = {{"source", cameras_txt.string()},
                   {"model", c.model},
                   {"params", c.params},
-                  {"refined_by_colmap", o_.refine_intrinsics}};
+                  {"refined_by_colmap", o_.sfm.refine_intrinsics}};
     } else {
       argv.insert(argv.end(), {"--ImageReader.camera_model", "OPENCV"});
       r_.prior = {{"source", "EXIF focal length, read by COLMAP"},
@@ -471,7 +471,7 @@ class ColmapPipeline {
   // masks/<image name>.png and ignores zero pixels.
   void add_masks(Argv& argv) {
     const fs::path masks = photos_ ? photos_->masks.dir : in_.run_dir / "masks";
-    if (masks.empty() || (!photos_ && !o_.use_masks) || !fs::is_directory(masks)) return;
+    if (masks.empty() || (!photos_ && !o_.sfm.use_masks) || !fs::is_directory(masks)) return;
     if (mask_dir_ready_) {
       argv.insert(argv.end(), {"--ImageReader.mask_path", (work_ / "masks").string()});
       return;
@@ -497,30 +497,31 @@ class ColmapPipeline {
   // views that can overlap. nullopt when the neighbours matcher cannot run.
   std::optional<Argv> matcher_args() {
     const int image_count = static_cast<int>(in_.images.names.size());
-    std::string matcher = o_.matcher;
-    if (matcher == "auto" && photos_) {
-      matcher = image_count <= kExhaustivePhotos || !flags_.imports_pair_lists ? "exhaustive"
-                                                                               : "sequential";
-    } else if (matcher == "auto") {
+    Matcher matcher = o_.sfm.matcher;
+    if (matcher == Matcher::automatic && photos_) {
+      matcher = image_count <= kExhaustivePhotos || !flags_.imports_pair_lists
+                    ? Matcher::exhaustive
+                    : Matcher::sequential;
+    } else if (matcher == Matcher::automatic) {
       const bool planned = every_image_planned(in_.images.names, in_.truth.poses);
-      matcher = planned && flags_.imports_pair_lists ? "neighbours"
-                : image_count > 100                  ? "sequential"
-                                                     : "exhaustive";
+      matcher = planned && flags_.imports_pair_lists ? Matcher::neighbours
+                : image_count > 100                  ? Matcher::sequential
+                                                     : Matcher::exhaustive;
     }
     const long all_pairs = static_cast<long>(image_count) * (image_count - 1) / 2;
-    r_.matching = {{"matcher", matcher}, {"all_pairs", all_pairs}};
+    r_.matching = {{"matcher", matcher_name(matcher)}, {"all_pairs", all_pairs}};
     Argv argv;
-    if (matcher == "sequential" && photos_ && flags_.imports_pair_lists) {
+    if (matcher == Matcher::sequential && photos_ && flags_.imports_pair_lists) {
       auto importer = sequential_photo_matching_args();
       if (!importer) return std::nullopt;
       argv = std::move(*importer);
-    } else if (matcher == "neighbours") {
+    } else if (matcher == Matcher::neighbours) {
       auto importer = neighbour_matching_args();
       if (!importer) return std::nullopt;
       argv = std::move(*importer);
     } else {
-      argv = {o_.colmap, matcher + "_matcher", "--database_path", db_.string()};
-      if (matcher == "exhaustive") r_.matching["pairs"] = all_pairs;
+      argv = {o_.sfm.colmap, matcher_name(matcher) + "_matcher", "--database_path", db_.string()};
+      if (matcher == Matcher::exhaustive) r_.matching["pairs"] = all_pairs;
     }
     if (!flags_.matching_gpu.empty()) {
       argv.push_back(flags_.matching_gpu);
@@ -539,7 +540,7 @@ class ColmapPipeline {
       return std::nullopt;
     }
     NeighbourPairOptions rule;
-    rule.max_angle_deg = o_.neighbour_angle_deg;
+    rule.max_angle_deg = o_.sfm.neighbour_angle_deg;
     std::vector<ir::Vec3> axes;
     for (const auto& name : in_.images.names) {
       // The optical axis (camera +Z) in the world: the third row of camera_from_world's rotation.
@@ -559,7 +560,7 @@ class ColmapPipeline {
         "at most, the nearest {} at least",
         (in_.run_dir / "sparse" / "images.txt").string(), rule.max_angle_deg, rule.max_per_image,
         rule.min_per_image);
-    return Argv{o_.colmap,           "matches_importer", "--database_path", db_.string(),
+    return Argv{o_.sfm.colmap,       "matches_importer", "--database_path", db_.string(),
                 "--match_list_path", pair_list.string(), "--match_type",    "pairs"};
   }
 
@@ -578,25 +579,25 @@ class ColmapPipeline {
     r_.matching["rule"] = fmt::format(
         "capture order ({}): each photo with the next {}, the last with the first (loop closure)",
         photos_->order_basis, kOverlap);
-    return Argv{o_.colmap,           "matches_importer", "--database_path", db_.string(),
+    return Argv{o_.sfm.colmap,       "matches_importer", "--database_path", db_.string(),
                 "--match_list_path", pair_list.string(), "--match_type",    "pairs"};
   }
 
   Argv mapper_args() const {
-    Argv argv = {o_.colmap, "mapper", "--database_path", db_.string(), "--image_path",
+    Argv argv = {o_.sfm.colmap, "mapper", "--database_path", db_.string(), "--image_path",
                  images_dir_.string(), "--output_path", (work_ / "sparse").string(),
                  // COLMAP 3.8 drops a model of fewer than min(images, 10) registered images: a
                  // ring with one photo lost registers in parts, which would be reported as
                  // nothing reconstructed.
                  "--Mapper.min_model_size", "3"};
-    if (photos_ && !photo_focal_unknown_ && !o_.refine_intrinsics) {
+    if (photos_ && !photo_focal_unknown_ && !o_.sfm.refine_intrinsics) {
       // Focal lengths from the bodies' sensors: refining them from a turntable's narrow views
       // is ill-conditioned. So is k1 for a small object near the frame's centre: refined, it
       // drifts, and the mapper restarts from pair after pair and can register nothing.
       argv.insert(argv.end(),
                   {"--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_extra_params", "0"});
     }
-    if (exact_prior_ && !o_.refine_intrinsics) {
+    if (exact_prior_ && !o_.sfm.refine_intrinsics) {
       // A known camera: refining focal length and distortion from two narrow-angle views of a
       // small object is ill-conditioned and can stop the reconstruction at its first pair.
       argv.insert(argv.end(),
@@ -654,9 +655,10 @@ class ColmapPipeline {
       fs::create_directories(tmp, ec);
       double cpu_s = 0;
       std::string error;
-      const int rc = run_logged({o_.colmap, "model_converter", "--input_path", e.path().string(),
-                                 "--output_path", tmp.string(), "--output_type", "TXT"},
-                                logs_ / "model_converter.log", &error, &cpu_s);
+      const int rc =
+          run_logged({o_.sfm.colmap, "model_converter", "--input_path", e.path().string(),
+                      "--output_path", tmp.string(), "--output_type", "TXT"},
+                     logs_ / "model_converter.log", &error, &cpu_s);
       convert_cpu_s += cpu_s;
       if (rc != 0) continue;
       auto images = run::read_colmap_images(tmp / "images.txt", &error);

@@ -20,6 +20,22 @@
 
 namespace rigc::eval {
 
+const std::vector<std::pair<std::string, Matcher>>& matcher_names() {
+  static const std::vector<std::pair<std::string, Matcher>> names = {
+      {"auto", Matcher::automatic},
+      {"exhaustive", Matcher::exhaustive},
+      {"sequential", Matcher::sequential},
+      {"neighbours", Matcher::neighbours}};
+  return names;
+}
+
+std::string matcher_name(Matcher matcher) {
+  for (const auto& [name, value] : matcher_names()) {
+    if (value == matcher) return name;
+  }
+  return "auto";
+}
+
 bool EvalOptions::check(std::string* error) const {
   auto refuse = [&](std::string why) {
     *error = std::move(why);
@@ -28,50 +44,52 @@ bool EvalOptions::check(std::string* error) const {
   if (run_dir.empty() == photos_dir.empty()) {
     return refuse("give a run folder or a folder of photos (one of them)");
   }
-  if (colmap.empty()) return refuse("no COLMAP executable given");
-  if (matcher != "auto" && matcher != "exhaustive" && matcher != "sequential" &&
-      matcher != "neighbours") {
+  if (sfm.colmap.empty()) return refuse("no COLMAP executable given");
+  if (!(sfm.neighbour_angle_deg > 0 && sfm.neighbour_angle_deg <= 180)) {
+    return refuse(fmt::format("the neighbour angle is {} deg; it must be in (0, 180]",
+                              sfm.neighbour_angle_deg));
+  }
+  if (metrics.poisson_depth < 1 || metrics.poisson_depth > 16) {
     return refuse(
-        fmt::format("unknown matcher '{}' (auto, exhaustive, sequential or neighbours)", matcher));
+        fmt::format("the Poisson depth is {}; it must be in 1 .. 16", metrics.poisson_depth));
   }
-  if (!(neighbour_angle_deg > 0 && neighbour_angle_deg <= 180)) {
+  if (!(std::isfinite(metrics.tau_mm) && metrics.tau_mm > 0)) {
     return refuse(
-        fmt::format("the neighbour angle is {} deg; it must be in (0, 180]", neighbour_angle_deg));
+        fmt::format("the F-score threshold is {} mm; it must be positive", metrics.tau_mm));
   }
-  if (poisson_depth < 1 || poisson_depth > 16) {
-    return refuse(fmt::format("the Poisson depth is {}; it must be in 1 .. 16", poisson_depth));
-  }
-  if (!(std::isfinite(tau_mm) && tau_mm > 0)) {
-    return refuse(fmt::format("the F-score threshold is {} mm; it must be positive", tau_mm));
-  }
-  if (min_track_length < 2 || min_track_length > 1000) {
+  if (sfm.min_track_length < 2 || sfm.min_track_length > 1000) {
     return refuse(fmt::format("the minimum track length is {}; it must be in 2 .. 1000 (images)",
-                              min_track_length));
+                              sfm.min_track_length));
   }
-  if (ground_truth_samples < 1) {
+  if (metrics.ground_truth_samples < 1) {
     return refuse(
-        fmt::format("{} ground-truth samples; at least 1 is needed", ground_truth_samples));
+        fmt::format("{} ground-truth samples; at least 1 is needed", metrics.ground_truth_samples));
   }
-  if (!(std::isfinite(key_tolerance) && key_tolerance > 0 && key_tolerance <= 1)) {
-    return refuse(fmt::format(
-        "the key tolerance is {}; it must be in (0, 1] (a chromaticity distance)", key_tolerance));
+  if (!(std::isfinite(photos.key_tolerance) && photos.key_tolerance > 0 &&
+        photos.key_tolerance <= 1)) {
+    return refuse(
+        fmt::format("the key tolerance is {}; it must be in (0, 1] (a chromaticity distance)",
+                    photos.key_tolerance));
   }
-  if (photos_dir.empty() && (!masks_dir.empty() || !camera.empty() || !reference_cameras.empty())) {
+  if (photos_dir.empty() &&
+      (!photos.masks_dir.empty() || !photos.camera.empty() || !photos.reference_cameras.empty())) {
     return refuse("--masks, --camera and --reference-cameras are for photos (--photos DIR)");
   }
-  if (!(std::isfinite(color_range_mm) && color_range_mm >= 0)) {
+  if (!(std::isfinite(metrics.color_range_mm) && metrics.color_range_mm >= 0)) {
     return refuse(fmt::format("the heat-map range is {} mm; it must be 0 (automatic) or positive",
-                              color_range_mm));
+                              metrics.color_range_mm));
   }
-  if (reconstruction.empty() && (!cameras.empty() || !align)) {
+  if (imported.reconstruction.empty() && (!imported.cameras.empty() || !imported.align)) {
     return refuse("--cameras and --no-align go with --reconstruction FILE");
   }
-  if (!cameras.empty() && !align) return refuse("give --cameras or --no-align, not both");
-  if (mesh_samples < 1000) {
-    return refuse(fmt::format("{} mesh samples; at least 1000 are needed", mesh_samples));
+  if (!imported.cameras.empty() && !imported.align)
+    return refuse("give --cameras or --no-align, not both");
+  if (imported.mesh_samples < 1000) {
+    return refuse(fmt::format("{} mesh samples; at least 1000 are needed", imported.mesh_samples));
   }
-  if (!(min_fitness >= 0 && min_fitness <= 1)) {
-    return refuse(fmt::format("the minimum fitness is {}; it must be in 0 .. 1", min_fitness));
+  if (!(imported.min_fitness >= 0 && imported.min_fitness <= 1)) {
+    return refuse(
+        fmt::format("the minimum fitness is {}; it must be in 0 .. 1", imported.min_fitness));
   }
   return true;
 }
@@ -87,7 +105,8 @@ double seconds_since(Clock::time_point t0) {
 // error unless --allow-partial.
 bool too_few_registered(const EvalOptions& o, const EvalInputs& in, std::size_t registered,
                         std::ostream& log) {
-  if (!in.photos || o.allow_partial || 2 * registered >= in.images.names.size()) return false;
+  if (!in.photos || o.photos.allow_partial || 2 * registered >= in.images.names.size())
+    return false;
   log << fmt::format(
       "rigc eval: error: only {} of the {} photos registered (fewer than half): the numbers "
       "above describe part of the object (see the causes above; --allow-partial accepts it)\n",
@@ -130,7 +149,8 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   }
   EvalReport report(*in, log, sum);
   if (photos) report.add_photos(*photos);
-  if (!o.reconstruction.empty()) return evaluate_reconstruction(o, *in, report, log, sum, t_start);
+  if (!o.imported.reconstruction.empty())
+    return evaluate_reconstruction(o, *in, report, log, sum, t_start);
 
   EvalTimes times;
   times.setup = seconds_since(t_start);
@@ -152,7 +172,7 @@ int evaluate(const EvalOptions& o, std::ostream& log, EvalSummary* summary) {
   if (!model) return report.fail("reconstruction", error, 2);
   const std::size_t points_in_model = model->points.size();
   std::erase_if(model->points, [&](const Point3D& p) {
-    return p.track_images.size() < static_cast<std::size_t>(o.min_track_length);
+    return p.track_images.size() < static_cast<std::size_t>(o.sfm.min_track_length);
   });
   report.add_reconstruction(*model, colmap, points_in_model, o);
   std::set<std::string> registered;

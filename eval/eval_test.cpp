@@ -354,20 +354,18 @@ TEST(EvalOptions, CheckRefusesFieldsOutOfRangeBeforeAnythingRuns) {
     change(bad);
     return !bad.check(&error);
   };
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.matcher = "fastest"; }));
-  EXPECT_THAT(error, HasSubstr("unknown matcher 'fastest'"));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.colmap.clear(); }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = 0; }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.neighbour_angle_deg = NAN; }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.poisson_depth = 0; }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.tau_mm = -1; }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.ground_truth_samples = 0; }));
-  EXPECT_TRUE(refused([](EvalOptions& b) { b.color_range_mm = -2; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.sfm.colmap.clear(); }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.sfm.neighbour_angle_deg = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.sfm.neighbour_angle_deg = NAN; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.metrics.poisson_depth = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.metrics.tau_mm = -1; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.metrics.ground_truth_samples = 0; }));
+  EXPECT_TRUE(refused([](EvalOptions& b) { b.metrics.color_range_mm = -2; }));
   // evaluate() refuses them as a user error, and writes nothing.
   rigc::testing::TempDir dir;
   EvalOptions bad = o;
   bad.run_dir = dir.file("run");
-  bad.tau_mm = 0;
+  bad.metrics.tau_mm = 0;
   std::ostringstream log;
   EXPECT_EQ(evaluate(bad, log, nullptr), 1);
   EXPECT_THAT(log.str(), HasSubstr("rigc eval: error: the F-score threshold is 0 mm"));
@@ -383,8 +381,8 @@ TEST(EvalCommand, NeighboursMatcherNeedsEveryImagesPlannedPose) {
   EvalOptions o;
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");
-  o.matcher = "neighbours";
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.matcher = Matcher::neighbours;
+  o.sfm.colmap = dir.file("no-such-colmap");
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_THAT(log.str(), HasSubstr("planned pose"));
@@ -398,7 +396,7 @@ EvalOptions photos_without_colmap(const rigc::testing::TempDir& dir) {
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   return o;
 }
 
@@ -433,16 +431,16 @@ TEST(EvalCommand, TwoViewPointsAreLeftOutOfTheMeasurement) {
   o.run_dir = run->dir.string();
   o.scene = run->scene_file.string();
   o.output_dir = (dir.path() / "eval").string();
-  o.reuse_colmap = true;
+  o.sfm.reuse_colmap = true;
   o.quiet = true;
-  o.ground_truth_samples = 20000;
+  o.metrics.ground_truth_samples = 20000;
   std::ostringstream log;
   EvalSummary three;
   ASSERT_EQ(evaluate(o, log, &three), 0) << log.str();
   EXPECT_EQ(three.points, long_tracks);
   EXPECT_LT(three.std_mm, 0.05);
   EXPECT_EQ(three.report["reconstruction"]["points_in_model"], all);
-  o.min_track_length = 2;
+  o.sfm.min_track_length = 2;
   EvalSummary two;
   ASSERT_EQ(evaluate(o, log, &two), 0) << log.str();
   EXPECT_EQ(two.points, all - static_cast<long>(std::count_if(
@@ -480,7 +478,7 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   o.run_dir = dir.file("run");
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   // The images are 64 x 64, the camera 64 x 3.
   rigc::testing::write_text(dir.file("run/sparse/cameras.txt"),
                             "1 OPENCV 64 3 80 80 32 32 0 0 0 0\n");
@@ -500,7 +498,7 @@ TEST(EvalCommand, ACameraFileThatDoesNotFitTheImagesIsAUserError) {
   o = EvalOptions{};
   o.photos_dir = dir.file("tiny");
   o.ground_truth = dir.file("cube.ply");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   log.str("");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_THAT(log.str(), HasSubstr("a.png is 1x1 pixels: too small"));
@@ -520,7 +518,7 @@ TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
   EvalOptions o;
   o.run_dir = dir.file("run");
   o.output_dir = dir.file("eval");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   std::ostringstream log;
   rigc::testing::write_text(dir.file("run/manifest.json"), "{");
   EXPECT_EQ(evaluate(o, log, nullptr), 1);

@@ -322,11 +322,11 @@ std::optional<GroundTruth> load_ground_truth(const EvalOptions& o, const fs::pat
                                              std::string* error) {
   GroundTruth gt;
   if (photos && o.ground_truth.empty() && o.scene.empty()) {
-    if (!o.reconstruction.empty() || o.poisson) {
+    if (!o.imported.reconstruction.empty() || o.metrics.poisson) {
       *error = fmt::format(
           "{} measures against a ground-truth mesh: give --ground-truth MESH or "
           "--scene FILE",
-          o.poisson ? "--poisson" : "--reconstruction");
+          o.metrics.poisson ? "--poisson" : "--reconstruction");
       return std::nullopt;
     }
     gt.description = "none (photos without a ground-truth mesh: registration only)";
@@ -357,7 +357,7 @@ bool check_images_for_colmap(const EvalOptions& o, const ImageSet& images, const
   if (!images.one_size() && !o.quiet) {
     log << "rigc eval: the photos differ in size: COLMAP gets one camera per photo\n";
   }
-  if (o.matcher == "neighbours" && !every_image_planned(images.names, truth.poses)) {
+  if (o.sfm.matcher == Matcher::neighbours && !every_image_planned(images.names, truth.poses)) {
     *error = fmt::format(
         "--matcher neighbours needs a planned pose for every image (a run folder's "
         "sparse/images.txt); {} has images without one",
@@ -379,7 +379,7 @@ std::string some_names(const std::vector<std::string>& names) {
 // take their photo's.
 bool load_reference_cameras(const EvalOptions& o, EvalInputs& in, std::ostream& log,
                             std::string* error) {
-  auto file = read_camera_file(o.reference_cameras, error);
+  auto file = read_camera_file(o.photos.reference_cameras, error);
   if (!file) return false;
   KnownCameras known = known_cameras(*file);
   std::vector<std::string> missing, extra;
@@ -394,14 +394,14 @@ bool load_reference_cameras(const EvalOptions& o, EvalInputs& in, std::ostream& 
     for (const auto& [name, camera] : known) named.push_back(name);
     *error = fmt::format(
         "{} has no camera for {} of the {} photos in {} ({}); its cameras are named {}",
-        o.reference_cameras, missing.size(), in.images.names.size(), in.images.dir.string(),
+        o.photos.reference_cameras, missing.size(), in.images.names.size(), in.images.dir.string(),
         some_names(missing), named.empty() ? "(none)" : some_names(named));
     return false;
   }
   if (!extra.empty() && !o.quiet) {
     log << fmt::format(
         "rigc eval: warning: {} has cameras for {} images not among the photos ({})\n",
-        o.reference_cameras, extra.size(), some_names(extra));
+        o.photos.reference_cameras, extra.size(), some_names(extra));
   }
   for (auto& [name, camera] : known) {
     const auto size = in.images.size.find(name);
@@ -411,9 +411,9 @@ bool load_reference_cameras(const EvalOptions& o, EvalInputs& in, std::ostream& 
     }
   }
   std::erase_if(known, [&](const auto& entry) { return !in.images.size.count(entry.first); });
-  protect_input_file(o.reference_cameras, "the reference cameras");
+  protect_input_file(o.photos.reference_cameras, "the reference cameras");
   in.reference = std::move(known);
-  in.reference_description = fmt::format("{} ({})", o.reference_cameras, file->format);
+  in.reference_description = fmt::format("{} ({})", o.photos.reference_cameras, file->format);
   return true;
 }
 
@@ -437,7 +437,8 @@ std::optional<EvalInputs> gather_inputs(const EvalOptions& o, std::ostream& log,
   if (!truth) return refuse();
   in.truth = std::move(*truth);
   if (!check_images_for_colmap(o, in.images, in.truth, log, &error)) return refuse();
-  if (!o.reference_cameras.empty() && !load_reference_cameras(o, in, log, &error)) return refuse();
+  if (!o.photos.reference_cameras.empty() && !load_reference_cameras(o, in, log, &error))
+    return refuse();
 
   in.out = o.output_dir.empty() ? in.run_dir / "eval" : fs::path(o.output_dir);
   std::error_code ec;

@@ -64,7 +64,7 @@ std::string evaluate_photos(const testing::TempDir& dir) {
   o.photos_dir = dir.file("photos");
   o.ground_truth = dir.file("cube.ply");
   o.output_dir = dir.file("eval");
-  o.colmap = dir.file("no-such-colmap");
+  o.sfm.colmap = dir.file("no-such-colmap");
   std::ostringstream log;
   EXPECT_EQ(evaluate(o, log, nullptr), 1);
   EXPECT_FALSE(fs::exists(dir.path() / "eval")) << "nothing is written";

@@ -101,13 +101,13 @@ ColmapRun triangulate_known_poses(const EvalOptions& o, const EvalInputs& in, co
   using Argv = std::vector<std::string>;
   const std::vector<std::pair<std::string, Argv>> steps = {
       {"point_triangulator",
-       {o.colmap, "point_triangulator", "--database_path",
+       {o.sfm.colmap, "point_triangulator", "--database_path",
         (in.out / "colmap" / "database.db").string(), "--image_path", sfm.images_dir.string(),
         "--input_path", (work / "input").string(), "--output_path", (work / "model").string(),
         "--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point", "0",
         "--Mapper.ba_refine_extra_params", "0"}},
       {"model_converter (known poses)",
-       {o.colmap, "model_converter", "--input_path", (work / "model").string(), "--output_path",
+       {o.sfm.colmap, "model_converter", "--input_path", (work / "model").string(), "--output_path",
         (work / "model_txt").string(), "--output_type", "TXT"}}};
   fs::create_directories(work / "model_txt", ec);
   for (const auto& [name, argv] : steps) {

@@ -61,7 +61,7 @@ class Measurer {
     m_.point_stats = m_.stats;
     // Poisson needs the points' observers: COLMAP's points have them, a file's have not.
     PoissonSamples poisson;
-    if (o_.poisson && view_points_.size() == m_.points.size() && !m_.points.empty()) {
+    if (o_.metrics.poisson && view_points_.size() == m_.points.size() && !m_.points.empty()) {
       compare_poisson_mesh(poisson);
     }
     if (poisson.cloud.empty()) {
@@ -77,7 +77,7 @@ class Measurer {
   // The points inside object_crop, and with --poisson for each the mean centre of the cameras
   // observing it (Poisson orients its normals towards them).
   void keep_points_near_object() {
-    const bool tracks = o_.poisson && model_.points.size() == a_.points.size();
+    const bool tracks = o_.metrics.poisson && model_.points.size() == a_.points.size();
     std::vector<std::size_t> kept;
     m_.points = points_inside(a_.points, object_crop(surface_),
                               std::numeric_limits<std::size_t>::max(), tracks ? &kept : nullptr);
@@ -108,7 +108,7 @@ class Measurer {
   // --poisson: a screened Poisson mesh of the points, measured by its surface samples.
   void compare_poisson_mesh(PoissonSamples& samples) {
     std::string why;
-    auto mesh = poisson_mesh(m_.points, view_points_, o_.poisson_depth, &why);
+    auto mesh = poisson_mesh(m_.points, view_points_, o_.metrics.poisson_depth, &why);
     if (!mesh) {
       report_["poisson_mesh"] = {{"status", "failed"}, {"reason", why}};
       return;
@@ -120,7 +120,7 @@ class Measurer {
     std::vector<double> dm = signed_distance_mm(surface_, mesh_samples);
     const DistanceStats ms = distance_stats(dm);
     report_["compared"] = "poisson_mesh";
-    report_["poisson_mesh"] = {{"depth", o_.poisson_depth},
+    report_["poisson_mesh"] = {{"depth", o_.metrics.poisson_depth},
                                {"triangles", mesh->triangles.size()},
                                {"samples", mesh_samples.size()},
                                {"signed_distance_mm", stats_json(ms)}};
@@ -159,7 +159,7 @@ class Measurer {
       truth_to_rec = nearest_distances(reference, cloud);
       for (auto& d : truth_to_rec) d *= 1000;
     }
-    m_.f = f_score(distance_mm, truth_to_rec, o_.tau_mm);
+    m_.f = f_score(distance_mm, truth_to_rec, o_.metrics.tau_mm);
     report_["fscore"] = {
         {"tau_mm", m_.f.tau},
         {"precision", m_.f.precision},

@@ -13,7 +13,7 @@ namespace rigc::eval {
 std::optional<PhotoSetup> prepare_photos(const EvalOptions& o, const EvalInputs& in,
                                          std::ostream& log, std::string* error) {
   PhotoSetup setup;
-  auto cameras = photo_cameras(in.images, o.camera, error);
+  auto cameras = photo_cameras(in.images, o.photos.camera, error);
   if (!cameras) return std::nullopt;
   setup.cameras = std::move(*cameras);
   if (!o.quiet) {
@@ -24,11 +24,11 @@ std::optional<PhotoSetup> prepare_photos(const EvalOptions& o, const EvalInputs&
     }
   }
   setup.order = capture_order(in.images, &setup.order_basis);
-  if (o.use_masks || !o.masks_dir.empty()) {
+  if (o.sfm.use_masks || !o.photos.masks_dir.empty()) {
     PhotoMaskOptions mask_options;
-    mask_options.masks_dir = o.masks_dir;
+    mask_options.masks_dir = o.photos.masks_dir;
     mask_options.backdrop_color = in.truth.backdrop_color;
-    mask_options.tolerance = o.key_tolerance;
+    mask_options.tolerance = o.photos.key_tolerance;
     mask_options.quiet = o.quiet;
     auto masks = make_photo_masks(in.images, mask_options, in.out, log, error);
     if (!masks) return std::nullopt;

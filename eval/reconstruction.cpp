@@ -346,17 +346,17 @@ class ReconstructionEval {
 
  private:
   AlignMethod method() const {
-    if (!o_.align) return AlignMethod::kNone;
-    return o_.cameras.empty() ? AlignMethod::kRegistration : AlignMethod::kCameras;
+    if (!o_.imported.align) return AlignMethod::kNone;
+    return o_.imported.cameras.empty() ? AlignMethod::kRegistration : AlignMethod::kCameras;
   }
 
   // The file, as points: a cloud's own, or a mesh's dense samples.
   int load() {
     std::string error;
-    auto g = load_reconstruction(o_.reconstruction, &error);
+    auto g = load_reconstruction(o_.imported.reconstruction, &error);
     if (!g) return report_.fail("reconstruction", error, 1);
     json section = {{"status", "ok"},
-                    {"file", o_.reconstruction},
+                    {"file", o_.imported.reconstruction},
                     {"kind", g->is_mesh() ? "mesh" : "point cloud"},
                     {"colors", g->has_colors},
                     {"normals", g->has_normals}};
@@ -364,7 +364,7 @@ class ReconstructionEval {
     if (g->is_mesh()) {
       mesh_ = std::make_unique<Surface>(g->positions, g->triangles);
       std::vector<Vec3> normals;
-      mesh_->sample(o_.mesh_samples, 13, &points, &normals);
+      mesh_->sample(o_.imported.mesh_samples, 13, &points, &normals);
       section["vertices"] = g->positions.size();
       section["triangles"] = g->triangles.size();
       section["samples"] = points.size();
@@ -374,21 +374,21 @@ class ReconstructionEval {
       section["points"] = points.size();
       section["non_finite_points_left_out"] = g->dropped;
     }
-    if (o_.poisson) {
+    if (o_.metrics.poisson) {
       section["poisson"] =
           g->is_mesh() ? "not applied: the file is a mesh already"
                        : "not applied: a file's points have no cameras to orient the normals by";
     }
     if (points.size() < 3) {
       return report_.fail("reconstruction",
-                          fmt::format("{} has fewer than 3 points", o_.reconstruction), 1);
+                          fmt::format("{} has fewer than 3 points", o_.imported.reconstruction), 1);
     }
     points_ = std::move(points);
     sum_.reconstructed = true;
     sum_.points = static_cast<long>(points_.size());
     report_.sections()["reconstruction"] = section;
     if (!o_.quiet) {
-      log_ << fmt::format("rigc eval: {}: {}\n", o_.reconstruction,
+      log_ << fmt::format("rigc eval: {}: {}\n", o_.imported.reconstruction,
                           g->is_mesh() ? fmt::format("mesh of {} triangles, {} samples",
                                                      g->triangles.size(), points_.size())
                                        : fmt::format("{} points", points_.size()));
@@ -398,7 +398,7 @@ class ReconstructionEval {
 
   // --cameras: the tool's poses, whose centres are fitted to the ground-truth ones.
   int load_cameras() {
-    if (o_.cameras.empty()) return 0;
+    if (o_.imported.cameras.empty()) return 0;
     if (in_.truth.poses.empty()) {
       return report_.fail(
           "reconstruction",
@@ -408,14 +408,14 @@ class ReconstructionEval {
           1);
     }
     std::string error;
-    auto cameras = read_camera_file(o_.cameras, &error);
+    auto cameras = read_camera_file(o_.imported.cameras, &error);
     if (!cameras) return report_.fail("reconstruction", error, 1);
     int matched = 0;
     for (const auto& im : cameras->images) matched += in_.truth.poses.count(im.name) > 0;
     model_.images = std::move(cameras->images);
     model_.cameras = std::move(cameras->cameras);
     sum_.registered = matched;
-    report_.sections()["reconstruction"]["cameras"] = {{"file", o_.cameras},
+    report_.sections()["reconstruction"]["cameras"] = {{"file", o_.imported.cameras},
                                                        {"format", cameras->format},
                                                        {"images", model_.images.size()},
                                                        {"with_ground_truth_pose", matched}};
@@ -424,7 +424,7 @@ class ReconstructionEval {
     }
     if (!o_.quiet) {
       log_ << fmt::format("rigc eval: {} ({}): {} cameras, {} with a ground-truth pose\n",
-                          o_.cameras, cameras->format, model_.images.size(), matched);
+                          o_.imported.cameras, cameras->format, model_.images.size(), matched);
     }
     return 0;
   }
@@ -436,13 +436,13 @@ class ReconstructionEval {
         "fitness {:.3f}: {:.1f} % of the points near the object lie within {:.2f} mm of the "
         "ground truth",
         a.fitness, 100 * a.fitness, 1000 * a.fitness_distance);
-    if (a.fitness >= o_.min_fitness) return 0;
+    if (a.fitness >= o_.imported.min_fitness) return 0;
     if (method() == AlignMethod::kRegistration) {
       return report_.fail(
           "alignment",
           fmt::format("the registration fits poorly ({}; at least {} is needed): is the "
                       "reconstruction of this object? Give its cameras with --cameras",
-                      figures, o_.min_fitness),
+                      figures, o_.imported.min_fitness),
           2);
     }
     log_ << fmt::format("rigc eval: warning: the aligned reconstruction fits poorly ({})\n",

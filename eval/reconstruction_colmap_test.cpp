@@ -58,7 +58,7 @@ TEST(EvalReconstructionColmap, ColmapsOwnPointsMeasureAsEvalDoes) {
   EvalOptions o;
   o.run_dir = dir.file("run");
   o.quiet = true;
-  o.ground_truth_samples = 20000;
+  o.metrics.ground_truth_samples = 20000;
   std::ostringstream log;
   EvalSummary colmap;
   ASSERT_EQ(evaluate(o, log, &colmap), 0) << log.str();
@@ -67,16 +67,16 @@ TEST(EvalReconstructionColmap, ColmapsOwnPointsMeasureAsEvalDoes) {
   const auto points = read_colmap_points(model / "points3D.txt", &error);
   ASSERT_TRUE(points) << error;
   open3d::geometry::PointCloud cloud;
-  // The points eval measures: those seen in at least o.min_track_length images.
+  // The points eval measures: those seen in at least o.sfm.min_track_length images.
   for (const auto& p : *points) {
-    if (p.track_images.size() < static_cast<std::size_t>(o.min_track_length)) continue;
+    if (p.track_images.size() < static_cast<std::size_t>(o.sfm.min_track_length)) continue;
     cloud.points_.push_back(p.position);
     cloud.colors_.push_back(Eigen::Vector3d(p.rgb[0], p.rgb[1], p.rgb[2]) / 255);
   }
   ASSERT_TRUE(open3d::io::WritePointCloud(dir.file("colmap_points.ply"), cloud));
 
-  o.reconstruction = dir.file("colmap_points.ply");
-  o.cameras = model.string();
+  o.imported.reconstruction = dir.file("colmap_points.ply");
+  o.imported.cameras = model.string();
   o.output_dir = dir.file("recon_eval");
   EvalSummary recon;
   ASSERT_EQ(evaluate(o, log, &recon), 0) << log.str();

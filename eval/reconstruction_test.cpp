@@ -72,11 +72,11 @@ EvalOptions reconstruction_options(const StatueRun& r, const std::string& file,
   EvalOptions o;
   o.run_dir = r.dir.string();
   o.scene = r.scene_file.string();
-  o.reconstruction = file;
+  o.imported.reconstruction = file;
   o.output_dir = out.string();
   o.quiet = true;
-  o.ground_truth_samples = 20000;
-  o.mesh_samples = 100000;
+  o.metrics.ground_truth_samples = 20000;
+  o.imported.mesh_samples = 100000;
   return o;
 }
 
@@ -107,7 +107,7 @@ TEST(EvalReconstruction, MovedNoisyMeshIsAlignedBackOnItsCamerasAndItsNoiseMeasu
   ASSERT_TRUE(write_ply(dir.file("mesh.ply"), noisy_soup(*r, kSigma, frame), &error)) << error;
   write_moved_bundler(*r, frame, dir.path() / "tool.out");
   EvalOptions o = reconstruction_options(*r, dir.file("mesh.ply"), dir.path() / "eval");
-  o.cameras = dir.file("tool.out");
+  o.imported.cameras = dir.file("tool.out");
   std::ostringstream log;
   EvalSummary s;
   ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
@@ -191,7 +191,7 @@ TEST(EvalReconstruction, PointsInTheScenesFrameNeedNoAlignment) {
   ascii.write_ascii = open3d::io::WritePointCloudOption::IsAscii::Ascii;
   ASSERT_TRUE(open3d::io::WritePointCloud(dir.file("points.ply"), cloud, ascii));
   EvalOptions o = reconstruction_options(*r, dir.file("points.ply"), dir.path() / "eval");
-  o.align = false;
+  o.imported.align = false;
   std::ostringstream log;
   EvalSummary s;
   ASSERT_EQ(evaluate(o, log, &s), 0) << log.str();
@@ -314,16 +314,16 @@ TEST(EvalReconstruction, OptionsThatGoTogether) {
   EvalOptions o;
   o.run_dir = "run";
   std::string error;
-  o.cameras = "c.out";
+  o.imported.cameras = "c.out";
   EXPECT_FALSE(o.check(&error));
   EXPECT_THAT(error, HasSubstr("go with --reconstruction"));
-  o.reconstruction = "r.ply";
-  o.align = false;
+  o.imported.reconstruction = "r.ply";
+  o.imported.align = false;
   EXPECT_FALSE(o.check(&error));
   EXPECT_THAT(error, HasSubstr("not both"));
-  o.cameras.clear();
+  o.imported.cameras.clear();
   EXPECT_TRUE(o.check(&error)) << error;
-  o.min_fitness = 1.5;
+  o.imported.min_fitness = 1.5;
   EXPECT_FALSE(o.check(&error));
 }
 

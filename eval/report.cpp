@@ -103,10 +103,10 @@ void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& c
       {"registered_images", model.images.size()},
       {"points", model.points.size()},
       {"points_in_model", points_in_model},
-      {"min_track_length", options.min_track_length},
+      {"min_track_length", options.sfm.min_track_length},
       {"points_left_out",
        fmt::format("{} seen in fewer than {} images", points_in_model - model.points.size(),
-                   options.min_track_length)},
+                   options.sfm.min_track_length)},
       {"mean_track_length", model.mean_track_length()},
       {"mean_reprojection_error_px", model.mean_reprojection_error()}};
   if (options.quiet) return;
@@ -114,7 +114,7 @@ void EvalReport::add_reconstruction(const SparseModel& model, const ColmapRun& c
       "rigc eval: COLMAP: {}/{} images registered, {} points ({} seen in {}+ images, measured), "
       "track {:.2f}, reprojection {:.3f} px ({:.1f} s)\n",
       model.images.size(), image_count_, points_in_model, model.points.size(),
-      options.min_track_length, model.mean_track_length(), model.mean_reprojection_error(),
+      options.sfm.min_track_length, model.mean_track_length(), model.mean_reprojection_error(),
       colmap.seconds);
 }
 
@@ -122,7 +122,8 @@ void EvalReport::write_pictures(const EvalOptions& o, const Surface& surface,
                                 const Alignment& alignment, const Measurements& m) {
   const std::vector<double>& d_mm = m.distance_mm;
   const DistanceStats& stats = m.point_stats;
-  const double range = o.color_range_mm > 0 ? o.color_range_mm : std::max(1e-3, 3 * stats.rms);
+  const double range =
+      o.metrics.color_range_mm > 0 ? o.metrics.color_range_mm : std::max(1e-3, 3 * stats.rms);
   const ViewCamera view =
       alignment.views.empty() ? overview_camera(surface) : alignment.views.front();
   // Three independent files: the cloud's write overlaps the pictures' drawing.
@@ -169,7 +170,7 @@ void EvalReport::print_measurements(const EvalOptions& o, const Measurements& m)
       compared == "points"         ? "points"
       : compared == "mesh_samples" ? "mesh samples"
                                    : "Poisson-mesh samples",
-      m.f.fscore, o.tau_mm, m.f.precision, m.f.recall);
+      m.f.fscore, o.metrics.tau_mm, m.f.precision, m.f.recall);
 }
 
 void EvalReport::print_written() const {

@@ -44,7 +44,7 @@ class EvalReport {
   void add_photos(const PhotoSetup& photos);
   // The "reconstruction" section, and its line on the log.
   // `model` holds the points measured: those of the `points_in_model` COLMAP made that are seen
-  // in at least options.min_track_length images.
+  // in at least options.sfm.min_track_length images.
   void add_reconstruction(const SparseModel& model, const ColmapRun& colmap,
                           std::size_t points_in_model, const EvalOptions& options);
   // cloud_signed_distance.ply, histogram.png and heatmap.png (seen by the first camera): the

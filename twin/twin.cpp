@@ -90,10 +90,10 @@ std::optional<std::vector<std::pair<std::string, eval::ViewCamera>>> capture_cam
   eval::EvalOptions eo;
   eo.photos_dir = o.photos_dir;
   eo.output_dir = in.out.string();
-  eo.colmap = o.colmap;
-  eo.matcher = o.matcher;
-  eo.masks_dir = o.masks_dir;
-  eo.allow_partial = true;
+  eo.sfm.colmap = o.colmap;
+  eo.sfm.matcher = o.matcher;
+  eo.photos.masks_dir = o.masks_dir;
+  eo.photos.allow_partial = true;
   eo.quiet = o.quiet;
   eval::EvalSummary summary;
   const int rc = eval::evaluate(eo, log, &summary);
@@ -270,8 +270,8 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   eval::EvalOptions eo;
   eo.photos_dir = o.photos_dir;
   eo.output_dir = (out / "eval").string();
-  eo.reference_cameras = o.reference_cameras;
-  eo.masks_dir = o.masks_dir;
+  eo.photos.reference_cameras = o.reference_cameras;
+  eo.photos.masks_dir = o.masks_dir;
   eo.quiet = o.quiet;
   eval::EvalSummary summary;
   const auto in = eval::gather_inputs(eo, log, summary);

@@ -15,6 +15,8 @@
 #include <ostream>
 #include <string>
 
+#include "eval/eval.h"
+
 namespace rigc::twin {
 
 struct TwinOptions {
@@ -26,8 +28,8 @@ struct TwinOptions {
   int max_misses = 0;             // silhouettes a hull point may fall outside (a key's errors)
   std::optional<double> object_height_m;  // the scale of a registration without reference
   std::string colmap = "colmap";
-  std::string matcher = "auto";  // a registration's matcher (eval's --matcher)
-  bool render = true;            // render the twin from every camera and compare it with the photos
+  eval::Matcher matcher = eval::Matcher::automatic;  // a registration's matcher (eval's --matcher)
+  bool render = true;  // render the twin from every camera and compare it with the photos
   int ring_views = 0;  // also write ring_N.yaml: N views on the real cameras' ring (a what-if)
   bool quiet = false;
 };
