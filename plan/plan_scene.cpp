@@ -8,7 +8,7 @@
 #include "compiler/check.h"
 #include "compiler/frontend.h"
 #include "compiler/limits.h"
-#include "plan/scene_text.h"
+#include "compiler/scene_text.h"
 #include "scene/studio_scene.h"
 
 namespace rigc::plan {
@@ -68,8 +68,8 @@ PlanProblem make_problem(const CandidateSet& set, int kept, const ir::Scene& can
 bool analyse_candidates(const std::string& text, const PlanRequest& request, PlanOutcome& outcome,
                         std::string* error) {
   std::string replace_error;
-  const auto candidate_text = replace_shots_section(
-      text, shots_yaml(outcome.candidates, all_candidates(outcome.candidates), false),
+  const auto candidate_text = replace_section(
+      text, "shots", shots_yaml(outcome.candidates, all_candidates(outcome.candidates), false),
       &replace_error);
   if (!candidate_text) {
     *error = replace_error;
@@ -153,8 +153,8 @@ std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEn
   std::string replace_error;
   const auto planned =
       request.keep_scene_shots
-          ? append_to_shots_section(*text, planned_shots_text(*outcome), &replace_error)
-          : replace_shots_section(*text, planned_shots_text(*outcome), &replace_error);
+          ? append_to_section(*text, "shots", planned_shots_text(*outcome), &replace_error)
+          : replace_section(*text, "shots", planned_shots_text(*outcome), &replace_error);
   if (!planned) {
     *error = replace_error;
     return nullptr;

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "studio/scene_edit.h"
+#include "compiler/scene_text.h"
 
 namespace rigc::studio {
 

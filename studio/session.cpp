@@ -17,12 +17,12 @@
 #include "compiler/frontend.h"
 #include "compiler/limits.h"
 #include "compiler/presets.h"
+#include "compiler/scene_text.h"
 #include "dslr/lens.h"
 #include "io/atomic_file.h"
 #include "io/bounded_file.h"
 #include "io/file_status.h"
 #include "plan/plan_scene.h"
-#include "plan/scene_text.h"
 #include "raster/shadow_map_cache.h"
 #include "run/run_loop.h"
 #include "scene/motion_blur.h"
@@ -218,7 +218,7 @@ Outcome Session::compile_view(const View& view) {
   std::string error;
   std::string pose = view_pose_text(view);
   pose = pose.substr(1, pose.size() - 2);  // the entry without its braces
-  const auto text = plan::replace_shots_section(text_, "shots:\n  - " + pose + "\n", &error);
+  const auto text = replace_section(text_, "shots", "shots:\n  - " + pose + "\n", &error);
   if (!text) return Outcome::fail(error);
   Compiled compiled = compile_text(*text, file_);
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
@@ -256,7 +256,7 @@ Outcome Session::set_values(const std::vector<std::pair<ScenePath, std::string>>
       return Outcome::fail("only camera.* and studio.* values can be set");
     }
     std::string error;
-    const auto edited = studio::set_value(text, path, value, &error);
+    const auto edited = rigc::set_value(text, path, value, &error);
     if (!edited) return Outcome::fail(error);
     text = *edited;
     if (path[0] != "camera") change = Change::kAnything;
@@ -654,7 +654,7 @@ std::optional<analysis::CoverageResult> Session::analyse(std::deque<AnalysisCach
 Session::Analysed Session::analysed() {
   std::lock_guard lock(mutex_);
   std::string error;
-  const auto without_shots = plan::replace_shots_section(text_, "shots:\n", &error);
+  const auto without_shots = replace_section(text_, "shots", "shots:\n", &error);
   return {scene_, studio_, analysis_generation_, without_shots ? *without_shots : text_};
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/coverage.h"
+#include "compiler/scene_text.h"
 #include "io/bounded_file.h"
 #include "ir/ir.h"
 #include "raster/shadow_map_cache.h"
@@ -25,7 +26,6 @@
 #include "studio/frame_encoding.h"
 #include "studio/live_develop.h"
 #include "studio/reference_check.h"
-#include "studio/scene_edit.h"
 
 namespace rigc::studio {
 

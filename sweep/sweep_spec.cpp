@@ -12,9 +12,9 @@
 
 #include "backends/registry.h"
 #include "compiler/check.h"
+#include "compiler/scene_text.h"
 #include "io/bounded_file.h"
 #include "run/backend.h"
-#include "sweep/scene_edit.h"
 
 namespace rigc::sweep {
 namespace {
@@ -58,7 +58,7 @@ void read_vary(const YAML::Node& node, const std::string& file, SweepSpec& spec,
   for (auto it = node.begin(); it != node.end(); ++it) {
     Axis axis{it->first.Scalar(), loc_of(it->first, file), {}};
     std::string error;
-    if (!parse_value_path(axis.path, &error)) {
+    if (!parse_scene_path(axis.path, &error)) {
       diag.error(axis.loc, error);
       continue;
     }
@@ -254,7 +254,7 @@ std::optional<Axis> parse_vary_option(const std::string& text, std::string* erro
     return std::nullopt;
   }
   Axis axis{text.substr(0, equals), {"--vary", 0, 0}, {}};
-  if (!axis.is_backend() && !parse_value_path(axis.path, error)) return std::nullopt;
+  if (!axis.is_backend() && !parse_scene_path(axis.path, error)) return std::nullopt;
   std::stringstream values(text.substr(equals + 1));
   std::string value;
   while (std::getline(values, value, ',')) {

@@ -1,10 +1,9 @@
-// The sweep's parts: value paths and spans in scene text, the sweep file and its errors, the
+// The sweep's parts: the sweep file and its errors, the
 // variants (grid, zip, names), compile errors at their lines, rank correlation, array lists.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "sweep/results.h"
-#include "sweep/scene_edit.h"
 #include "sweep/slurm_executor.h"
 #include "sweep/sweep_spec.h"
 #include "sweep/variants.h"
@@ -32,52 +31,6 @@ std::string all_diagnostics(DiagnosticEngine& diag) {
             d.message + "\n";
   }
   return text;
-}
-
-TEST(SweepEdit, PathsFollowTheSchemasNames) {
-  std::string error;
-  const auto steps = parse_value_path("shots[0].turntable.steps", &error);
-  ASSERT_TRUE(steps) << error;
-  ASSERT_EQ(steps->size(), 4u);
-  EXPECT_EQ((*steps)[0].key, "shots");
-  EXPECT_EQ((*steps)[1].index, 0);
-  EXPECT_EQ((*steps)[3].key, "steps");
-  EXPECT_FALSE(parse_value_path("shots[x].a", &error));
-  EXPECT_FALSE(parse_value_path("[0].a", &error));
-  EXPECT_FALSE(parse_value_path("a..b", &error));
-  EXPECT_FALSE(parse_value_path("a;rm -rf", &error));
-}
-
-TEST(SweepEdit, ReplacesOnlyTheValuesSpanInFlowAndBlockStyle) {
-  const std::string text =
-      "camera:\n  exposure: {aperture: f/13, shutter: 1/125}  # keep\n  focus: auto # note\n"
-      "shots:\n  - turntable: {steps: 18, step: 20deg}\n";
-  std::string error;
-  const auto span = find_value_span(text, "camera.exposure.aperture", &error);
-  ASSERT_TRUE(span) << error;
-  EXPECT_EQ(span->line, 2);
-  EXPECT_EQ(text.substr(span->begin, span->end - span->begin), "f/13");
-  const auto edited = edit_scene_text(text,
-                                      {{"camera.exposure.aperture", "f/4"},
-                                       {"shots[0].turntable.steps", "36"},
-                                       {"camera.focus", "1.2m"}},
-                                      &error);
-  ASSERT_TRUE(edited) << error;
-  EXPECT_EQ(*edited,
-            "camera:\n  exposure: {aperture: f/4, shutter: 1/125}  # keep\n  focus: 1.2m # note\n"
-            "shots:\n  - turntable: {steps: 36, step: 20deg}\n");
-  EXPECT_FALSE(find_value_span(text, "camera.exposure.iso", &error));
-  EXPECT_THAT(error, HasSubstr("no key 'iso'"));
-  EXPECT_FALSE(find_value_span(text, "shots[3].turntable", &error));
-  EXPECT_FALSE(find_value_span(text, "camera.exposure", &error));  // not a scalar
-}
-
-TEST(SweepEdit, ValuesThatAreNotPlainAreQuoted) {
-  EXPECT_EQ(yaml_scalar_text("f/8"), "f/8");
-  EXPECT_EQ(yaml_scalar_text("-0.5"), "-0.5");
-  EXPECT_EQ(yaml_scalar_text("a: b"), "\"a: b\"");
-  EXPECT_EQ(yaml_scalar_text("x\"\n"), "\"x\\\"\\x0a\"");
-  EXPECT_EQ(yaml_scalar_text("[1, 2]"), "\"[1, 2]\"");
 }
 
 TEST(SweepFile, ReadsAxesZipBackendScaleAndMeasures) {

@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "compiler/frontend.h"
+#include "compiler/scene_text.h"
 #include "io/atomic_file.h"
 #include "io/files.h"
 #include "run/manifest.h"
 #include "run/scene_inputs.h"
-#include "sweep/scene_edit.h"
 
 namespace rigc::sweep {
 namespace {
@@ -58,12 +58,20 @@ std::string read_text(const fs::path& path) {
   return in ? text.str() : std::string();
 }
 
-// The (path, value) edits that make a variant's scene text; a relative mesh path becomes absolute.
-std::vector<std::pair<std::string, std::string>> variant_edits(const SweepSpec& spec,
-                                                               const std::string& scene_text,
-                                                               const Variant& variant) {
+// An axis's path in the scene (checked when the sweep was read).
+ScenePath axis_scene_path(const Axis& axis) {
+  std::string ignored;
+  return parse_scene_path(axis.path, &ignored).value_or(ScenePath{});
+}
+
+// The (path, YAML text) edits that make a variant's scene text; a relative mesh path becomes
+// absolute.
+std::vector<std::pair<ScenePath, std::string>> variant_edits(const SweepSpec& spec,
+                                                             const std::string& scene_text,
+                                                             const Variant& variant) {
   const fs::path scene_dir = fs::absolute(fs::path(spec.scene_path)).parent_path();
-  std::vector<std::pair<std::string, std::string>> edits;
+  const ScenePath mesh_path = {"object", "mesh"};
+  std::vector<std::pair<ScenePath, std::string>> edits;
   bool mesh_varied = false;
   for (std::size_t a = 0; a < spec.axes.size(); ++a) {
     if (spec.axes[a].is_backend()) continue;
@@ -72,17 +80,17 @@ std::vector<std::pair<std::string, std::string>> variant_edits(const SweepSpec& 
       mesh_varied = true;
       if (fs::path(value).is_relative()) value = (scene_dir / value).lexically_normal().string();
     }
-    edits.emplace_back(spec.axes[a].path, value);
+    edits.emplace_back(axis_scene_path(spec.axes[a]), yaml_scalar_text(value));
   }
   std::string ignored;
-  if (const auto mesh = find_value_span(scene_text, "object.mesh", &ignored);
-      mesh && !mesh_varied) {
+  if (const auto mesh = find_value_span(scene_text, mesh_path, &ignored); mesh && !mesh_varied) {
     const std::string written = scene_text.substr(mesh->begin, mesh->end - mesh->begin);
     const std::string unquoted = written.size() > 1 && (written[0] == '"' || written[0] == '\'')
                                      ? written.substr(1, written.size() - 2)
                                      : written;
     if (fs::path(unquoted).is_relative()) {
-      edits.emplace_back("object.mesh", (scene_dir / unquoted).lexically_normal().string());
+      edits.emplace_back(mesh_path,
+                         yaml_scalar_text((scene_dir / unquoted).lexically_normal().string()));
     }
   }
   return edits;
@@ -174,8 +182,12 @@ bool build_variants(const SweepSpec& spec, const std::string& scene_text, const 
   for (std::size_t a = 0; a < spec.axes.size(); ++a) {
     if (spec.axes[a].is_backend()) continue;
     std::string error;
-    const auto span = find_value_span(scene_text, spec.axes[a].path, &error);
-    if (!span) {
+    const auto span = find_value_span(scene_text, axis_scene_path(spec.axes[a]), &error);
+    if (span && !span->scalar) {
+      error = fmt::format("'{}' is not a single value in the scene (a sweep varies scalars)",
+                          spec.axes[a].path);
+    }
+    if (!span || !span->scalar) {
       diag.error(spec.axes[a].loc, fmt::format("{} (in {})", error, spec.scene_path));
       return false;
     }
@@ -187,7 +199,7 @@ bool build_variants(const SweepSpec& spec, const std::string& scene_text, const 
   bool ok = true;
   for (Variant& v : variants) {
     std::string error;
-    const auto text = edit_scene_text(scene_text, variant_edits(spec, scene_text, v), &error);
+    const auto text = replace_values(scene_text, variant_edits(spec, scene_text, v), &error);
     if (!text) {
       diag.error(spec.axes.front().loc, error);
       return false;
