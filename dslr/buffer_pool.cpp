@@ -54,11 +54,8 @@ std::size_t bytes_of(const std::vector<T>& buffer) {
 // only write them a second time.
 //
 // The pages are asked to stay 4 KB ones (MADV_NOHUGEPAGE, which also holds where THP is
-// "always"; Debian's mode is "madvise"). On a virtual machine a fresh 2 MB page can cost several
-// times as much CPU to fault in as the same memory in 4 KB pages, once the memory has been free
-// for a few seconds: most likely the guest's free 2 MB blocks go back to the host (virtio-balloon
-// free page reporting) while its scattered 4 KB pages stay backed. Later shots reuse the pool's
-// buffers, so small pages cost them nothing.
+// "always"): on a virtual machine a fresh 2 MB page can cost several times as much to fault in.
+// Later shots reuse the pool's buffers, so small pages cost them nothing.
 void first_touch(void* data, std::size_t bytes) {
   constexpr std::uintptr_t kPiece = std::uintptr_t{2} << 20, kPage = 4096;
   const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(data);

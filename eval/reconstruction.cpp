@@ -178,9 +178,9 @@ Vec3 ply_record_point(const char* record, const PlyCloudLayout& layout) {
   return p;
 }
 
-// Binary little-endian PLY clouds read straight from the file (Open3D's reader calls back per
-// value: 11 s for 5M points), in chunks converted in parallel. nullopt for any other PLY (then
-// Open3D reads it); false with `error` for a file cut short.
+// Binary little-endian PLY clouds read straight from the file, in chunks converted in parallel
+// (Open3D's reader calls back once per value, several times slower). nullopt for any other PLY
+// (then Open3D reads it); false with `error` for a file cut short.
 std::optional<bool> read_binary_ply_cloud(const fs::path& path, ReconstructionGeometry& g,
                                           std::string* error) {
   if constexpr (std::endian::native != std::endian::little) return std::nullopt;

@@ -47,9 +47,8 @@ class PreviewBackend : public run::Backend {
   bool takes_samples() const override { return true; }
   int default_samples() const override { return 1; }
   bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
-  // 2: depth of field blurs by the circle of confusion in the image, not on the sensor; 3: an
-  // area light's size widens the highlights it makes; 4: the whole diffuse under the highlight;
-  // 5: Burley's diffuse lobe; 6: depth of field no longer widens small discs by a pixel's box.
+  // Raised with every change to the preview's pixels, so that earlier runs render again (the
+  // history is in git log).
   int output_version() const override { return 6; }
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
