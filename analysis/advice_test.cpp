@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -23,7 +24,7 @@ struct Advised {
 Advised advise(const std::string& scene_text) {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   const auto scene = compile_scene_text(scene_text, "test.yaml", ".", diag);
   EXPECT_TRUE(scene) << messages;
   if (!scene) return {};

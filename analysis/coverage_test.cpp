@@ -34,7 +34,7 @@ Analysed analyse(const std::string& text) {
   Analysed out;
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   auto scene = compile_scene_text(text, "test.yaml", ".", diag);
   EXPECT_TRUE(scene) << messages;
   if (!scene) return out;
@@ -44,7 +44,7 @@ Analysed analyse(const std::string& text) {
   options.visibility_scale = 0.2;
   out.coverage = analyse_coverage(out.scene, studio, options);
   DiagnosticEngine advice;
-  advice.set_handler([&](const Diagnostic&, const std::string& m) { out.warnings += m; });
+  rigc::testing::capture_diagnostics(advice, out.warnings);
   report_capture_advice(out.scene, studio, out.coverage, advice);
   out.warning_count = advice.warning_count();
   return out;

@@ -9,6 +9,7 @@
 
 #include "analysis/coverage.h"
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 namespace rigc::analysis {
 
@@ -18,7 +19,7 @@ inline std::shared_ptr<const ir::Scene> compile_statue_scene(
     const std::string& exposure = "{aperture: f/11, shutter: 1/125, iso: 200}") {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   auto scene = compile_scene_text(R"(rigc: 1
 object:
   primitive: {shape: statue, detail: 4}

@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 ir::Scene compile(const std::string& text, const std::string& base_dir = ".") {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   auto scene = compile_scene_text(text, "test.yaml", base_dir, diag);
   EXPECT_TRUE(scene) << messages;
   return scene ? *scene : ir::Scene{};

@@ -87,7 +87,7 @@ RenderedRun render(const rigc::testing::TempDir& dir, const std::string& text, d
   r.run_dir = dir.path() / "run";
   rigc::testing::write_text(r.scene_file.string(), text);
   DiagnosticEngine diag;
-  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  rigc::testing::silence_diagnostics(diag);
   auto scene = compile_scene_file(r.scene_file.string(), diag);
   EXPECT_TRUE(scene.has_value());
   if (!scene) return r;

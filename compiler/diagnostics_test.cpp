@@ -2,13 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_support.h"
+
 namespace rigc {
 namespace {
 
 TEST(Diagnostics, RendersLocationSourceLineAndCaret) {
   DiagnosticEngine diag;
   std::string captured;
-  diag.set_handler([&](const Diagnostic&, const std::string& text) { captured += text; });
+  rigc::testing::capture_diagnostics(diag, captured);
   diag.add_source("rig.yaml", "camera:\n  exposure: {aperture: f/0.8}\n");
   diag.error({"rig.yaml", 2, 24}, "aperture f/0.8 is outside f/1.2..f/64");
   EXPECT_EQ(captured,

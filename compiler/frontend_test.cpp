@@ -32,7 +32,7 @@ Compiled compile_repo_file(const std::string& relative) {
   fs::current_path(RIGC_SOURCE_DIR);
   DiagnosticEngine diag;
   Compiled result;
-  diag.set_handler([&](const Diagnostic&, const std::string& text) { result.diagnostics += text; });
+  rigc::testing::capture_diagnostics(diag, result.diagnostics);
   result.scene = compile_scene_file(relative, diag);
   result.errors = diag.error_count();
   result.warnings = diag.warning_count();
@@ -42,7 +42,7 @@ Compiled compile_repo_file(const std::string& relative) {
 Compiled compile_text(const std::string& text, const std::string& base_dir = ".") {
   DiagnosticEngine diag;
   Compiled result;
-  diag.set_handler([&](const Diagnostic&, const std::string& out) { result.diagnostics += out; });
+  rigc::testing::capture_diagnostics(diag, result.diagnostics);
   result.scene = compile_scene_text(text, "test.yaml", base_dir, diag);
   result.errors = diag.error_count();
   result.warnings = diag.warning_count();

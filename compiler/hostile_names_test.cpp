@@ -122,7 +122,7 @@ TEST(HostileNames, DiagnosticsQuotingBytesAreValidJson) {
 std::string compile_messages(const std::string& path) {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   EXPECT_FALSE(compile_scene_file(path, diag)) << path;
   return messages;
 }
@@ -147,7 +147,7 @@ TEST(HostileNames, AnUnreadableSceneFileSaysWhy) {
 std::string text_messages(const std::string& text) {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   EXPECT_FALSE(compile_scene_text(text, "s.yaml", ".", diag));
   return messages;
 }
@@ -161,7 +161,7 @@ TEST(HostileNames, AnUnreadableMeshSaysWhy) {
   const auto messages = [&](const std::string& mesh) {
     DiagnosticEngine diag;
     std::string out;
-    diag.set_handler([&](const Diagnostic&, const std::string& m) { out += m; });
+    rigc::testing::capture_diagnostics(diag, out);
     EXPECT_FALSE(compile_scene_text("rigc: 1\nobject: {mesh: " + mesh + ", fit: {size: 1cm}}\n",
                                     "s.yaml", dir.path().string(), diag));
     return out;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 namespace rigc {
 namespace {
@@ -24,7 +25,7 @@ struct Compiled {
 Compiled compile_text(const std::string& text) {
   DiagnosticEngine diag;
   Compiled result;
-  diag.set_handler([&](const Diagnostic&, const std::string& out) { result.diagnostics += out; });
+  rigc::testing::capture_diagnostics(diag, result.diagnostics);
   result.scene = compile_scene_text(text, "test.yaml", ".", diag);
   return result;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 using ::testing::HasSubstr;
 
@@ -45,7 +46,7 @@ Compiled compile_with(const std::string& lens, const std::string& aperture = "f/
       distance + ", height: 20cm}}\n";
   DiagnosticEngine diag;
   Compiled out;
-  diag.set_handler([&](const Diagnostic&, const std::string& text) { out.diagnostics += text; });
+  rigc::testing::capture_diagnostics(diag, out.diagnostics);
   out.scene = compile_scene_text(text, "lens.yaml", ".", diag);
   return out;
 }

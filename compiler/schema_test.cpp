@@ -35,7 +35,7 @@ TEST(Schema, EveryExampleSceneIsValidAndCompiles) {
   for (const auto& scene : scenes) {
     EXPECT_THAT(result.out, HasSubstr(scene + ": valid"));
     DiagnosticEngine diag;
-    diag.set_handler([](const Diagnostic&, const std::string&) {});
+    rigc::testing::silence_diagnostics(diag);
     EXPECT_TRUE(compile_scene_file(scene, diag)) << scene;
   }
 }
@@ -77,7 +77,7 @@ shots:
   EXPECT_EQ(result.exit_code, 0) << result.out << result.err;
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   EXPECT_TRUE(compile_scene_file(path, diag)) << messages;
 }
 

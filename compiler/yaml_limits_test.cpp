@@ -7,6 +7,7 @@
 #include <string>
 
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -73,7 +74,7 @@ TEST(YamlLimits, DeepNestingIsALimitAtItsLine) {
 TEST(YamlLimits, TheFrontEndReportsTheProblemAtItsLine) {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   const std::string text = "rigc: 1\nobject: " + std::string(3000, '[') + std::string(3000, ']');
   EXPECT_FALSE(compile_scene_text(text, "deep.yaml", ".", diag));
   EXPECT_EQ(messages.rfind("deep.yaml:2:", 0), 0u) << messages;

@@ -3,9 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "dslr/dslr_test_support.h"
 #include "dslr/exposure.h"
 #include "dslr/pipeline.h"
-#include "dslr/test_helpers.h"
 
 using ::testing::HasSubstr;
 

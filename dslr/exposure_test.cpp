@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "dslr/dslr_test_support.h"
 #include "dslr/pipeline.h"
-#include "dslr/test_helpers.h"
 
 namespace rigc::dslr {
 namespace {

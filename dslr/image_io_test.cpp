@@ -8,8 +8,8 @@
 
 #include <csignal>
 
+#include "dslr/dslr_test_support.h"
 #include "dslr/pipeline.h"
-#include "dslr/test_helpers.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;

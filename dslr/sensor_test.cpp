@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "dslr/develop.h"
+#include "dslr/dslr_test_support.h"
 #include "dslr/exposure.h"
 #include "dslr/pipeline.h"
-#include "dslr/test_helpers.h"
 
 namespace rigc::dslr {
 namespace {

@@ -12,6 +12,7 @@
 #include "eval/inputs.h"
 #include "eval/reconstruction_test_support.h"
 #include "ir/ir.h"
+#include "tests/test_support.h"
 
 namespace rigc::eval {
 namespace {
@@ -27,7 +28,7 @@ struct RingCase {
 RingCase ring_case(int turn) {
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   auto scene = compile_scene_text(test_inputs::kStatueScene, "statue.yaml", ".", diag);
   EXPECT_TRUE(scene) << messages;
   RingCase c;

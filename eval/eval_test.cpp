@@ -526,7 +526,7 @@ TEST(EvalCommand, ABrokenManifestIsNamedAndAnotherObjectIsWarnedAbout) {
   // Rendered from one object, measured against the paper scene's statue: said, then measured.
   o.scene = rigc::testing::source_path("scenes/paper-turntable.yaml");
   DiagnosticEngine diag;
-  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  rigc::testing::silence_diagnostics(diag);
   auto paper = compile_scene_file(o.scene, diag);
   ASSERT_TRUE(paper);
   const std::string paper_hash = run::object_geometry_hash(*paper);

@@ -60,7 +60,7 @@ inline std::optional<StatueRun> make_statue_run(const std::filesystem::path& dir
   rigc::testing::write_text(r.scene_file.string(), kStatueScene);
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& text) { messages += text; });
+  rigc::testing::capture_diagnostics(diag, messages);
   auto scene = compile_scene_file(r.scene_file.string(), diag);
   if (!scene) {
     ADD_FAILURE() << messages;

@@ -7,7 +7,7 @@
 #include "fuzz/entries.h"
 #include "fuzz/input_file.h"
 #include "studio/edit_requests.h"
-#include "studio/studio_test_scene.h"
+#include "studio/scene_test_support.h"
 
 namespace rigc::fuzz {
 

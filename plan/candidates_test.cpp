@@ -6,6 +6,7 @@
 
 #include "compiler/check.h"
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 using ::testing::HasSubstr;
 
@@ -35,7 +36,7 @@ TEST(Candidates, RotationPoseIsWrittenBackExactly) {
       r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2));
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& m) { messages += m; });
+  rigc::testing::capture_diagnostics(diag, messages);
   const std::string text = scene_with(shots);
   const auto root = parse_yaml(text, "test.yaml", diag);
   ASSERT_TRUE(root) << messages;

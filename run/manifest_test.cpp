@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "tests/test_scene.h"
+#include "tests/scene_test_support.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;

@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "run/colmap_text.h"
-#include "tests/test_scene.h"
+#include "tests/scene_test_support.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;

@@ -8,7 +8,7 @@
 #include "backends/preview/preview_backend.h"
 #include "run/run_loop.h"
 #include "scene/studio_scene.h"
-#include "tests/test_scene.h"
+#include "tests/scene_test_support.h"
 
 namespace rigc::studio {
 namespace {

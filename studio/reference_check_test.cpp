@@ -14,7 +14,7 @@
 
 #include "io/child_processes.h"
 #include "studio/server.h"
-#include "studio/studio_test_server.h"
+#include "studio/server_test_support.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;

@@ -17,7 +17,7 @@
 
 #include "analysis/coverage.h"
 #include "compiler/frontend.h"
-#include "studio/studio_test_server.h"
+#include "studio/server_test_support.h"
 #include "tests/test_support.h"
 
 namespace rigc::studio {
@@ -178,7 +178,7 @@ TEST_F(StudioApi, CapturesUndoAndChangesGiveTheCoverageOfAFullAnalysis) {
     const auto coverage = nlohmann::json::parse(res->body);
     ASSERT_EQ(post("/api/save", {})->status, 200) << after;
     DiagnosticEngine diag;
-    diag.set_handler([](const Diagnostic&, const std::string&) {});
+    rigc::testing::silence_diagnostics(diag);
     const auto scene = compile_scene_file(scene_file_.string(), diag);
     ASSERT_TRUE(scene) << after;
     const auto full = analysis::analyse_coverage(*scene, scene::prepare_studio_scene(*scene));
@@ -258,7 +258,7 @@ TEST_F(StudioApi, SaveWritesTheEditsAndCapturesAndKeepsTheComments) {
   EXPECT_THAT(saved, HasSubstr("exposure: {aperture: f/8, shutter: 1/125, iso: 200}  # daylight"));
   EXPECT_THAT(saved, HasSubstr("\n  - pose: {position: ["));
   DiagnosticEngine diag;
-  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  rigc::testing::silence_diagnostics(diag);
   const auto scene = compile_scene_file(scene_file_.string(), diag);
   ASSERT_TRUE(scene);
   EXPECT_EQ(scene->shots.size(), 2u);

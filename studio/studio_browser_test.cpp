@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "studio/studio_test_scene.h"
+#include "studio/scene_test_support.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;

@@ -21,7 +21,7 @@ using testing::write_text;
 
 // Keeps the diagnostics in the engine instead of printing them.
 void capture(DiagnosticEngine& diag) {
-  diag.set_handler([](const Diagnostic&, const std::string&) {});
+  rigc::testing::silence_diagnostics(diag);
 }
 
 std::string all_diagnostics(DiagnosticEngine& diag) {

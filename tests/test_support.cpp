@@ -11,9 +11,19 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "compiler/diagnostics.h"
+
 extern char** environ;
 
 namespace rigc::testing {
+
+void capture_diagnostics(DiagnosticEngine& diag, std::string& text) {
+  diag.set_handler([&text](const Diagnostic&, const std::string& rendered) { text += rendered; });
+}
+
+void silence_diagnostics(DiagnosticEngine& diag) {
+  diag.set_handler([](const Diagnostic&, const std::string&) {});
+}
 
 namespace fs = std::filesystem;
 

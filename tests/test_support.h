@@ -5,7 +5,18 @@
 #include <string>
 #include <vector>
 
+namespace rigc {
+class DiagnosticEngine;
+}
+
 namespace rigc::testing {
+
+// Appends each of `diag`'s diagnostics, rendered as rigc prints them, to `text` instead of
+// printing them. `text` must outlive the engine's use.
+void capture_diagnostics(DiagnosticEngine& diag, std::string& text);
+
+// Prints none of `diag`'s diagnostics; they stay in diag.diagnostics().
+void silence_diagnostics(DiagnosticEngine& diag);
 
 struct ProcessResult {
   int exit_code = -1;

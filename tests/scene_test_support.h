@@ -7,6 +7,7 @@
 #include <string>
 
 #include "compiler/frontend.h"
+#include "tests/test_support.h"
 
 namespace rigc::testing {
 
@@ -27,7 +28,7 @@ shots:
 )";
   DiagnosticEngine diag;
   std::string messages;
-  diag.set_handler([&](const Diagnostic&, const std::string& text) { messages += text; });
+  rigc::testing::capture_diagnostics(diag, messages);
   std::optional<ir::Scene> scene = compile_scene_text(kText, "test.yaml", ".", diag);
   EXPECT_TRUE(scene.has_value()) << messages;
   return scene ? *scene : ir::Scene{};

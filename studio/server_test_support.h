@@ -11,9 +11,9 @@
 #include <string>
 #include <thread>
 
+#include "studio/scene_test_support.h"
 #include "studio/server.h"
 #include "studio/session.h"
-#include "studio/studio_test_scene.h"
 #include "tests/test_support.h"
 
 namespace rigc::studio {
