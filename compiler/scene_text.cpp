@@ -108,7 +108,9 @@ YAML::Node map_child(const YAML::Node& map, const std::string& key) {
   return YAML::Node(YAML::NodeType::Undefined);
 }
 
-// Follows `path` from `root` as far as it leads; `error` says why it stopped short.
+// Follows `path` from `root` as far as it leads; `error` says why it stopped short. (Nodes are
+// rebound with reset: yaml-cpp's operator= assigns into the tree, which then held the child in
+// the root's place for the next path.)
 Followed follow(const YAML::Node& root, const ScenePath& path, std::string* error) {
   Followed at{root};
   for (; at.steps < path.size(); ++at.steps) {
@@ -122,7 +124,7 @@ Followed follow(const YAML::Node& root, const ScenePath& path, std::string* erro
         *error = fmt::format("{} has {} items, no [{}]", here, at.node.size(), step);
         return at;
       }
-      at.node = at.node[index];
+      at.node.reset(at.node[index]);
     } else if (at.node.IsMap() && !is_digits(step)) {
       YAML::Node next = map_child(at.node, step);
       if (!next.IsDefined()) {
@@ -130,7 +132,7 @@ Followed follow(const YAML::Node& root, const ScenePath& path, std::string* erro
         *error = fmt::format("{} has no key '{}'", here, step);
         return at;
       }
-      at.node = next;
+      at.node.reset(next);
     } else {
       *error = is_digits(step) ? fmt::format("{} is not a list", here)
                                : fmt::format("{} has no key '{}'", here, step);
