@@ -7,11 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "dslr/lens.h"
 #include "raster/rasterizer.h"
+#include "raster/shadow_map_cache.h"
 #include "scene/motion_blur.h"
 
 namespace rigc::preview {
@@ -167,6 +169,34 @@ bool PreviewBackend::render(const ir::Scene& scene, const scene::StudioScene& st
   if (settings.samples > 0) shot_options.supersample = grid_side(settings.samples);
   *out = render_linear(scene, studio, shot, settings.scale, nullptr, shot_options);
   return true;
+}
+
+namespace {
+
+class PreviewLiveRenderer : public run::LiveRenderer {
+ public:
+  bool render(const ir::Scene& scene, const std::shared_ptr<const scene::StudioScene>& studio,
+              const ir::Shot& shot, double scale, bool draft, run::RenderedShot* out,
+              std::string* /*error*/) override {
+    if (shadow_studio_ != studio || !shadow_cache_) {
+      shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
+      shadow_studio_ = studio;
+    }
+    *out =
+        render_linear(scene, *studio, shot, scale, shadow_cache_.get(), {.draft_surface = draft});
+    return true;
+  }
+
+ private:
+  // The shadow maps of shadow_studio_'s lights (whoever changes the lights makes a new studio).
+  std::shared_ptr<const scene::StudioScene> shadow_studio_;
+  std::unique_ptr<raster::ShadowMapCache> shadow_cache_;
+};
+
+}  // namespace
+
+std::unique_ptr<run::LiveRenderer> PreviewBackend::live_renderer() const {
+  return std::make_unique<PreviewLiveRenderer>();
 }
 
 dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene& studio,

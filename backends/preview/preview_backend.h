@@ -53,6 +53,8 @@ class PreviewBackend : public run::Backend {
   bool render(const ir::Scene& scene, const scene::StudioScene& studio, const ir::Shot& shot,
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
+  // Keeps the shadow maps while the studio stays; a draft point-samples the surface.
+  std::unique_ptr<run::LiveRenderer> live_renderer() const override;
 };
 
 // One shot in linear light, with the rasterizer's stages in stage_ms. A `shadow_cache` keeps the
