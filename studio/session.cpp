@@ -3,36 +3,21 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
 #include <cmath>
-#include <fstream>
 #include <numbers>
 #include <sstream>
-#include <thread>
 
-#include "analysis/advice.h"
-#include "analysis/coverage_output.h"
-#include "backends/preview/preview_backend.h"
 #include "compiler/diagnostics.h"
 #include "compiler/frontend.h"
-#include "compiler/limits.h"
 #include "compiler/presets.h"
 #include "compiler/scene_text.h"
 #include "dslr/lens.h"
-#include "io/atomic_file.h"
-#include "io/bounded_file.h"
-#include "io/file_status.h"
 #include "plan/plan_scene.h"
-#include "raster/shadow_map_cache.h"
-#include "run/run_loop.h"
-#include "scene/motion_blur.h"
-#include "studio/frame_encoding.h"
 
 namespace rigc::studio {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 struct Compiled {
   std::optional<ir::Scene> scene;
@@ -79,25 +64,19 @@ std::string scene_lens_preset(const std::string& text) {
   }
 }
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 }  // namespace
 
 std::unique_ptr<Session> Session::open(const fs::path& scene_file, std::string* error,
                                        fs::path run_folder) {
   std::unique_ptr<Session> session(new Session());
-  session->file_ = scene_file;
-  session->disk_text_ = session->read_disk(error, &session->disk_identity_);
-  if (!error->empty()) return nullptr;
-  session->opened_target_ = file_to_replace(scene_file, error);
-  if (!error->empty()) return nullptr;
-  const Outcome outcome = session->apply_text(session->disk_text_, Change::kAnything);
+  SceneDocument& document = session->document_;
+  if (!document.open(scene_file, error)) return nullptr;
+  const Outcome outcome = session->apply_text(document.disk_text(), Change::kAnything);
   if (!outcome.ok) {
     *error = outcome.message;
     return nullptr;
   }
+  document.set_text(document.disk_text());
   // The first view: the scene's first shot.
   const ir::Shot& first = session->scene_->shots.front();
   View view;
@@ -131,51 +110,13 @@ Outcome Session::start_reference(const ReferenceRequest& request) {
   return {};
 }
 
-std::string Session::read_disk(std::string* error, FileIdentity* identity) const {
-  std::string why;
-  auto file = read_bounded_file(file_, limits::kMostSceneFileBytes, &why);
-  if (!file) {
-    *error = fmt::format("rigc: error: cannot read {}: it {}\n", file_.string(), why);
-    return {};
-  }
-  error->clear();
-  *identity = file->identity;
-  return std::move(file->bytes);
-}
-
-// Empty when file_ still leads to the file the session opened, that file is the one read or saved
-// last and it holds what was read: otherwise why Save must not replace it.
-std::string Session::changed_on_disk() const {
-  std::string error;
-  const fs::path target = file_to_replace(file_, &error);
-  if (!error.empty()) return error;
-  if (target != opened_target_) {
-    return fmt::format("{} now leads to {}, not to the file the studio opened ({})", file_.string(),
-                       target.string(), opened_target_.string());
-  }
-  if (names_nothing(target)) return "";  // deleted since: Save writes it anew
-  FileIdentity identity;
-  const std::string now = read_disk(&error, &identity);
-  if (!error.empty()) return error;
-  if (identity == disk_identity_ && now == disk_text_) return "";
-  std::size_t line = 1, at = 0;
-  while (at < now.size() && at < disk_text_.size() && now[at] == disk_text_[at]) {
-    if (now[at++] == '\n') ++line;
-  }
-  const std::size_t start = now.rfind('\n', at == 0 ? 0 : at - 1);
-  const std::size_t from = start == std::string::npos || at == 0 ? 0 : start + 1;
-  const std::string now_line = now.substr(from, now.find('\n', from) - from);
-  return fmt::format(
-      "{} changed on disk since the studio read it (line {} now reads '{}'); the studio "
-      "loads it on its next poll, then Save writes your changes over it",
-      file_.string(), line, now_line.substr(0, 80));
-}
-
-// Compiles `text`; when it compiles it becomes the session's scene, otherwise the last good
-// scene stays and the diagnostics are the message. What `change` cannot have touched is kept.
-// Unless only shots changed, the view is compiled with it in one go: appended as the last shot
-// (the compiler places, focuses and refuses it there as in a scene of its own).
-Outcome Session::apply_text(std::string text, Change change) {
+// Compiles `text`; when it compiles it becomes the session's scene (the caller gives the
+// document the text), otherwise the last good scene stays and the diagnostics are the message.
+// What `change` cannot have touched is kept. Unless only shots changed, the view is compiled with
+// it in one go: appended as the last shot (the compiler places, focuses and refuses it there as
+// in a scene of its own).
+Outcome Session::apply_text(const std::string& text, Change change) {
+  const fs::path& file = document_.file();
   std::optional<ir::Shot> view_shot;
   std::optional<ir::Scene> compiled_scene;
   if (view_shot_ && change != Change::kShots) {
@@ -184,13 +125,13 @@ Outcome Session::apply_text(std::string text, Change change) {
     entry = entry.substr(1, entry.size() - 2);
     const auto with_view = append_to_list(text, {"shots"}, entry, &error);
     if (!with_view) return Outcome::fail(error);
-    Compiled compiled = compile_text(*with_view, file_);
+    Compiled compiled = compile_text(*with_view, file);
     if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
     view_shot = as_view_shot(compiled.scene->shots.back());
     compiled.scene->shots.pop_back();
     compiled_scene = std::move(compiled.scene);
   } else {
-    Compiled compiled = compile_text(text, file_);
+    Compiled compiled = compile_text(text, file);
     if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
     compiled_scene = std::move(compiled.scene);
   }
@@ -198,10 +139,9 @@ Outcome Session::apply_text(std::string text, Change change) {
   studio_ = change != Change::kAnything && studio_
                 ? studio_
                 : std::make_shared<const scene::StudioScene>(scene::prepare_studio_scene(*scene));
-  text_ = std::move(text);
   scene_ = scene;
   if (view_shot) view_shot_ = std::move(view_shot);
-  if (change != Change::kShots) ++analysis_generation_;
+  if (change != Change::kShots) analyses_.next_generation();
   ++revision_;
   return {};
 }
@@ -218,9 +158,10 @@ Outcome Session::compile_view(const View& view) {
   std::string error;
   std::string pose = view_pose_text(view);
   pose = pose.substr(1, pose.size() - 2);  // the entry without its braces
-  const auto text = replace_section(text_, "shots", "shots:\n  - " + pose + "\n", &error);
+  const auto text =
+      replace_section(document_.text(), "shots", "shots:\n  - " + pose + "\n", &error);
   if (!text) return Outcome::fail(error);
-  Compiled compiled = compile_text(*text, file_);
+  Compiled compiled = compile_text(*text, document_.file());
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
   view_shot_ = as_view_shot(compiled.scene->shots.front());
   view_ = view;
@@ -249,7 +190,7 @@ Outcome Session::set_value(const ScenePath& path, const std::string& value) {
 
 Outcome Session::set_values(const std::vector<std::pair<ScenePath, std::string>>& values) {
   std::lock_guard lock(mutex_);
-  std::string text = text_;
+  std::string text = document_.text();
   Change change = Change::kCamera;
   for (const auto& [path, value] : values) {
     if (path.size() < 2 || (path[0] != "camera" && path[0] != "studio")) {
@@ -267,7 +208,7 @@ Outcome Session::set_values(const std::vector<std::pair<ScenePath, std::string>>
 Outcome Session::add_light(const std::string& entry) {
   std::lock_guard lock(mutex_);
   std::string error;
-  const auto text = append_to_list(text_, {"studio", "lights"}, entry, &error);
+  const auto text = append_to_list(document_.text(), {"studio", "lights"}, entry, &error);
   if (!text) return Outcome::fail(error);
   return push_text(*text, Change::kAnything);
 }
@@ -275,21 +216,15 @@ Outcome Session::add_light(const std::string& entry) {
 Outcome Session::remove_light(size_t index) {
   std::lock_guard lock(mutex_);
   std::string error;
-  const auto text = remove_from_list(text_, {"studio", "lights"}, index, &error);
+  const auto text = remove_from_list(document_.text(), {"studio", "lights"}, index, &error);
   if (!text) return Outcome::fail(error);
   return push_text(*text, Change::kAnything);
 }
 
-void Session::remember_for_undo(std::string text, Change change) {
-  undo_.push_back({std::move(text), change});
-  if (undo_.size() > kMostUndoSteps) undo_.pop_front();
-}
-
 // A change the user can undo.
 Outcome Session::push_text(const std::string& text, Change change) {
-  std::string before = text_;
   const Outcome outcome = apply_text(text, change);
-  if (outcome.ok) remember_for_undo(std::move(before), change);
+  if (outcome.ok) document_.change_text(text, change);
   return outcome;
 }
 
@@ -307,7 +242,7 @@ Outcome Session::capture() {
   std::string error;
   std::string entry = view_pose_text(view_);
   entry = entry.substr(1, entry.size() - 2);
-  const auto text = append_to_list(text_, {"shots"}, entry, &error);
+  const auto text = append_to_list(document_.text(), {"shots"}, entry, &error);
   if (!text) return Outcome::fail(error);
   const Outcome outcome = push_text(*text, Change::kShots);
   if (outcome.ok) ++captures_;
@@ -315,13 +250,13 @@ Outcome Session::capture() {
 }
 
 Outcome Session::suggest_next_shot(Suggestion* suggestion) {
-  std::lock_guard analysing(analysis_mutex_);
+  std::lock_guard planning(analyses_.advice_mutex());
   plan::PlanRequest request;
   {
     std::lock_guard lock(mutex_);
-    request.scene_text = text_;
+    request.scene_text = document_.text();
   }
-  request.scene_path = request.output_path = file_.string();
+  request.scene_path = request.output_path = document_.file().string();
   request.keep_scene_shots = request.next_shot_only = true;
   request.target = 1;
   request.candidates.azimuth_step_rad = 20 * std::numbers::pi / 180;  // seconds, not tens
@@ -350,10 +285,10 @@ Outcome Session::suggest_next_shot(Suggestion* suggestion) {
 
 Outcome Session::undo() {
   std::lock_guard lock(mutex_);
-  if (undo_.empty()) return Outcome::fail("nothing to undo");
-  const UndoEntry entry = undo_.back();
-  const Outcome outcome = apply_text(entry.text, entry.change);
-  if (outcome.ok) undo_.pop_back();
+  if (!document_.can_undo()) return Outcome::fail("nothing to undo");
+  const UndoStep& step = document_.last_step();
+  const Outcome outcome = apply_text(step.text, step.change);
+  if (outcome.ok) document_.undo_last_step();
   return outcome;
 }
 
@@ -361,37 +296,22 @@ Outcome Session::undo() {
 // write is atomic.
 Outcome Session::save() {
   std::lock_guard lock(mutex_);
-  const Compiled compiled = compile_text(text_, file_);
+  const Compiled compiled = compile_text(document_.text(), document_.file());
   if (!compiled.scene) return Outcome::fail(compiled.diagnostics);
-  if (const std::string changed = changed_on_disk(); !changed.empty()) {
-    return Outcome::fail("rigc: error: not saved: " + changed);
-  }
   std::string error;
-  if (!write_file_atomically(file_, text_, &error)) return Outcome::fail("rigc: error: " + error);
-  disk_text_ = text_;
-  if (const auto identity = identity_of(file_)) disk_identity_ = *identity;
-  disk_error_.clear();
-  file_error_.clear();
+  if (!document_.save(&error)) return Outcome::fail(error);
   return {};
 }
 
 void Session::reload_if_changed() {
   std::lock_guard lock(mutex_);
-  std::string error;
-  FileIdentity identity;
-  const std::string text = read_disk(&error, &identity);
-  if (error != disk_error_) ++revision_;
-  disk_error_ = error;
-  if (!error.empty()) return;
-  disk_identity_ = identity;
-  if (text == disk_text_) return;
-  disk_text_ = text;
-  const std::string before = text_;
-  const Outcome outcome = apply_text(text, Change::kAnything);
-  file_error_ = outcome.ok ? "" : outcome.message;
+  bool read_error_changed = false;
+  const std::optional<std::string> text = document_.poll_disk(&read_error_changed);
+  if (read_error_changed) ++revision_;
+  if (!text) return;
+  const Outcome outcome = apply_text(*text, Change::kAnything);
+  document_.reloaded(*text, outcome.ok, outcome.message);
   ++revision_;
-  ++reloads_;
-  if (outcome.ok && before != text) remember_for_undo(before, Change::kAnything);
 }
 
 namespace {
@@ -438,7 +358,8 @@ nlohmann::json Session::state() {
   std::lock_guard lock(mutex_);
   const ir::Scene& scene = *scene_;
   const ir::Shot& view_shot = *view_shot_;
-  const auto focus = scene_focus_auto(text_);
+  const std::string& text = document_.text();
+  const auto focus = scene_focus_auto(text);
   nlohmann::json bodies = nlohmann::json::array();
   for (const auto& preset : body_presets()) bodies.push_back(preset.name);
   nlohmann::json lenses = nlohmann::json::array();
@@ -453,14 +374,14 @@ nlohmann::json Session::state() {
       (ir::world_from_object(scene, view_.turntable_rad) *
        ((scene.object.bounds_min_object + scene.object.bounds_max_object) / 2).homogeneous())
           .head<3>();
-  return {{"file", file_.filename().string()},
+  return {{"file", document_.file().filename().string()},
           {"name", scene.name},
-          {"unsaved", text_ != disk_text_},
-          {"file_error", disk_error_.empty() ? file_error_ : disk_error_},
+          {"unsaved", document_.unsaved()},
+          {"file_error", document_.file_error()},
           {"captures", captures_},
           {"revision", revision_},
-          {"reloads", reloads_},
-          {"can_undo", !undo_.empty()},
+          {"reloads", document_.reloads()},
+          {"can_undo", document_.can_undo()},
           {"shots", scene.shots.size()},
           {"camera", camera_json(scene.camera)},
           {"focus_auto", focus},
@@ -477,61 +398,8 @@ nlohmann::json Session::state() {
             {"ambient_lx", scene.studio.ambient_lx},
             {"lights", lights_json(scene.studio.lights)}}},
           {"bodies", bodies},
-          {"lens", scene_lens_preset(text_)},
+          {"lens", scene_lens_preset(text)},
           {"lenses", lenses}};
-}
-
-// The preview's linear frame of `shot`, or the one kept from an earlier frame that differs only
-// in what the DSLR model applies (exposure, focus, white balance, noise). The studio stays the
-// same object as long as the object, the materials, the studio and its lights do.
-bool Session::render_linear(const ir::Scene& scene,
-                            const std::shared_ptr<const scene::StudioScene>& studio,
-                            const ir::Shot& shot, const run::RenderSettings& settings, bool draft,
-                            std::shared_ptr<const run::RenderedShot>* rendered, bool* reused) {
-  RenderCache key;
-  key.draft = draft;
-  key.studio = studio;
-  key.world_from_camera = shot.world_from_camera;
-  key.turntable_angle_rad = shot.turntable_angle_rad;
-  key.turntable_velocity_rad_s = shot.turntable_velocity_rad_s;
-  key.canvas = dslr::render_geometry_for(scene.camera, settings.scale);
-  key.subframes = scene::motion_blur_subframes(scene, *studio, shot, settings.scale);
-  key.shutter_s = key.subframes > 1 ? scene.camera.shutter_s : 0;
-  const auto same = [&](const RenderCache& c) {
-    return c.studio == key.studio && c.world_from_camera == key.world_from_camera &&
-           c.turntable_angle_rad == key.turntable_angle_rad &&
-           c.turntable_velocity_rad_s == key.turntable_velocity_rad_s &&
-           c.shutter_s == key.shutter_s && c.subframes == key.subframes && c.draft == key.draft &&
-           c.canvas.width == key.canvas.width && c.canvas.height == key.canvas.height &&
-           c.canvas.fx == key.canvas.fx && c.canvas.fy == key.canvas.fy &&
-           c.canvas.cx == key.canvas.cx && c.canvas.cy == key.canvas.cy;
-  };
-  const auto hit = std::find_if(render_cache_.begin(), render_cache_.end(), same);
-  *reused = hit != render_cache_.end();
-  if (*reused) {
-    *rendered = hit->rendered;
-    return true;
-  }
-  auto fresh = std::make_shared<run::RenderedShot>();
-  render_preview(scene, studio, shot, settings.scale, draft, fresh.get());
-  key.rendered = *rendered = std::move(fresh);
-  render_cache_.push_front(std::move(key));
-  // The live view's two sizes (moving and at rest) of the current view.
-  if (render_cache_.size() > 2) render_cache_.pop_back();
-  return true;
-}
-
-// The preview's frame, with the shadow maps kept while the studio (and its lights) stays.
-void Session::render_preview(const ir::Scene& scene,
-                             const std::shared_ptr<const scene::StudioScene>& studio,
-                             const ir::Shot& shot, double scale, bool draft,
-                             run::RenderedShot* rendered) {
-  if (shadow_studio_ != studio || !shadow_cache_) {
-    shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
-    shadow_studio_ = studio;
-  }
-  *rendered = preview::render_linear(scene, *studio, shot, scale, shadow_cache_.get(),
-                                     {.draft_surface = draft});
 }
 
 std::optional<Frame> Session::frame(double scale, bool draft, std::string* error) {
@@ -544,198 +412,31 @@ std::optional<Frame> Session::frame(double scale, bool draft, std::string* error
     shot = *view_shot_;
     studio = studio_;
   }
-  ++frames_rendering_;
-  struct Done {
-    std::atomic<int>& count;
-    std::atomic<std::int64_t>& ended;
-    ~Done() {
-      ended = Clock::now().time_since_epoch().count();
-      --count;
-    }
-  } done{frames_rendering_, last_frame_end_};
-  std::lock_guard render_lock(render_mutex_);
-  const auto start = Clock::now();
-  run::RenderSettings settings;
-  settings.scale = scale;
-  if (!settings.check(error)) return std::nullopt;
-  std::shared_ptr<const run::RenderedShot> rendered;
-  Frame frame;
-  if (!render_linear(*scene, studio, shot, settings, draft, &rendered, &frame.reused_render)) {
-    return std::nullopt;
-  }
-  error->clear();
-  std::map<std::string, double> stages;
-  if (!frame.reused_render) stages = rendered->stage_ms;
-  bool reused_optics = false;
-  dslr::DevelopResult developed =
-      live_develop_.develop(scene->camera, std::move(rendered), shot, settings.seed, scale,
-                            &reused_optics, error, &stages);
-  if (developed.encoded_bytes.empty()) {
-    if (error->empty()) *error = "the DSLR model produced no image";
-    return std::nullopt;
-  }
-  frame.width = developed.width;
-  frame.height = developed.height;
-  frame.render_ms = ms_since(start);
-  frame.stage_ms = std::move(stages);
-  const auto encode_start = Clock::now();
-  frame.jpeg = encode_jpeg(developed.encoded_bytes, frame.width, frame.height, 90, error);
-  if (frame.jpeg.empty()) return std::nullopt;
-  frame.histogram = histogram_of(developed.encoded_bytes);
-  frame.encode_ms = ms_since(encode_start);
-  return frame;
-}
-
-// The coverage of `scene`'s shots with `options`. A kept analysis of the same scene but for its
-// shots (`key`: the scene text without them) serves: the shots it has beyond those `scene`
-// begins with are taken back, and `scene`'s further shots added. Nullopt when a newer change
-// started another generation meanwhile (the analysis stops at its next shot, and is kept for
-// when its scene comes back), or when a capture waits for a background coverage. A background
-// analysis yields to the live view between shots.
-std::optional<analysis::CoverageResult> Session::analyse(std::deque<AnalysisCache>& caches,
-                                                         const Analysed& what,
-                                                         const analysis::CoverageOptions& options,
-                                                         bool background) {
-  const auto same_shot = [](const ir::Shot& a, const ir::Shot& b) {
-    return a.world_from_camera == b.world_from_camera &&
-           a.object_from_camera == b.object_from_camera &&
-           a.turntable_angle_rad == b.turntable_angle_rad &&
-           a.turntable_velocity_rad_s == b.turntable_velocity_rad_s &&
-           a.focus_distance_m == b.focus_distance_m;
-  };
-  const auto& shots = what.scene->shots;
-  auto hit = std::find_if(caches.begin(), caches.end(),
-                          [&](const AnalysisCache& c) { return c.key == what.key; });
-  if (hit == caches.end()) {
-    caches.push_front({what.key, nullptr});
-    if (caches.size() > kKeptAnalyses) caches.pop_back();
-    hit = caches.begin();
-  }
-  // Each kept state is a copy of the whole analysis: only the scene in use keeps its undo.
-  for (auto& other : caches) {
-    if (&other != &*hit && other.run) other.run->forget_undo();
-  }
-  AnalysisCache& cache = *hit;
-  if (cache.run) {
-    const auto& kept = cache.run->shots();
-    size_t common = 0;
-    while (common < kept.size() && common < shots.size() &&
-           same_shot(kept[common], shots[common])) {
-      ++common;
-    }
-    while (cache.run && static_cast<size_t>(cache.run->shot_count()) > common) {
-      if (!cache.run->remove_last_shot()) cache.run.reset();
-    }
-  }
-  if (!cache.run) {
-    cache.run = std::make_unique<analysis::IncrementalCoverage>(what.scene, what.studio, options);
-  }
-  // The live view first: while frames come (a slider or the camera moving), the next shot of a
-  // background analysis waits until they pause, unless a capture waits for the coverage.
-  const auto live_view_busy = [&] {
-    const Clock::duration since_frame =
-        Clock::now().time_since_epoch() - Clock::duration(last_frame_end_.load());
-    return urgent_requests_ == 0 &&
-           (frames_rendering_ > 0 || since_frame < std::chrono::milliseconds(200));
-  };
-  for (size_t s = cache.run->shot_count(); s < shots.size(); ++s) {
-    if (analysis_generation_ != what.generation) return std::nullopt;
-    // A background analysis hands the kept work to a waiting capture's (it goes on from here).
-    if (background && urgent_requests_ > 0 && &caches == &coverage_caches_) return std::nullopt;
-    while (background && live_view_busy() && analysis_generation_ == what.generation) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    cache.run->add_shot(shots[s]);
-  }
-  return cache.run->result();
+  return live_view_.frame(*scene, studio, shot, scale, draft, error);
 }
 
 // What the analyses see now: the scene, its studio, the generation and the cache key.
-Session::Analysed Session::analysed() {
+AnalysedScene Session::analysed() {
   std::lock_guard lock(mutex_);
   std::string error;
-  const auto without_shots = replace_section(text_, "shots", "shots:\n", &error);
-  return {scene_, studio_, analysis_generation_, without_shots ? *without_shots : text_};
+  const std::string& text = document_.text();
+  const auto without_shots = replace_section(text, "shots", "shots:\n", &error);
+  return {scene_, studio_, analyses_.generation(), without_shots ? *without_shots : text};
 }
 
-// The coverage `rigc coverage` computes (its default options). A capture's (not `background`)
-// goes first: background analyses stop yielding to the live view while it waits.
 std::optional<nlohmann::json> Session::coverage(bool background) {
-  const Analysed what = analysed();
-  struct Urgent {
-    std::atomic<int>& count;
-    bool on;
-    ~Urgent() {
-      if (on) --count;
-    }
-  } urgent{urgent_requests_, !background};
-  if (!background) ++urgent_requests_;
-  const auto asked = Clock::now();
-  std::lock_guard coverage_lock(coverage_mutex_);
-  const auto start = Clock::now();
-  analysis::CoverageOptions options;
-  options.visibility_cache = visibility_cache_;
-  const auto result = analyse(coverage_caches_, what, options, background);
-  if (!result) return std::nullopt;
-  const double ms = ms_since(start);
-  nlohmann::json out = coverage_json(*what.scene, *result);
-  out["wait_ms"] = std::chrono::duration<double, std::milli>(start - asked).count();
-  out["analysis_ms"] = ms;
-  out["json_ms"] = ms_since(start) - ms;
-  return out;
+  return analyses_.coverage(analysed(), background);
 }
 
-nlohmann::json Session::coverage_json(const ir::Scene& scene,
-                                      const analysis::CoverageResult& coverage) const {
-  std::ostringstream table;
-  analysis::print_coverage_table(scene, coverage, table);
-  const analysis::ShotCoverage& last = coverage.shots.back();
-  return {{"views", coverage.views},
-          {"reconstructable_faces", coverage.reconstructable},
-          {"table", table.str()},
-          {"shots", coverage.shots.size()},
-          {"seen_1", last.seen_1},
-          {"seen_2", last.seen_2},
-          {"reconstructable", last.reconstructable},
-          {"new", last.new_area_m2 / coverage.total_area_m2},
-          {"overlap", last.overlap_with_previous}};
-}
-
-// The warnings `rigc check` prints, at the same reduced resolution.
 std::optional<nlohmann::json> Session::advice() {
-  const Analysed what = analysed();
-  std::shared_ptr<const ir::Scene> scene = what.scene;
-  std::lock_guard analysis_lock(analysis_mutex_);
-  const std::string text = text_snapshot(scene);
-  for (const auto& [given_for, given] : advice_given_) {
-    if (!text.empty() && given_for == text) return given;
-  }
-  DiagnosticEngine diag;
-  diag.add_source(file_.string(), text);
-  nlohmann::json out = nlohmann::json::array();
-  diag.set_handler([&](const Diagnostic& d, const std::string& rendered) {
-    out.push_back({{"line", d.loc.line},
-                   {"col", d.loc.col},
-                   {"severity", d.severity == Severity::kError ? "error" : "warning"},
-                   {"message", d.message},
-                   {"rendered", rendered}});
-  });
-  analysis::CoverageOptions options;
-  options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-  options.visibility_cache = visibility_cache_;
-  const auto coverage = analyse(advice_caches_, what, options, true);
-  if (!coverage) return std::nullopt;
-  analysis::report_capture_advice(*scene, *what.studio, *coverage, diag);
-  if (!text.empty()) {
-    advice_given_.emplace_front(text, out);
-    if (advice_given_.size() > kKeptAnalyses) advice_given_.pop_back();
-  }
-  return out;
+  const AnalysedScene what = analysed();
+  return analyses_.advice(
+      what, [&] { return text_snapshot(what.scene); }, document_.file());
 }
 
 std::string Session::text_snapshot(const std::shared_ptr<const ir::Scene>& scene) {
   std::lock_guard lock(mutex_);
-  return scene == scene_ ? text_ : std::string();
+  return scene == scene_ ? document_.text() : std::string();
 }
 
 // The object's mesh in the object frame, for the page's coverage view.
