@@ -12,6 +12,7 @@
 #include "dslr/exposure.h"
 #include "dslr/lens.h"
 #include "dslr/sensor.h"
+#include "dslr/stops.h"
 
 namespace rigc::analysis {
 namespace {
@@ -69,10 +70,7 @@ std::string stops_text(double stops) {
   return count + (thirds > 3 ? " stops" : " stop");
 }
 
-// The standard third-stop f-numbers, over the language's apertures.
-constexpr double kFNumberStops[] = {1.2, 1.4, 1.6, 1.8, 2,  2.2, 2.5, 2.8, 3.2, 3.5, 4,  4.5,
-                                    5,   5.6, 6.3, 7.1, 8,  9,   10,  11,  13,  14,  16, 18,
-                                    20,  22,  25,  29,  32, 36,  40,  45,  51,  57,  64};
+using dslr::kFNumberStops;
 static_assert(kFNumberStops[0] == limits::camera::kAperture.min &&
               kFNumberStops[std::size(kFNumberStops) - 1] == limits::camera::kAperture.max);
 

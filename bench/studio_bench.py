@@ -27,7 +27,7 @@ def percentile(values, p):
 
 
 def settle(driver):
-    wait_for(driver, 'return !frames.busy && !frames.wanted && !viewBusy', what='the page')
+    wait_for(driver, 'return !rigcStudio.frames.busy && !rigcStudio.frames.wanted && !rigcStudio.view.busy', what='the page')
     time.sleep(0.3)
 
 
@@ -37,9 +37,9 @@ def bench_slider(driver, changes):
         index = start + (1 if i % 2 == 0 else 0)
         driver.execute_script("const s = document.getElementById('iso'); s.value = arguments[0];"
                               "s.dispatchEvent(new Event('change'));", index)
-        wait_for(driver, f'return window.rigcBench.slider.length > {i}', what='a frame')
+        wait_for(driver, f"return performance.getEntriesByName('rigc:slider').length > {i}", what='a frame')
         settle(driver)
-    return driver.execute_script('return window.rigcBench.slider')
+    return driver.execute_script("return performance.getEntriesByName('rigc:slider').map((e) => e.duration)")
 
 
 def bench_capture(driver, captures):
@@ -47,11 +47,12 @@ def bench_capture(driver, captures):
         driver.execute_script("const s = document.getElementById('turntable');"
                               "s.value = Number(s.value) + 25; s.dispatchEvent(new Event('change'));")
         settle(driver)
-        driver.execute_script('capture()')
-        wait_for(driver, f'return window.rigcBench.capture.length > {i}', what='the coverage')
+        driver.execute_script("document.getElementById('capture').click()")
+        wait_for(driver, f"return performance.getEntriesByName('rigc:capture').length > {i}", what='the coverage')
         settle(driver)
-    return driver.execute_script('return window.rigcBench.capture'), \
-        driver.execute_script('return window.rigcBench.captureParts')
+    entries = "performance.getEntriesByName('rigc:capture')"
+    return driver.execute_script(f'return {entries}.map((e) => e.duration)'), \
+        driver.execute_script(f'return {entries}.map((e) => e.detail)')
 
 
 DRAG_JS = """
@@ -63,7 +64,8 @@ const ev = (type, x) => canvas.dispatchEvent(new PointerEvent(type, {clientX: x,
   pointerId: 1, bubbles: true}));
 canvas.setPointerCapture = () => {};
 ev('pointerdown', r.left + 400);
-const before = window.rigcBench.dragFrames.length;
+const drags = () => performance.getEntriesByName('rigc:drag');
+const before = drags().length;
 const t0 = performance.now();
 let x = 400;
 const timer = setInterval(() => {
@@ -71,9 +73,9 @@ const timer = setInterval(() => {
   ev('pointermove', r.left + x);
   if (performance.now() - t0 > seconds * 1000) {
     clearInterval(timer);
-    const frames = window.rigcBench.dragFrames.slice(before).filter((f) => f.at <= t0 + seconds * 1000);
+    const frames = drags().slice(before).filter((f) => f.startTime + f.duration <= t0 + seconds * 1000);
     ev('pointerup', r.left + x);
-    done({frames: frames.length, seconds: seconds, ms: frames.map((f) => f.ms)});
+    done({frames: frames.length, seconds: seconds, ms: frames.map((f) => f.duration)});
   }
 }, 16);
 """
@@ -98,7 +100,7 @@ def main():
     driver = browser(1600, 1000)
     try:
         driver.get(url)
-        wait_for(driver, 'return window.rigcFrame.count > 0 && window.rigcCoverage', timeout=300,
+        wait_for(driver, 'return rigcStudio.frame.count > 0 && rigcStudio.coverage', timeout=300,
                  what='the page')
         settle(driver)
         slider = bench_slider(driver, args.changes)

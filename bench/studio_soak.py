@@ -62,7 +62,7 @@ def rss_mb(pid):
 
 
 def settle(driver):
-    wait_for(driver, 'return !frames.busy && !frames.wanted && !viewBusy', timeout=120,
+    wait_for(driver, 'return !rigcStudio.frames.busy && !rigcStudio.frames.wanted && !rigcStudio.view.busy', timeout=120,
              what='the page')
 
 
@@ -79,7 +79,7 @@ def act(driver, rng, kinds):
     elif action == 'turn':
         driver.execute_script(SLIDE_JS, 'turntable', rng.choice([-40, -15, 15, 40]))
     elif action == 'capture':
-        driver.execute_script('capture()')
+        driver.execute_script("document.getElementById('capture').click()")
     else:
         driver.execute_script(f"document.getElementById('{action}').click()")
     settle(driver)
@@ -111,7 +111,7 @@ def main():
     failed = []
     try:
         driver.get(url)
-        wait_for(driver, 'return window.rigcFrame.count > 0', timeout=120, what='the first frame')
+        wait_for(driver, 'return rigcStudio.frame.count > 0', timeout=120, what='the first frame')
         driver.execute_script(COUNT_STATUSES_JS)
         start = time.time()
         end = start + 60 * args.minutes

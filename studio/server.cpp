@@ -202,7 +202,13 @@ void StudioServer::add_page_routes() {
     res.set_content(html, "text/html; charset=utf-8");
     res.set_header("Cache-Control", "no-store");
   });
-  serve("/studio.js", page::k_studio_js, kJavaScript);
+  for (const page::Module& module : page::kModules) {
+    server_->Get("/" + std::string(module.name),
+                 [text = module.text](const httplib::Request&, httplib::Response& res) {
+                   res.set_content(std::string(text), kJavaScript);
+                   res.set_header("Cache-Control", "no-store");
+                 });
+  }
   serve("/studio.css", page::k_studio_css, "text/css");
   auto three = [this](const char* route, std::string file) {
     server_->Get(route, [file](const httplib::Request&, httplib::Response& res) {

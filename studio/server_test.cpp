@@ -67,7 +67,7 @@ TEST_F(StudioApi, DraftFrameIsTheViewPointSampled) {
 // second to compress with Brotli, for a loopback that gains nothing from it.
 TEST_F(StudioApi, AnswersAreNotCompressed) {
   const httplib::Headers browser = {{"Accept-Encoding", "gzip, deflate, br"}};
-  for (const char* path : {"/api/mesh", "/api/coverage", "/studio.js"}) {
+  for (const char* path : {"/api/mesh", "/api/coverage", "/panels.js"}) {
     const auto res = client_->Get(path, browser);
     ASSERT_TRUE(res);
     ASSERT_EQ(res->status, 200) << path << ": " << res->body;
@@ -75,6 +75,32 @@ TEST_F(StudioApi, AnswersAreNotCompressed) {
     EXPECT_GT(res->body.size(), 1000u) << path;
   }
   EXPECT_TRUE(nlohmann::json::accept(client_->Get("/api/mesh", browser)->body));
+}
+
+// The page's import map names each module with the token; every one it names is served, and the
+// state carries the camera tables the sliders step through.
+TEST_F(StudioApi, EveryModuleThePageImportsIsServed) {
+  const auto page = client_->Get("/");
+  ASSERT_TRUE(page);
+  ASSERT_EQ(page->status, 200);
+  std::vector<std::string> modules;
+  for (std::size_t at = 0; (at = page->body.find("\"./", at)) != std::string::npos; ++at) {
+    const std::size_t end = page->body.find("?token=", at);
+    if (end != std::string::npos && page->body.compare(end - 3, 3, ".js") == 0) {
+      modules.push_back(page->body.substr(at + 2, end - at - 2));
+    }
+  }
+  EXPECT_GE(modules.size(), 8u);
+  for (const std::string& module : modules) {
+    const auto res = client_->Get(module);
+    ASSERT_TRUE(res) << module;
+    EXPECT_EQ(res->status, 200) << module;
+    EXPECT_THAT(res->get_header_value("Content-Type"), HasSubstr("javascript")) << module;
+  }
+  const nlohmann::json state = nlohmann::json::parse(client_->Get("/api/state")->body);
+  EXPECT_EQ(state["stops"]["apertures"].front(), 1.2);
+  EXPECT_EQ(state["stops"]["shutters"].back(), 1.0 / 8000);
+  EXPECT_EQ(state["stops"]["isos"].size(), 24u);
 }
 
 TEST_F(StudioApi, FrameIsAJpegOfTheRequestedWidthWithItsHistogram) {

@@ -12,6 +12,7 @@
 #include "compiler/presets.h"
 #include "compiler/scene_text.h"
 #include "dslr/lens.h"
+#include "dslr/stops.h"
 #include "plan/plan_scene.h"
 
 namespace rigc::studio {
@@ -352,6 +353,12 @@ nlohmann::json lights_json(const std::vector<ir::Light>& lights) {
   return out;
 }
 
+// A table of camera steps for the page's sliders.
+template <std::size_t N>
+nlohmann::json table(const double (&steps)[N]) {
+  return std::vector<double>(std::begin(steps), std::end(steps));
+}
+
 }  // namespace
 
 nlohmann::json Session::state() {
@@ -398,6 +405,10 @@ nlohmann::json Session::state() {
             {"ambient_lx", scene.studio.ambient_lx},
             {"lights", lights_json(scene.studio.lights)}}},
           {"bodies", bodies},
+          {"stops",
+           {{"apertures", table(dslr::kFNumberStops)},
+            {"shutters", table(dslr::kShutterStops)},
+            {"isos", table(dslr::kIsoStops)}}},
           {"lens", scene_lens_preset(text)},
           {"lenses", lenses}};
 }

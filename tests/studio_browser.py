@@ -51,7 +51,7 @@ for (let i = 0; i < d.length; i += 4) {
 return {mean: sum / n, sharpness: grad / n, red: red, green: green, white: white};
 """
 
-SHUTTER_INDEX_JS = "return SHUTTERS.findIndex((s) => Math.abs(s - arguments[0]) < 1e-9);"
+SHUTTER_INDEX_JS = "return rigcStudio.state.stops.shutters.findIndex((s) => Math.abs(s - arguments[0]) < 1e-9);"
 
 
 class Checks:
@@ -100,13 +100,13 @@ def wait_for(driver, script, timeout=60, what='the page'):
 
 
 def frames_shown(driver):
-    return driver.execute_script('return window.rigcFrame.count')
+    return driver.execute_script('return rigcStudio.frame.count')
 
 
 def wait_full_frame(driver, after_count):
     """Waits for a full-width frame newer than `after_count` and for the page to settle."""
-    wait_for(driver, f'return window.rigcFrame.count > {after_count} && '
-             'window.rigcFrame.width == 1280 && !frames.busy && !frames.wanted',
+    wait_for(driver, f'return rigcStudio.frame.count > {after_count} && '
+             'rigcStudio.frame.width == 1280 && !rigcStudio.frames.busy && !rigcStudio.frames.wanted',
              what='a full frame')
     time.sleep(0.2)
 
@@ -124,20 +124,20 @@ def stats(driver, canvas, box=(0, 0, 1, 1)):
 
 
 def check_exposure_and_depth_of_field(driver, checks):
-    shutter = driver.execute_script('return state.camera.shutter_s')
+    shutter = driver.execute_script('return rigcStudio.state.camera.shutter_s')
     index = driver.execute_script(SHUTTER_INDEX_JS, shutter)
     before = stats(driver, 'view')['mean']
     set_slider(driver, 'shutter', index - 3)  # three third-stops: one stop longer
     after = stats(driver, 'view')['mean']
     stops = math.log2(after / before)
-    new_shutter = driver.execute_script('return state.camera.shutter_s')
+    new_shutter = driver.execute_script('return rigcStudio.state.camera.shutter_s')
     checks.expect(abs(new_shutter / shutter - 2) < 0.15, f'shutter {shutter:.5f} s -> {new_shutter:.5f} s')
     checks.expect(0.75 <= stops <= 1.25, f'one stop longer brightens the frame by {stops:.2f} stops')
     set_slider(driver, 'shutter', index)
 
     # The backdrop behind the object is out of focus wide open; stopped down, its edge (the
     # floor line, in the lower part of the frame) sharpens.
-    apertures = driver.execute_script('return APERTURES')
+    apertures = driver.execute_script('return rigcStudio.state.stops.apertures')
     box = (0.0, 0.55, 1.0, 1.0)
     shutter_at = lambda s: driver.execute_script(SHUTTER_INDEX_JS, s)
     set_slider(driver, 'aperture', apertures.index(2.8))
@@ -159,9 +159,9 @@ def coverage_counts(driver):
 
 
 def capture(driver):
-    shots = driver.execute_script('return window.rigcCoverage.shots')
+    shots = driver.execute_script('return rigcStudio.coverage.shots')
     driver.find_element(By.TAG_NAME, 'body').send_keys(Keys.SPACE)
-    wait_for(driver, f'return window.rigcCoverage.shots == {shots + 1}', what='the coverage')
+    wait_for(driver, f'return rigcStudio.coverage.shots == {shots + 1}', what='the coverage')
     time.sleep(0.3)
 
 
@@ -183,7 +183,7 @@ def check_capture_and_coverage(driver, checks, rigc, scene, workdir):
     # Orbit by dragging the live view a little: the second view overlaps the first.
     view = driver.find_element(By.ID, 'view')
     ActionChains(driver).move_to_element(view).click_and_hold().move_by_offset(-60, 0).release().perform()
-    wait_for(driver, 'return !viewBusy && !frames.busy', what='the drag')
+    wait_for(driver, 'return !rigcStudio.view.busy && !rigcStudio.frames.busy', what='the drag')
     capture(driver)
     second = coverage_counts(driver)
     checks.expect(second['green'] > first['green'] + 200,
@@ -192,7 +192,7 @@ def check_capture_and_coverage(driver, checks, rigc, scene, workdir):
     wait_for(driver, 'return !state.unsaved', what='the save')
     out = os.path.join(workdir, 'coverage-out')
     run = subprocess.run([rigc, 'coverage', scene, '-o', out], capture_output=True, text=True)
-    table = driver.execute_script('return window.rigcCoverage.table').strip().splitlines()
+    table = driver.execute_script('return rigcStudio.coverage.table').strip().splitlines()
     printed = [line for line in run.stdout.splitlines() if line.split()[:1] in (['shot'], ) or
                re.match(r'shot_\d+ ', line)]
     checks.expect(run.returncode == 0 and table == printed,
@@ -266,7 +266,7 @@ def screenshots(rigc, scene, directory):
         driver = browser(width, height)
         try:
             driver.get(url)
-            wait_for(driver, 'return window.rigcFrame.count > 0 && window.rigcCoverage && '
+            wait_for(driver, 'return rigcStudio.frame.count > 0 && rigcStudio.coverage && '
                      "document.querySelectorAll('#advice li').length > 0", what='the page')
             time.sleep(1.0)
             path = os.path.join(directory, f'studio-{width}x{height}.png')
@@ -294,7 +294,7 @@ def main():
     driver = browser(1600, 1000)
     try:
         driver.get(url)
-        wait_for(driver, 'return window.rigcFrame.count > 0 && window.rigcCoverage', what='the page')
+        wait_for(driver, 'return rigcStudio.frame.count > 0 && rigcStudio.coverage', what='the page')
         wait_full_frame(driver, 0)
         check_exposure_and_depth_of_field(driver, checks)
         check_capture_and_coverage(driver, checks, args.rigc, args.scene, os.path.dirname(args.scene))
