@@ -189,7 +189,7 @@ def check_capture_and_coverage(driver, checks, rigc, scene, workdir):
     checks.expect(second['green'] > first['green'] + 200,
                   f"a second, overlapping capture turns faces green ({first['green']} -> {second['green']} green px)")
     driver.find_element(By.ID, 'save').click()
-    wait_for(driver, 'return !state.unsaved', what='the save')
+    wait_for(driver, 'return !rigcStudio.state.unsaved', what='the save')
     out = os.path.join(workdir, 'coverage-out')
     run = subprocess.run([rigc, 'coverage', scene, '-o', out], capture_output=True, text=True)
     table = driver.execute_script('return rigcStudio.coverage.table').strip().splitlines()
