@@ -141,7 +141,8 @@ void BM_SensorNoise(benchmark::State& state) {
     state.PauseTiming();
     std::copy(signal.begin(), signal.end(), work.begin());
     state.ResumeTiming();
-    rigc::dslr::apply_sensor(f.scene.camera, f.sensor.width, f.sensor.height, work, 7, ++shot);
+    rigc::dslr::apply_sensor(
+        f.scene.camera, rigc::dslr::view_of(work, f.sensor.width, f.sensor.height), {7, ++shot});
   }
 }
 
@@ -153,7 +154,8 @@ void BM_SensorAndEncodeBytes(benchmark::State& state) {
   int shot = 0;
   for (auto _ : state) {
     auto bytes = rigc::dslr::apply_sensor_and_encode_bytes(
-        f.scene.camera, f.sensor.width, f.sensor.height, signal, 7, ++shot, encoding);
+        f.scene.camera, rigc::dslr::view_of(signal, f.sensor.width, f.sensor.height), {7, ++shot},
+        encoding);
     benchmark::DoNotOptimize(bytes.data());
     rigc::dslr::recycle(std::move(bytes));
   }
@@ -191,7 +193,9 @@ void BM_WriteJpegAndMask(benchmark::State& state) {
     auto start = std::chrono::steady_clock::now();
     rigc::dslr::write_image(dir / "shot.jpg", result, f.scene.camera, nullptr);
     auto middle = std::chrono::steady_clock::now();
-    rigc::dslr::write_mask(dir / "mask.png", result.mask, result.width, result.height, nullptr);
+    rigc::dslr::write_mask(dir / "mask.png",
+                           rigc::dslr::view_of(result.mask, result.width, result.height, 1),
+                           nullptr);
     auto end = std::chrono::steady_clock::now();
     jpeg_ms += std::chrono::duration<double, std::milli>(middle - start).count();
     mask_ms += std::chrono::duration<double, std::milli>(end - middle).count();

@@ -148,19 +148,18 @@ bool write_image(const fs::path& path, const DevelopResult& result, const ir::Ca
   return write_pixels(path, spec, result.encoded.data(), error);
 }
 
-bool write_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int width, int height,
-                std::string* error) {
-  if (width <= 0 || height <= 0 || mask.size() != static_cast<std::size_t>(width) * height) {
+bool write_mask(const fs::path& path, ImageView<const std::uint8_t> mask, std::string* error) {
+  if (mask.empty() || mask.channels != 1) {
     set_error(error, "cannot write " + path.string() + ": the mask is empty or malformed");
     return false;
   }
   if (lowercase_extension(path) == ".png") {
     // Encoded by runs: much faster than zlib on a mask (see mask_png.h).
-    return write_file_atomically(path, encode_mask_png(mask.data(), width, height), error);
+    return write_file_atomically(path, encode_mask_png(mask), error);
   }
   // Any other format OpenImageIO writes (the backends name masks .png).
-  return write_pixels(path, OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::UINT8), mask.data(),
-                      error);
+  return write_pixels(path, OIIO::ImageSpec(mask.width, mask.height, 1, OIIO::TypeDesc::UINT8),
+                      mask.values, error);
 }
 
 }  // namespace rigc::dslr

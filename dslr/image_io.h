@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dslr/frame.h"
+#include "dslr/image_view.h"
 #include "ir/ir.h"
 
 namespace rigc::dslr {
@@ -39,7 +40,7 @@ bool write_image(const std::filesystem::path& path, const DevelopResult& result,
 
 // Writes an 8-bit single-channel mask (0/255) atomically: a PNG encoded by runs for a .png path
 // (encode_mask_png), otherwise the format OpenImageIO gives the extension.
-bool write_mask(const std::filesystem::path& path, const std::vector<std::uint8_t>& mask, int width,
-                int height, std::string* error);
+bool write_mask(const std::filesystem::path& path, ImageView<const std::uint8_t> mask,
+                std::string* error);
 
 }  // namespace rigc::dslr

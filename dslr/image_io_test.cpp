@@ -140,7 +140,7 @@ TEST(DslrWrite, MaskIsAnEightBitPng) {
   const DevelopResult image = small_image(camera);
   const std::string path = dir.file("shot_000.png");
   std::string error;
-  ASSERT_TRUE(write_mask(path, image.mask, image.width, image.height, &error)) << error;
+  ASSERT_TRUE(write_mask(path, view_of(image.mask, image.width, image.height, 1), &error)) << error;
   auto in = OIIO::ImageInput::open(path);
   ASSERT_TRUE(in);
   EXPECT_EQ(in->spec().nchannels, 1);
@@ -190,7 +190,8 @@ TEST(DslrWrite, UnwritablePlacesGiveAnErrorAndLeaveNothing) {
   EXPECT_FALSE(write_image(dir.path() / "taken.jpg", image, camera, &error));
   EXPECT_FALSE(error.empty());
   error.clear();
-  EXPECT_FALSE(write_mask(dir.path() / "taken.jpg", image.mask, image.width, image.height, &error));
+  EXPECT_FALSE(write_mask(dir.path() / "taken.jpg",
+                          view_of(image.mask, image.width, image.height, 1), &error));
   auto entries = folder_entries(dir.path());
   std::sort(entries.begin(), entries.end());
   EXPECT_EQ(entries, (std::vector<std::string>{"file", "taken.jpg"}));
@@ -251,7 +252,8 @@ TEST(DslrWrite, AWriteThatRunsOutOfSpaceFailsAndLeavesNothing) {
   std::string error;
   {
     const FileSizeLimit limit(20);
-    EXPECT_FALSE(write_mask(dir.file("mask.png"), image.mask, image.width, image.height, &error));
+    EXPECT_FALSE(write_mask(dir.file("mask.png"), view_of(image.mask, image.width, image.height, 1),
+                            &error));
   }
   EXPECT_THAT(error, HasSubstr("File too large"));
   EXPECT_TRUE(folder_entries(dir.path()).empty());

@@ -177,7 +177,9 @@ void put_chunk(std::string& out, const char type[4], const std::string& data) {
 
 }  // namespace
 
-std::string encode_mask_png(const std::uint8_t* pixels, int width, int height) {
+std::string encode_mask_png(ImageView<const std::uint8_t> mask) {
+  const std::uint8_t* pixels = mask.values;
+  const int width = mask.width, height = mask.height;
   std::string png("\x89PNG\r\n\x1a\n", 8);
   std::string header;
   put_u32_big_endian(header, static_cast<std::uint32_t>(width));

@@ -11,11 +11,12 @@
 #include <cstdint>
 #include <string>
 
+#include "dslr/image_view.h"
+
 namespace rigc::dslr {
 
-// The PNG file (signature, IHDR, one IDAT, IEND) of a width x height single-channel 8-bit image
-// stored row by row at `pixels`. Any byte values are allowed; runs of equal bytes pack best.
-// width and height must be positive.
-std::string encode_mask_png(const std::uint8_t* pixels, int width, int height);
+// The PNG file (signature, IHDR, one IDAT, IEND) of a single-channel 8-bit image. Any byte
+// values are allowed; runs of equal bytes pack best. The view must not be empty.
+std::string encode_mask_png(ImageView<const std::uint8_t> mask);
 
 }  // namespace rigc::dslr

@@ -61,7 +61,7 @@ std::vector<std::uint8_t> decoded_by_oiio(const std::string& png, int width, int
 }
 
 void expect_round_trip(const std::vector<std::uint8_t>& mask, int width, int height) {
-  const std::string png = encode_mask_png(mask.data(), width, height);
+  const std::string png = encode_mask_png(view_of(mask, width, height, 1));
   std::vector<std::uint8_t> filtered;
   for (int y = 0; y < height; ++y) {
     filtered.push_back(0);
@@ -124,7 +124,7 @@ TEST(MaskPng, AnObjectMaskPacksAboutAsTightAsZlib) {
       filtered.push_back(mask[static_cast<std::size_t>(y) * width + x]);
     }
   }
-  const std::string png = encode_mask_png(mask.data(), width, height);
+  const std::string png = encode_mask_png(view_of(mask, width, height, 1));
   std::vector<Bytef> packed(compressBound(filtered.size()));
   uLongf packed_size = packed.size();
   ASSERT_EQ(compress2(packed.data(), &packed_size, filtered.data(), filtered.size(), 1), Z_OK);

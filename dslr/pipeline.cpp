@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/develop.h"
@@ -104,17 +105,20 @@ DevelopResult develop(const ir::Camera& camera, const LinearFrame& frame, Linear
     const auto gains = white_balance_gains(camera, {}, {});
     result.white_balance_gains = gains;
     const SrgbEncoding encoding = srgb_encoding(gains, result.bits);
+    const ImageView<const float> signal =
+        view_of(std::as_const(image.rgb), sensor.width, sensor.height);
     if (result.bits == 8) {
-      result.encoded_bytes = apply_sensor_and_encode_bytes(
-          camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index, encoding);
+      result.encoded_bytes =
+          apply_sensor_and_encode_bytes(camera, signal, {shot.seed, shot.shot_index}, encoding);
     } else {
-      result.encoded = apply_sensor_and_encode(camera, sensor.width, sensor.height, image.rgb,
-                                               shot.seed, shot.shot_index, encoding);
+      result.encoded =
+          apply_sensor_and_encode(camera, signal, {shot.seed, shot.shot_index}, encoding);
     }
     recycle(std::move(image.rgb));
     result.timings.noise_ms = clock.lap_ms();
   } else {
-    apply_sensor(camera, sensor.width, sensor.height, image.rgb, shot.seed, shot.shot_index);
+    apply_sensor(camera, view_of(image.rgb, sensor.width, sensor.height),
+                 {shot.seed, shot.shot_index});
     result.timings.noise_ms = clock.lap_ms();
     const auto gains = white_balance_gains(camera, image.rgb, image.mask);
     result.white_balance_gains = gains;

@@ -277,9 +277,12 @@ void clipping_pass(std::size_t values, const float* signal, const Store& store) 
 // receives values [first, first + count) as the ADC leaves them, normalised (first is a multiple
 // of eight). The store may write over the signal it came from.
 template <typename Store>
-void sensor_pass(const ir::Camera& camera, int width, int height, const float* signal,
-                 std::uint64_t seed, int shot_index, const Store& store) {
-  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+void sensor_pass(const ir::Camera& camera, ImageView<const float> image, NoiseDraw draw,
+                 const Store& store) {
+  const float* signal = image.values;
+  const std::uint64_t seed = draw.seed;
+  const int shot_index = draw.shot_index;
+  const std::size_t pixels = image.pixels();
   const std::size_t values = 3 * pixels;
   if (!camera.effects.noise) {
     clipping_pass(values, signal, store);
@@ -368,10 +371,10 @@ void sensor_pass(const ir::Camera& camera, int width, int height, const float* s
 
 }  // namespace
 
-void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
-                  std::uint64_t seed, int shot_index) {
-  float* values = signal.data();
-  sensor_pass(camera, width, height, values, seed, shot_index,
+void apply_sensor(const ir::Camera& camera, ImageView<float> signal, NoiseDraw draw) {
+  if (signal.empty() || signal.channels != 3) return;
+  float* values = signal.values;
+  sensor_pass(camera, ImageView<const float>{values, signal.width, signal.height}, draw,
               [values](std::size_t first, std::size_t count, F32x8 out) {
                 if (count == kNoiseLanes) {
                   std::memcpy(values + first, &out, sizeof(out));
@@ -386,10 +389,9 @@ namespace {
 // apply_sensor_and_encode for codes of type Code (std::uint16_t, or std::uint8_t for 8-bit
 // tables).
 template <typename Code>
-std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int height,
-                                    const std::vector<float>& signal, std::uint64_t seed,
-                                    int shot_index, const SrgbEncoding& encode) {
-  if (signal.size() != 3 * static_cast<std::size_t>(width) * height) return {};
+std::vector<Code> sensor_and_encode(const ir::Camera& camera, ImageView<const float> signal,
+                                    NoiseDraw draw, const SrgbEncoding& encode) {
+  if (signal.empty() || signal.channels != 3) return {};
   // From the pool (a writer hands it back); every value is written.
   std::vector<Code> encoded;
   if constexpr (sizeof(Code) == 1) {
@@ -405,7 +407,7 @@ std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int hei
   }
   const std::uint16_t* table = encode.table;
   const float last = encode.last;
-  sensor_pass(camera, width, height, signal.data(), seed, shot_index,
+  sensor_pass(camera, signal, draw,
               [codes, table, last, gains](std::size_t first, std::size_t count, F32x8 out) {
                 // SrgbEncoding's arithmetic, eight values at once.
                 const F32x8 zero = {};
@@ -445,21 +447,19 @@ std::vector<Code> sensor_and_encode(const ir::Camera& camera, int width, int hei
 
 }  // namespace
 
-std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
-                                                   const std::vector<float>& signal,
-                                                   std::uint64_t seed, int shot_index,
+std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera,
+                                                   ImageView<const float> signal, NoiseDraw draw,
                                                    const SrgbEncoding& encode) {
-  return sensor_and_encode<std::uint16_t>(camera, width, height, signal, seed, shot_index, encode);
+  return sensor_and_encode<std::uint16_t>(camera, signal, draw, encode);
 }
 
-std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera, int width,
-                                                        int height,
-                                                        const std::vector<float>& signal,
-                                                        std::uint64_t seed, int shot_index,
+std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera,
+                                                        ImageView<const float> signal,
+                                                        NoiseDraw draw,
                                                         const SrgbEncoding& encode) {
   // Bytes hold 8-bit codes only: the 8-bit table's index runs to 2^16 - 1.
   if (encode.last != 65535.0f) return {};
-  return sensor_and_encode<std::uint8_t>(camera, width, height, signal, seed, shot_index, encode);
+  return sensor_and_encode<std::uint8_t>(camera, signal, draw, encode);
 }
 
 }  // namespace rigc::dslr

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "dslr/develop.h"
+#include "dslr/image_view.h"
 #include "ir/ir.h"
 
 namespace rigc::dslr {
@@ -28,31 +29,36 @@ std::uint64_t hash64(std::uint64_t seed, std::uint64_t stream, std::uint64_t ind
 // Standard normal from 16 bits (a table of the inverse CDF at bin centres, |z| <= 4.3).
 float normal_from_bits(std::uint32_t bits16);
 
+// Which draw of the sensor's noise: the camera's seed fixes its fixed-pattern noise (PRNU and
+// DSNU: the same camera gives the same pattern in every shot), the shot's index varies the
+// temporal noise.
+struct NoiseDraw {
+  std::uint64_t seed = 1;
+  int shot_index = 0;
+};
+
 // Applies the sensor to a normalised signal (3 per pixel, 1.0 = clipping at this ISO), in place:
 //   e = v·electrons_at_clipping; PRNU gain; + dark current·t; Poisson shot noise (exact below
 //   12 e⁻; above, one Gaussian for shot and read noise together, with the Poisson law's skew
 //   added by a Cornish-Fisher term); + Gaussian read noise; + DSNU offset; quantise to adc_bits
 //   with clipping at full scale; back to normalised. PRNU and DSNU are drawn once per camera
 //   seed and resolution and kept (one byte each per value).
-// Each colour channel is simulated as its own photosite (no Bayer mosaic). PRNU and DSNU depend
-// on `seed` only (the same camera gives the same pattern in every shot); the temporal noise also
-// on `shot_index`. With camera.effects.noise off the signal is only clipped to [0, 1].
-void apply_sensor(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
-                  std::uint64_t seed, int shot_index);
+// Each colour channel is simulated as its own photosite (no Bayer mosaic). With
+// camera.effects.noise off the signal is only clipped to [0, 1]. An empty view (view_of a vector
+// of the wrong size) is left alone.
+void apply_sensor(const ir::Camera& camera, ImageView<float> signal, NoiseDraw draw);
 
 // apply_sensor and then `encode` (white balance and sRGB, see encode_srgb) in one pass, for a
 // caller that keeps only the encoded image: the same codes, without writing the noisy signal
 // back. `signal` is left as it was.
-std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera, int width, int height,
-                                                   const std::vector<float>& signal,
-                                                   std::uint64_t seed, int shot_index,
+std::vector<std::uint16_t> apply_sensor_and_encode(const ir::Camera& camera,
+                                                   ImageView<const float> signal, NoiseDraw draw,
                                                    const SrgbEncoding& encode);
 // The same for an 8-bit encoding (srgb_encoding(gains, 8)): one byte per value. Both return
-// nothing when `signal` is not 3·width·height values, the bytes also for a 16-bit encoding.
-std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera, int width,
-                                                        int height,
-                                                        const std::vector<float>& signal,
-                                                        std::uint64_t seed, int shot_index,
-                                                        const SrgbEncoding& encode);
+// nothing for an empty view (view_of a vector of the wrong size), the bytes also for a 16-bit
+// encoding.
+std::vector<std::uint8_t> apply_sensor_and_encode_bytes(const ir::Camera& camera,
+                                                        ImageView<const float> signal,
+                                                        NoiseDraw draw, const SrgbEncoding& encode);
 
 }  // namespace rigc::dslr

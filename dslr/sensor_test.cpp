@@ -59,16 +59,16 @@ TEST(DslrNoise, SensorAndEncodingInOnePassGiveTheSameCodes) {
     for (const int bits : {8, 16}) {
       camera.effects.noise = noise;
       std::vector<float> two_stages = signal;
-      apply_sensor(camera, width, height, two_stages, 5, 3);
+      apply_sensor(camera, view_of(two_stages, width, height), {5, 3});
       const std::vector<std::uint16_t> expected = encode_srgb(two_stages, gains, bits);
       const std::vector<float> before = signal;
-      const std::vector<std::uint16_t> fused =
-          apply_sensor_and_encode(camera, width, height, signal, 5, 3, srgb_encoding(gains, bits));
+      const std::vector<std::uint16_t> fused = apply_sensor_and_encode(
+          camera, view_of(signal, width, height), {5, 3}, srgb_encoding(gains, bits));
       EXPECT_EQ(fused, expected) << "noise " << noise << ", " << bits << " bits";
       EXPECT_EQ(signal, before);
       if (bits == 8) {
         const std::vector<std::uint8_t> bytes = apply_sensor_and_encode_bytes(
-            camera, width, height, signal, 5, 3, srgb_encoding(gains, bits));
+            camera, view_of(signal, width, height), {5, 3}, srgb_encoding(gains, bits));
         EXPECT_EQ(std::vector<std::uint16_t>(bytes.begin(), bytes.end()), expected);
       }
     }

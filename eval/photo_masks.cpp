@@ -35,8 +35,8 @@ double coverage_of(const std::vector<std::uint8_t>& mask) {
 
 bool write_full_size_mask(const fs::path& path, const std::vector<std::uint8_t>& mask, int w, int h,
                           std::pair<int, int> full, std::string* error) {
-  return dslr::write_mask(path, scale_mask(mask, w, h, full.first, full.second), full.first,
-                          full.second, error);
+  const std::vector<std::uint8_t> scaled = scale_mask(mask, w, h, full.first, full.second);
+  return dslr::write_mask(path, dslr::view_of(scaled, full.first, full.second, 1), error);
 }
 
 // The still background of each working size that at least five photos share.
@@ -176,7 +176,8 @@ bool import_masks(const ImageSet& images, const PhotoMaskOptions& o, const fs::p
     const auto mask = read_mask_made_elsewhere(*file, size, error);
     if (!mask) return false;
     const fs::path path = dir / (fs::path(name).stem().string() + ".png");
-    if (!dslr::write_mask(path, *mask, size.first, size.second, error)) return false;
+    if (!dslr::write_mask(path, dslr::view_of(*mask, size.first, size.second, 1), error))
+      return false;
     by_photo[name] = {
         {"mask", path.string()}, {"from", file->string()}, {"coverage", coverage_of(*mask)}};
     ++found;

@@ -58,7 +58,8 @@ WriteOutcome write_shot_files(const ir::Scene& scene, const fs::path& run_dir,
   const auto start = Clock::now();
   WriteOutcome outcome;
   if (dslr::write_image(run_dir / image, result, scene.camera, &outcome.error) &&
-      !dslr::write_mask(run_dir / mask, result.mask, result.width, result.height, &outcome.error)) {
+      !dslr::write_mask(run_dir / mask, dslr::view_of(result.mask, result.width, result.height, 1),
+                        &outcome.error)) {
     // A shot has both files or neither: an image without its mask is in no manifest.
     std::error_code ec;
     fs::remove(run_dir / image, ec);

@@ -7,8 +7,11 @@
 
 namespace rigc::studio {
 
-std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int height, int quality,
-                        std::string* error) {
+std::string encode_jpeg(dslr::ImageView<const std::uint8_t> rgb, int quality, std::string* error) {
+  if (rgb.empty() || rgb.channels != 3) {
+    *error = "cannot encode the frame: it is empty or not RGB";
+    return {};
+  }
   std::vector<unsigned char> bytes;
   OIIO::Filesystem::IOVecOutput proxy(bytes);
   auto out = OIIO::ImageOutput::create("frame.jpg");
@@ -16,11 +19,11 @@ std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int hei
     *error = "OpenImageIO has no JPEG writer";
     return {};
   }
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  OIIO::ImageSpec spec(rgb.width, rgb.height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("Compression", "jpeg:" + std::to_string(std::clamp(quality, 1, 100)));
   void* proxy_pointer = &proxy;
   spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
-  if (!out->open("frame.jpg", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
+  if (!out->open("frame.jpg", spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.values) ||
       !out->close()) {
     *error = "cannot encode the frame: " + out->geterror();
     return {};
@@ -52,7 +55,7 @@ std::string jpeg_of_image_file(const std::string& path, int quality, int* width,
   if (channels == 1) {
     for (size_t i = 0; i < pixels; ++i) rgb[3 * i + 1] = rgb[3 * i + 2] = rgb[3 * i];
   }
-  return encode_jpeg(rgb, spec.width, spec.height, quality, error);
+  return encode_jpeg(dslr::view_of(rgb, spec.width, spec.height), quality, error);
 }
 
 Histogram histogram_of(const std::vector<std::uint8_t>& rgb) {

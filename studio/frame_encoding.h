@@ -5,12 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "dslr/image_view.h"
+
 namespace rigc::studio {
 
-// 8-bit RGB, `width` x `height`, as a baseline JPEG of `quality` (1..100); empty on failure with
+// 8-bit RGB as a baseline JPEG of `quality` (1..100); empty on failure (an empty view, too) with
 // `error` set.
-std::string encode_jpeg(const std::vector<std::uint8_t>& rgb, int width, int height, int quality,
-                        std::string* error);
+std::string encode_jpeg(dslr::ImageView<const std::uint8_t> rgb, int quality, std::string* error);
 
 // An image file (any format OpenImageIO reads) as a JPEG of `quality`, with its size; empty on
 // failure with `error` set.

@@ -1,6 +1,7 @@
 #include "studio/live_develop.h"
 
 #include <chrono>
+#include <utility>
 
 #include "dslr/buffer_pool.h"
 #include "dslr/depth_of_field.h"
@@ -35,18 +36,19 @@ bool same_lens(const ir::Camera& a, const ir::Camera& b) {
          ea.distortion == eb.distortion && ea.vignetting == eb.vignetting;
 }
 
-// The 8-bit codes of the exposed signal through the sensor and the white balance.
-void sense_and_encode(const ir::Camera& camera, int width, int height, std::vector<float>& signal,
-                      std::uint64_t seed, int shot_index, dslr::DevelopResult* result,
-                      const std::vector<std::uint8_t>& mask) {
+// The 8-bit codes of the exposed signal (result->width x result->height) through the sensor and
+// the white balance.
+void sense_and_encode(const ir::Camera& camera, std::vector<float>& signal, dslr::NoiseDraw draw,
+                      const std::vector<std::uint8_t>& mask, dslr::DevelopResult* result) {
+  const int width = result->width, height = result->height;
   if (camera.white_balance == ir::WhiteBalanceMode::kKelvin) {
     result->white_balance_gains = dslr::white_balance_gains(camera, {}, {});
-    result->encoded_bytes =
-        dslr::apply_sensor_and_encode_bytes(camera, width, height, signal, seed, shot_index,
-                                            dslr::srgb_encoding(result->white_balance_gains, 8));
+    result->encoded_bytes = dslr::apply_sensor_and_encode_bytes(
+        camera, dslr::view_of(std::as_const(signal), width, height), draw,
+        dslr::srgb_encoding(result->white_balance_gains, 8));
     return;
   }
-  dslr::apply_sensor(camera, width, height, signal, seed, shot_index);
+  dslr::apply_sensor(camera, dslr::view_of(signal, width, height), draw);
   result->white_balance_gains = dslr::white_balance_gains(camera, signal, mask);
   const std::vector<std::uint16_t> codes =
       dslr::encode_srgb(signal, result->white_balance_gains, 8);
@@ -135,8 +137,7 @@ dslr::DevelopResult LiveDevelop::develop(const ir::Camera& camera,
   result.width = image.intrinsics.width;
   result.height = image.intrinsics.height;
   result.bits = 8;
-  sense_and_encode(camera, result.width, result.height, signal, seed, shot.index, &result,
-                   image.mask);
+  sense_and_encode(camera, signal, {seed, shot.index}, image.mask, &result);
   dslr::recycle(std::move(signal));
   (*stage_ms)["noise"] = lap_ms(&last);
   return result;

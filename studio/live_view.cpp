@@ -115,7 +115,8 @@ std::optional<Frame> LiveView::frame(const ir::Scene& scene,
   frame.render_ms = ms_since(start);
   frame.stage_ms = std::move(stages);
   const auto encode_start = Clock::now();
-  frame.jpeg = encode_jpeg(developed.encoded_bytes, frame.width, frame.height, 90, error);
+  frame.jpeg =
+      encode_jpeg(dslr::view_of(developed.encoded_bytes, frame.width, frame.height), 90, error);
   if (frame.jpeg.empty()) return std::nullopt;
   frame.histogram = histogram_of(developed.encoded_bytes);
   frame.encode_ms = ms_since(encode_start);
