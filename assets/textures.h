@@ -15,6 +15,7 @@ inline constexpr std::uint64_t kMostTexturePixels = std::uint64_t{1} << 26;
 
 // Converts decoded pixels (8 or 16 bits per channel) to an 8-bit ir::Texture. `what` names the
 // image in a LoadError.
+// (Seven parameters: a decoder's output as the decoders hand it over.)
 ir::Texture make_texture(std::string source, int width, int height, int channels, int bits,
                          const std::vector<unsigned char>& data, const std::string& what);
 

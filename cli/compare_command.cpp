@@ -242,6 +242,7 @@ std::string picture_row(const std::string& title, const std::vector<std::string>
   return md;
 }
 
+// (Seven parameters: the parts of the report, each made by the caller.)
 std::string compare_markdown(const ir::Scene& scene, const std::string& scene_path, double scale,
                              const EvalOptions& base, const std::vector<Row>& rows,
                              const std::string& table, const fs::path& out) {

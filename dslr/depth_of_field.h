@@ -44,8 +44,12 @@ struct DepthOfFieldOptions {
 // Fills `ranges` (sized by resize_for) for the tiles inside [x0, x1) x [y0, y1) of a frame
 // `width` pixels wide: x0 and y0 multiples of TileRanges::kTile, x1 and y1 too or the frame's
 // edges.
+// (Eight parameters: a rectangle of a frame's two planes; the renderer calls it per strip.)
 void record_tile_ranges(const float* rgb, const float* depth_m, int width, int x0, int y0, int x1,
                         int y1, TileRanges& ranges);
+
+// The blurred canvas into `out`.
+// (Seven parameters, the last optional: the camera, the canvas and its planes.)
 void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
                           const Intrinsics& canvas, const std::vector<float>& rgb,
                           const std::vector<float>& depth_m, std::vector<float>& out,
@@ -53,6 +57,7 @@ void apply_depth_of_field(const ir::Camera& camera, double focus_distance_m,
 // The same result, written over `rgb`: tiles that stay sharp are not copied. `spare` (contents
 // unspecified; grown to about two thirds of `rgb` when it is smaller, never shrunk) holds the
 // half-size frames of the big discs and the strips' kept border rows meanwhile.
+// (Seven parameters, the last optional: the camera, the canvas and its planes.)
 void apply_depth_of_field_in_place(const ir::Camera& camera, double focus_distance_m,
                                    const Intrinsics& canvas, std::vector<float>& rgb,
                                    const std::vector<float>& depth_m, std::vector<float>& spare,

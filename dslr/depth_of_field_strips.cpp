@@ -150,6 +150,7 @@ void clear_planes(Planes& pl, std::size_t begin, std::size_t end) {
 // Also the taps from which no pixel is behind any of the group's (behind its nearest) and no disc
 // of a pixel in front of one of them (of its furthest) reaches: from there on the cheaper
 // arithmetic of one surface gives the same sums. Counts the groups that need fewer taps.
+// (Seven parameters: one group's place in the planes, inlined into the gather.)
 GroupTaps taps_for_group(const Planes& pl, const TapSet& set, int x, int y, int tap_count,
                          int extent, std::int64_t& groups_with_fewer_taps) {
   const std::size_t i = pl.index(x, y);

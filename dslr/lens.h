@@ -49,6 +49,8 @@ struct SensorImage {
 // `storage`, if given, is a spare buffer reused for the output colour (no fresh pages to fault in).
 // `signal_scale` multiplies the colour with the vignetting gain (the exposure, when the canvas
 // holds radiance).
+// (Eight parameters, two optional: the grids, the frame's three planes, a reused buffer and a
+// gain; a frame struct would be made only to be taken apart.)
 SensorImage warp_to_sensor(const ir::Camera& camera, const Intrinsics& sensor,
                            const Intrinsics& canvas, const std::vector<float>& rgb,
                            const std::vector<float>& depth_m, const std::vector<std::uint8_t>& mask,

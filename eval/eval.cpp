@@ -116,6 +116,7 @@ bool too_few_registered(const EvalOptions& o, const EvalInputs& in, std::size_t 
 
 // Photos without a ground-truth mesh: the registration (and the reference cameras) is the
 // result.
+// (Eight parameters: the evaluation's state at this point, as evaluate() holds it.)
 int finish_without_mesh(const EvalOptions& o, const EvalInputs& in, const ColmapRun& colmap,
                         EvalReport& report, EvalTimes& times, Clock::time_point t_start,
                         std::ostream& log, std::size_t registered) {

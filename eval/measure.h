@@ -30,6 +30,7 @@ struct Measurements {
 // `model`'s points: recall then measures the ground-truth samples against the mesh itself
 // (CloudCompare's cloud-to-mesh both ways). The recall reference is the ground-truth samples the
 // cameras see, or all of them when there is no camera.
+// (Eight parameters, the last optional: every input of the measurement, each used.)
 Measurements measure(const EvalOptions& options, const SparseModel& model, const GroundTruth& truth,
                      const Surface& surface, const Alignment& alignment,
                      const std::filesystem::path& out, nlohmann::json& report,

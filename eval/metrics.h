@@ -48,6 +48,7 @@ bool write_histogram_png(const std::filesystem::path& path, const std::vector<do
 
 // The coloured points splatted over the grey-shaded ground-truth surface, seen by `camera`
 // (scaled so the image is at most max_width wide).
+// (Eight parameters: the picture's inputs, each used once.)
 bool write_heatmap_png(const std::filesystem::path& path, const Surface& surface,
                        const ViewCamera& camera, const std::vector<Vec3>& points,
                        const std::vector<double>& d_mm, double range_mm, int max_width,

@@ -96,6 +96,7 @@ __attribute__((always_inline)) inline bool sample_light(const FrameLight& light,
 // A light of some size widens the lobe it is seen in: `spread2` is added to α² (a convolution of
 // two narrow lobes adds their variances), which lowers a glossy highlight's peak as integrating
 // over the light does.
+// (Seven parameters: one light's and pixel's dot products, inlined into the shading loop.)
 inline float ggx_specular(float n_dot_l, float n_dot_v, float n_dot_h, float v_dot_h,
                           float roughness, float f0, float spread2) {
   const float alpha = std::max(roughness * roughness, 0.002f);

@@ -35,6 +35,7 @@ struct CasterMesh {
 // One row of a coarser shadow-map level from two rows of the finer one, `finer_size` texels (an
 // odd last column alone): per texel, the nearest depth of its 2 x 2 and the fraction of them
 // that hold a caster. At level 0 (`top_held` and `bottom_held` null) a caster is a finite depth.
+// (Seven parameters: two rows in and one out, each plane on its own, in a loop over rows.)
 void halve_rows(const float* top, const float* bottom, const float* top_held,
                 const float* bottom_held, int finer_size, float* nearest, float* held) {
   const float inf = std::numeric_limits<float>::infinity();

@@ -73,6 +73,7 @@ Vector3f StudioPlanes::new_corner(PlaneCorners& cache, const ScreenTriangle& pla
   return color;
 }
 
+// (Eight parameters: a tile's rectangle and its plane, called per tile by the rasterizer.)
 void StudioPlanes::tile_corners_of(PlaneCorners& cache, const ScreenTriangle& plane,
                                    std::int32_t id, int x0, int y0, int x1, int columns,
                                    int rows) const {

@@ -40,17 +40,23 @@ struct ShotFiles {
   std::filesystem::path log;       // the external program's log for this shot; else empty
 };
 
+// The frame a live view wants: its size as a share of the sensor's, and whether a draft serves
+// (the frames while the camera or a slider moves may trade fidelity for speed).
+struct FrameWish {
+  double scale = 1;
+  bool draft = false;
+};
+
 // A live view's renderer: frame after frame of one scene while the camera or a setting moves.
 // It may keep what stays between frames (the preview keeps its shadow maps while the studio
 // object, the angle and the size stay); `studio` is held so that its address stays unique.
 class LiveRenderer {
  public:
   virtual ~LiveRenderer() = default;
-  // One frame at `scale` of the sensor. A `draft` may trade fidelity for speed (the frames while
-  // something moves). False with a one-line `error`.
+  // One frame of `shot` as `wish` says. False with a one-line `error`.
   virtual bool render(const ir::Scene& scene,
                       const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                      double scale, bool draft, RenderedShot* out, std::string* error) = 0;
+                      FrameWish wish, RenderedShot* out, std::string* error) = 0;
 };
 
 class Backend {
@@ -91,7 +97,8 @@ class Backend {
                        const RenderSettings& settings, const ShotFiles& files, std::string* error);
   // A renderer for a live view (the studio's), or null when the backend is too slow for one.
   virtual std::unique_ptr<LiveRenderer> live_renderer() const { return nullptr; }
-  // Renders one shot. False with a one-line `error`.
+  // Renders one shot. False with a one-line `error`. (Seven parameters: the shot's inputs, its
+  // files and its output; every backend's override has them.)
   virtual bool render(const ir::Scene& scene, const scene::StudioScene& studio,
                       const ir::Shot& shot, const RenderSettings& settings, const ShotFiles& files,
                       RenderedShot* out, std::string* error) = 0;

@@ -21,6 +21,7 @@ namespace rigc::run {
 // and fy differ by the rounding of the sensor's size in millimetres (0.14 % for the Canon 6D).
 std::string bundler_camera_problem(const ir::Camera& camera, double scale);
 
+// (Seven parameters: the two files it writes and what they describe.)
 bool write_bundler(const std::filesystem::path& out_path, const std::filesystem::path& list_path,
                    const ir::Scene& scene, const std::vector<int>& shots, double scale,
                    const GroundTruthPoints& points, std::string* error);

@@ -83,6 +83,7 @@ std::string object_geometry_hash(const ir::Scene& scene);
 // (object placement, materials, textures, studio, camera and this shot; not the other shots, the
 // scene name or source locations), `content_hash`, the backend, scale, seed, `extra` (backend
 // options) and the rigc version.
+// (Seven parameters: every input of the key, as the manifest names them.)
 std::string shot_key(const ir::Scene& scene, const std::string& content_hash, const ir::Shot& shot,
                      const std::string& backend, double scale, std::uint64_t seed,
                      const std::string& extra = "");

@@ -277,6 +277,7 @@ namespace {
 
 // bundle.out for a camera Bundler can describe; for another (fx != fy, a principal point off the
 // centre: a real camera's intrinsics) none, and an earlier one removed, rather than a wrong one.
+// (Seven parameters: write_bundler's, with the log.)
 bool write_bundler_if_it_fits(const fs::path& run_dir, const ir::Scene& scene,
                               const std::vector<int>& present, double scale,
                               const GroundTruthPoints& points, std::ostream& log,

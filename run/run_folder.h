@@ -73,6 +73,7 @@ std::string progress_line(int done, int total, const std::string& name, double s
 // points on the surface the shots see, run/ground_truth_points.h), transforms.json, bundle.out
 // with bundle.list.txt, and cameras.csv; then the closing line. Returns the run's exit code: 2 if
 // anything failed, else 0.
+// (Seven parameters: the run's summary as the run loop ends it.)
 int finish_run(const ir::Scene& scene, const Manifest& manifest,
                const std::filesystem::path& run_dir, double scale, int failures, size_t shots,
                std::ostream& log);

@@ -44,6 +44,8 @@ int run_backend(const ir::Scene& scene, Backend& backend, const RunOptions& opti
 // A rendered shot through the DSLR model, as the run loop develops it. `keep_linear` keeps the
 // linear image in the result (tests); a run writing files does without. Adds the model's stages
 // to `stage_ms` when given.
+// (Seven parameters, the last optional: the shot, its render and the settings it was made
+// with.)
 dslr::DevelopResult develop_shot(const ir::Scene& scene, const ir::Shot& shot,
                                  RenderedShot&& rendered, const RenderSettings& settings,
                                  bool keep_linear, std::string* error,

@@ -245,6 +245,7 @@ F32x8 max8(F32x8 a, F32x8 b) {
 }
 
 // Adds the dots of cells (x, y, z) [0, count) to the lanes of `lanes` that `active` selects.
+// (Nine parameters: one group of lanes' registers, inlined into the gather loop.)
 void gather_dots(const Footprints8& p, const FootprintShape& shape, simd::I32x8 active, F32x8 x,
                  F32x8 y, F32x8 z, int count, float seed_offset, LaneDots& lanes) {
   const F32x8 &dx_squared = shape.dx_squared, &dy_squared = shape.dy_squared, &reach = shape.reach;

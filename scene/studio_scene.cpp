@@ -258,6 +258,7 @@ struct PatternFade {
 };
 
 // pattern_factors with point i's footprint footprint_of(i).
+// (Seven parameters: points as planes x, y, z with their count, eight a step.)
 template <typename FootprintOf>
 void pattern_factors_with(const ir::SurfacePattern& pattern, const float* x, const float* y,
                           const float* z, int count, const FootprintOf& footprint_of, float* out) {

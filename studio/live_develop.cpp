@@ -103,9 +103,12 @@ bool LiveDevelop::develop_optics(const OpticsKey& key, std::string* error,
 
 dslr::DevelopResult LiveDevelop::develop(const ir::Camera& camera,
                                          std::shared_ptr<const run::RenderedShot> rendered,
-                                         const ir::Shot& shot, std::uint64_t seed, double scale,
-                                         bool* reused, std::string* error,
-                                         std::map<std::string, double>* stage_ms) {
+                                         const ir::Shot& shot, const run::RenderSettings& settings,
+                                         DevelopReport* report, std::string* error) {
+  const std::uint64_t seed = settings.seed;
+  const double scale = settings.scale;
+  std::map<std::string, double>* stage_ms = &report->stage_ms;
+  bool* reused = &report->reused_optics;
   *reused = false;
   if (!rendered->frame.rgb_clean) {
     // Radiance with negative or non-finite values: the full pipeline scales and cleans it first.

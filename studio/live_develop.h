@@ -17,14 +17,21 @@
 
 namespace rigc::studio {
 
+// How a live development went: whether the kept optics served, and each stage's time (added to
+// what is there).
+struct DevelopReport {
+  bool reused_optics = false;
+  std::map<std::string, double> stage_ms;
+};
+
 class LiveDevelop {
  public:
-  // 8-bit sRGB codes of `rendered` (the renderer's linear frame of `shot`) as the camera takes
-  // it; `reused` says whether the kept optics served. Stage times go to `stage_ms`.
+  // 8-bit sRGB codes of `rendered` (the renderer's linear frame of `shot` at settings.scale) as
+  // the camera takes it, with settings.seed's noise. Empty with `error` set on failure.
   dslr::DevelopResult develop(const ir::Camera& camera,
                               std::shared_ptr<const run::RenderedShot> rendered,
-                              const ir::Shot& shot, std::uint64_t seed, double scale, bool* reused,
-                              std::string* error, std::map<std::string, double>* stage_ms);
+                              const ir::Shot& shot, const run::RenderSettings& settings,
+                              DevelopReport* report, std::string* error);
 
  private:
   // What the optics read besides the frame: the lens, the aperture, the focus, the sensor grid.

@@ -46,17 +46,18 @@ TEST(StudioLiveDevelop, KeptOpticsGiveTheDslrModelsImageAfterExposureChanges) {
   auto rendered =
       std::make_shared<const run::RenderedShot>(preview::render_linear(scene, studio, shot, scale));
   LiveDevelop live;
+  run::RenderSettings settings;
+  settings.scale = scale;
   const double isos[] = {100, 400, 1600};
   for (int i = 0; i < 3; ++i) {
     scene.camera.iso = isos[i];
     scene.camera.shutter_s = i == 2 ? 1.0 / 500 : 1.0 / 125;
-    bool reused = false;
+    DevelopReport report;
     std::string error;
-    std::map<std::string, double> stages;
     const dslr::DevelopResult live_result =
-        live.develop(scene.camera, rendered, shot, 1, scale, &reused, &error, &stages);
+        live.develop(scene.camera, rendered, shot, settings, &report, &error);
     ASSERT_FALSE(live_result.encoded_bytes.empty()) << error;
-    EXPECT_EQ(reused, i > 0) << "the optics serve every exposure of one frame";
+    EXPECT_EQ(report.reused_optics, i > 0) << "the optics serve every exposure of one frame";
     // Float rounding of the exposure gain may move a code by one.
     EXPECT_LE(max_code_difference(live_result.encoded_bytes,
                                   reference_codes(scene, shot, *rendered, scale)),
@@ -65,12 +66,12 @@ TEST(StudioLiveDevelop, KeptOpticsGiveTheDslrModelsImageAfterExposureChanges) {
   }
   // The aperture changes the depth of field: the optics run again.
   scene.camera.aperture_f_number *= 2;
-  bool reused = true;
+  DevelopReport report;
+  report.reused_optics = true;
   std::string error;
-  std::map<std::string, double> stages;
   const dslr::DevelopResult stopped_down =
-      live.develop(scene.camera, rendered, shot, 1, scale, &reused, &error, &stages);
-  EXPECT_FALSE(reused);
+      live.develop(scene.camera, rendered, shot, settings, &report, &error);
+  EXPECT_FALSE(report.reused_optics);
   EXPECT_LE(max_code_difference(stopped_down.encoded_bytes,
                                 reference_codes(scene, shot, *rendered, scale)),
             1);

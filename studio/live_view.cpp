@@ -44,15 +44,14 @@ bool LiveView::RenderedView::same_view(const RenderedView& o) const {
 }
 
 // The renderer's linear frame of `shot`, or the one kept from an earlier frame that differs only
-// in what the DSLR model applies. The studio stays the same object as long as the object, the
-// materials, the studio and its lights do.
-bool LiveView::render_linear(const ir::Scene& scene,
-                             const std::shared_ptr<const scene::StudioScene>& studio,
-                             const ir::Shot& shot, double scale, bool draft,
-                             std::shared_ptr<const run::RenderedShot>* rendered, bool* reused,
-                             std::string* error) {
+// in what the DSLR model applies (`reused`). The studio stays the same object as long as the
+// object, the materials, the studio and its lights do. Null with `error` on failure.
+std::shared_ptr<const run::RenderedShot> LiveView::render_linear(
+    const ir::Scene& scene, const std::shared_ptr<const scene::StudioScene>& studio,
+    const ir::Shot& shot, run::FrameWish wish, bool* reused, std::string* error) {
+  const double scale = wish.scale;
   RenderedView view;
-  view.draft = draft;
+  view.draft = wish.draft;
   view.studio = studio;
   view.world_from_camera = shot.world_from_camera;
   view.turntable_angle_rad = shot.turntable_angle_rad;
@@ -63,22 +62,21 @@ bool LiveView::render_linear(const ir::Scene& scene,
   const auto hit = std::find_if(kept_.begin(), kept_.end(),
                                 [&](const RenderedView& k) { return k.same_view(view); });
   *reused = hit != kept_.end();
-  if (*reused) {
-    *rendered = hit->rendered;
-    return true;
-  }
+  if (*reused) return hit->rendered;
   auto fresh = std::make_shared<run::RenderedShot>();
-  if (!renderer_->render(scene, studio, shot, scale, draft, fresh.get(), error)) return false;
-  view.rendered = *rendered = std::move(fresh);
+  if (!renderer_->render(scene, studio, shot, wish, fresh.get(), error)) {
+    return nullptr;
+  }
+  view.rendered = std::move(fresh);
   kept_.push_front(std::move(view));
   // The live view's two sizes (moving and at rest) of the current view.
   if (kept_.size() > 2) kept_.pop_back();
-  return true;
+  return kept_.front().rendered;
 }
 
 std::optional<Frame> LiveView::frame(const ir::Scene& scene,
                                      const std::shared_ptr<const scene::StudioScene>& studio,
-                                     const ir::Shot& shot, double scale, bool draft,
+                                     const ir::Shot& shot, run::FrameWish wish,
                                      std::string* error) {
   ++frames_rendering_;
   struct Done {
@@ -92,20 +90,17 @@ std::optional<Frame> LiveView::frame(const ir::Scene& scene,
   std::lock_guard render_lock(render_mutex_);
   const auto start = Clock::now();
   run::RenderSettings settings;
-  settings.scale = scale;
+  settings.scale = wish.scale;
   if (!settings.check(error)) return std::nullopt;
-  std::shared_ptr<const run::RenderedShot> rendered;
   Frame frame;
-  if (!render_linear(scene, studio, shot, scale, draft, &rendered, &frame.reused_render, error)) {
-    return std::nullopt;
-  }
+  std::shared_ptr<const run::RenderedShot> rendered =
+      render_linear(scene, studio, shot, wish, &frame.reused_render, error);
+  if (!rendered) return std::nullopt;
   error->clear();
-  std::map<std::string, double> stages;
-  if (!frame.reused_render) stages = rendered->stage_ms;
-  bool reused_optics = false;
+  DevelopReport report;
+  if (!frame.reused_render) report.stage_ms = rendered->stage_ms;
   dslr::DevelopResult developed =
-      live_develop_.develop(scene.camera, std::move(rendered), shot, settings.seed, scale,
-                            &reused_optics, error, &stages);
+      live_develop_.develop(scene.camera, std::move(rendered), shot, settings, &report, error);
   if (developed.encoded_bytes.empty()) {
     if (error->empty()) *error = "the DSLR model produced no image";
     return std::nullopt;
@@ -113,7 +108,7 @@ std::optional<Frame> LiveView::frame(const ir::Scene& scene,
   frame.width = developed.width;
   frame.height = developed.height;
   frame.render_ms = ms_since(start);
-  frame.stage_ms = std::move(stages);
+  frame.stage_ms = std::move(report.stage_ms);
   const auto encode_start = Clock::now();
   frame.jpeg =
       encode_jpeg(dslr::view_of(developed.encoded_bytes, frame.width, frame.height), 90, error);

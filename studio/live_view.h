@@ -39,11 +39,10 @@ class LiveView {
   explicit LiveView(const std::string& backend = "preview");
   ~LiveView();
 
-  // `shot` of `scene` at `scale` of the sensor, developed and encoded as JPEG. A `draft` may
-  // trade fidelity for speed (the frames while the camera or a slider moves).
+  // `shot` of `scene` as `wish` says, developed and encoded as JPEG.
   std::optional<Frame> frame(const ir::Scene& scene,
                              const std::shared_ptr<const scene::StudioScene>& studio,
-                             const ir::Shot& shot, double scale, bool draft, std::string* error);
+                             const ir::Shot& shot, run::FrameWish wish, std::string* error);
 
   // Whether a frame is rendering or one ended less than `quiet` ago: while the user moves
   // something, background work waits.
@@ -61,10 +60,9 @@ class LiveView {
     std::shared_ptr<const run::RenderedShot> rendered;
     bool same_view(const RenderedView& other) const;
   };
-  bool render_linear(const ir::Scene& scene,
-                     const std::shared_ptr<const scene::StudioScene>& studio, const ir::Shot& shot,
-                     double scale, bool draft, std::shared_ptr<const run::RenderedShot>* rendered,
-                     bool* reused, std::string* error);
+  std::shared_ptr<const run::RenderedShot> render_linear(
+      const ir::Scene& scene, const std::shared_ptr<const scene::StudioScene>& studio,
+      const ir::Shot& shot, run::FrameWish wish, bool* reused, std::string* error);
 
   std::unique_ptr<run::LiveRenderer> renderer_;
   std::mutex render_mutex_;                      // one frame at a time

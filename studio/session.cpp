@@ -423,7 +423,7 @@ std::optional<Frame> Session::frame(double scale, bool draft, std::string* error
     shot = *view_shot_;
     studio = studio_;
   }
-  return live_view_.frame(*scene, studio, shot, scale, draft, error);
+  return live_view_.frame(*scene, studio, shot, {scale, draft}, error);
 }
 
 // What the analyses see now: the scene, its studio, the generation and the cache key.

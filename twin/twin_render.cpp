@@ -110,6 +110,7 @@ Brightness brightness(const std::vector<CapturedPhoto>& photos, const RenderedVi
 }
 
 // The photos' brightness over the twin's, on the object, in `probes` rendered with `lights`.
+// (Eight parameters: the twin being made and where its renders go, as twin.cpp holds them.)
 std::optional<double> photos_over_twin(const fs::path& scene_path, TwinScene& scene,
                                        const TwinLights& lights,
                                        const std::vector<CapturedPhoto>& photos,
@@ -138,6 +139,7 @@ std::optional<double> photos_over_twin(const fs::path& scene_path, TwinScene& sc
 // photos' shading is in the colours already, and a strong key would shade them twice (views
 // from its far side dark). The ambient and the key are measured alone, then together once more
 // (the development's tone curve is not linear).
+// (Seven parameters: the twin being made and where its renders go, as twin.cpp holds them.)
 int calibrate_lights(const fs::path& scene_path, TwinScene& scene,
                      const std::vector<CapturedPhoto>& photos, const fs::path& run, json& report,
                      std::ostream& log, std::string* error) {

@@ -32,6 +32,7 @@ std::optional<Silhouette> read_silhouette(const std::filesystem::path& path, std
 // OUT/render, rewriting the scene with its lights scaled to the photos' brightness; writes
 // OUT/contact_sheet.png and report["comparison"]. 0, or 2 with `error` (the scene did not
 // compile or a shot failed to render).
+// (Seven parameters: the twin being made and where its renders go, as twin.cpp holds them.)
 int render_and_compare(const std::filesystem::path& scene_path, TwinScene& scene,
                        const std::vector<CapturedPhoto>& photos, const std::filesystem::path& out,
                        nlohmann::json& report, std::ostream& log, std::string* error);

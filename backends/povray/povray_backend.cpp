@@ -438,6 +438,7 @@ std::string shot_pov(const ir::Scene& scene, const ir::Shot& shot, const dslr::I
   return text;
 }
 
+// (Seven parameters: the shot, its canvas and the switches of its INI file.)
 std::string shot_ini(const ir::Shot& shot, const dslr::Intrinsics& canvas, int subframes,
                      int samples, bool mask, bool focal_blur, bool albedo) {
   const std::string stem = shot.name;

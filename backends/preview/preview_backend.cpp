@@ -176,14 +176,14 @@ namespace {
 class PreviewLiveRenderer : public run::LiveRenderer {
  public:
   bool render(const ir::Scene& scene, const std::shared_ptr<const scene::StudioScene>& studio,
-              const ir::Shot& shot, double scale, bool draft, run::RenderedShot* out,
+              const ir::Shot& shot, run::FrameWish wish, run::RenderedShot* out,
               std::string* /*error*/) override {
     if (shadow_studio_ != studio || !shadow_cache_) {
       shadow_cache_ = std::make_unique<raster::ShadowMapCache>();
       shadow_studio_ = studio;
     }
-    *out =
-        render_linear(scene, *studio, shot, scale, shadow_cache_.get(), {.draft_surface = draft});
+    *out = render_linear(scene, *studio, shot, wish.scale, shadow_cache_.get(),
+                         {.draft_surface = wish.draft});
     return true;
   }
 

@@ -71,6 +71,7 @@ dslr::LinearFrame render_albedo(const ir::Scene& scene, const scene::StudioScene
 
 // Renders and develops one shot (no files), for tests and benchmarks. Without `keep_linear` the
 // result's linear image is left empty (what a run that writes files does).
+// (Eight parameters, the last three optional: tests and benchmarks name what they read.)
 dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene& studio,
                                 const ir::Shot& shot, double scale, std::uint64_t seed,
                                 run::ShotTiming* timing = nullptr,
