@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "dslr/buffer_pool.h"
+#include "dslr/image_view.h"
 #include "dslr/simd.h"
 
 // The 32-byte vectors are only passed between inlined functions, so GCC's note on their ABI
@@ -67,16 +68,17 @@ void with_common_tap_count(int taps, Fn&& fn) {
 // there. Bands are at least 2·radius tall: no row is near two borders.
 class GaussianBlur {
  public:
-  GaussianBlur(std::vector<float>& rgb, int width, int height, double sigma, int radius)
-      : rgb_(rgb),
-        w_(width),
-        h_(height),
+  // Over `rgb`, which must not be empty.
+  GaussianBlur(ImageView<float> rgb, double sigma, int radius)
+      : rgb_(rgb.values),
+        w_(rgb.width),
+        h_(rgb.height),
         radius_(radius),
         taps_(2 * radius + 1),
         kernel_(gaussian_kernel(sigma, radius)),
-        row_values_(3 * static_cast<std::size_t>(width)),
+        row_values_(3 * static_cast<std::size_t>(rgb.width)),
         band_rows_(std::max(96, 2 * radius)),
-        bands_((height + band_rows_ - 1) / band_rows_),
+        bands_((rgb.height + band_rows_ - 1) / band_rows_),
         borders_(bands_ - 1),
         border_span_(2 * radius),
         border_rows_(take_floats(static_cast<std::size_t>(borders_) * border_span_ * row_values_)) {
@@ -138,7 +140,7 @@ class GaussianBlur {
     }
   }
 
-  std::vector<float>& rgb_;
+  float* rgb_;
   const int w_, h_, radius_, taps_;
   const std::vector<float> kernel_;
   const std::size_t row_values_;
@@ -229,8 +231,9 @@ double apply_diffraction(const ir::Camera& camera, const Intrinsics& canvas,
   const double sigma =
       diffraction_sigma_m(camera.aperture_f_number) * canvas.fx / camera.focal_length_m;
   if (sigma < 0.2) return 0;
-  if (canvas.width <= 0 || canvas.height <= 0) return sigma;
-  GaussianBlur(rgb, canvas.width, canvas.height, sigma, diffraction_radius_px(sigma)).run();
+  const ImageView<float> image = view_of(rgb, canvas.width, canvas.height);
+  if (image.empty()) return sigma;
+  GaussianBlur(image, sigma, diffraction_radius_px(sigma)).run();
   return sigma;
 }
 
