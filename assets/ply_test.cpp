@@ -172,7 +172,7 @@ TEST(MeshIoWritePly, ReportsFailures) {
   const ir::Mesh mesh = make_primitive(PrimitiveKind::kBox, 1, 1);
   std::string error;
   EXPECT_FALSE(write_ply("/nonexistent-dir/x/box.ply", mesh, &error));
-  EXPECT_EQ(error.rfind("/nonexistent-dir/x/box.ply: ", 0), 0u) << error;
+  EXPECT_EQ(error.rfind("cannot write /nonexistent-dir/x/box.ply: ", 0), 0u) << error;
   ir::Mesh bad = mesh;
   bad.triangles.push_back({0, 1, 99});
   TempDir dir;
