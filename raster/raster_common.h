@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dslr/simd.h"
+#include "io/elapsed.h"
 
 namespace rigc::raster {
 
@@ -31,9 +32,7 @@ inline constexpr float kSampleY[kSamples] = {0.125f, 0.375f, 0.625f, 0.875f};
 inline constexpr float kNear = 0.01f;
 inline constexpr float kPi = std::numbers::pi_v<float>;
 
-inline double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using io::ms_since;
 
 // Eight floats or lane masks (a shadow map's texels, two pixels' samples), four (one pixel's
 // samples, or four pixel centres in a row).

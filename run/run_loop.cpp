@@ -17,6 +17,7 @@
 #include "dslr/buffer_pool.h"
 #include "dslr/image_io.h"
 #include "dslr/pipeline.h"
+#include "io/elapsed.h"
 #include "run/colmap_text.h"
 #include "run/manifest.h"
 #include "run/run_folder.h"
@@ -27,10 +28,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // The manifest is saved once this long has passed since the last save (and at the end): an
 // interrupted run resumes about where it stopped, and thousands of small shots do not rewrite
@@ -67,7 +64,7 @@ WriteOutcome write_shot_files(const ir::Scene& scene, const fs::path& run_dir,
   dslr::recycle(std::move(result.encoded));
   dslr::recycle(std::move(result.encoded_bytes));
   dslr::recycle(std::move(result.mask));
-  outcome.ms = ms_since(start);
+  outcome.ms = io::ms_since(start);
   return outcome;
 }
 
@@ -258,7 +255,7 @@ bool RunLoop::render_and_queue(const ir::Shot& shot, const std::string& key) {
     ok = !result.encoded.empty() || !result.encoded_bytes.empty();
     if (!ok && error.empty()) error = "the DSLR model produced no image";
   }
-  write.timing.total_ms = ms_since(start);
+  write.timing.total_ms = io::ms_since(start);
   finish_pending_write();
   if (manifest_failed_) return false;
   if (!ok) {
@@ -322,7 +319,7 @@ void RunLoop::record_shot(const PendingWrite& write) {
 }
 
 bool RunLoop::save_manifest(bool now) {
-  if (!unsaved_ || (!now && ms_since(last_save_) < kManifestSaveIntervalMs)) return true;
+  if (!unsaved_ || (!now && io::ms_since(last_save_) < kManifestSaveIntervalMs)) return true;
   // inputs.seed is every shot's seed, or null when `--shots` reran some with another.
   nlohmann::json inputs = manifest_.inputs();
   const bool one_seed =

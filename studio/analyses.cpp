@@ -8,15 +8,12 @@
 #include "analysis/advice.h"
 #include "analysis/coverage_output.h"
 #include "compiler/diagnostics.h"
+#include "io/elapsed.h"
 
 namespace rigc::studio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 bool same_shot(const ir::Shot& a, const ir::Shot& b) {
   return a.world_from_camera == b.world_from_camera &&
@@ -120,11 +117,11 @@ std::optional<nlohmann::json> Analyses::coverage(const AnalysedScene& what, bool
   options.visibility_cache = visibility_cache_;
   const auto result = analyse(coverage_kept_, what, options, background);
   if (!result) return std::nullopt;
-  const double ms = ms_since(start);
+  const double ms = io::ms_since(start);
   nlohmann::json out = coverage_json(*what.scene, *result);
   out["wait_ms"] = std::chrono::duration<double, std::milli>(start - asked).count();
   out["analysis_ms"] = ms;
-  out["json_ms"] = ms_since(start) - ms;
+  out["json_ms"] = io::ms_since(start) - ms;
   return out;
 }
 

@@ -4,16 +4,13 @@
 #include <stdexcept>
 
 #include "backends/registry.h"
+#include "io/elapsed.h"
 #include "scene/motion_blur.h"
 
 namespace rigc::studio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::unique_ptr<run::LiveRenderer> live_renderer_of(const std::string& name) {
   const backends::BackendEntry* entry = backends::find_backend(name);
@@ -107,14 +104,14 @@ std::optional<Frame> LiveView::frame(const ir::Scene& scene,
   }
   frame.width = developed.width;
   frame.height = developed.height;
-  frame.render_ms = ms_since(start);
+  frame.render_ms = io::ms_since(start);
   frame.stage_ms = std::move(report.stage_ms);
   const auto encode_start = Clock::now();
   frame.jpeg =
       encode_jpeg(dslr::view_of(developed.encoded_bytes, frame.width, frame.height), 90, error);
   if (frame.jpeg.empty()) return std::nullopt;
   frame.histogram = histogram_of(developed.encoded_bytes);
-  frame.encode_ms = ms_since(encode_start);
+  frame.encode_ms = io::ms_since(encode_start);
   return frame;
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dslr/lens.h"
+#include "io/elapsed.h"
 #include "raster/rasterizer.h"
 #include "raster/shadow_map_cache.h"
 #include "scene/motion_blur.h"
@@ -21,10 +22,6 @@ namespace rigc::preview {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Sub-frames spread evenly over the open shutter, centred on the shot's angle, averaged. Depth
 // and mask come from the middle one.
@@ -214,7 +211,7 @@ dslr::DevelopResult render_shot(const ir::Scene& scene, const scene::StudioScene
   shot_timing.subframes = rendered.subframes;
   dslr::DevelopResult result = run::develop_shot(scene, shot, std::move(rendered), settings,
                                                  keep_linear, nullptr, &shot_timing.stage_ms);
-  shot_timing.total_ms = ms_since(start);
+  shot_timing.total_ms = io::ms_since(start);
   if (timing) *timing = std::move(shot_timing);
   return result;
 }
