@@ -15,14 +15,10 @@ namespace rigc::sweep {
 namespace {
 
 using testing::read_text;
+using testing::silence_diagnostics;
 using testing::source_path;
 using testing::TempDir;
 using testing::write_text;
-
-// Keeps the diagnostics in the engine instead of printing them.
-void capture(DiagnosticEngine& diag) {
-  rigc::testing::silence_diagnostics(diag);
-}
 
 std::string all_diagnostics(DiagnosticEngine& diag) {
   std::string text;
@@ -59,7 +55,7 @@ TEST(SweepFile, ReadsAxesZipBackendScaleAndMeasures) {
 
 TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
   DiagnosticEngine diag;
-  capture(diag);
+  silence_diagnostics(diag);
   EXPECT_FALSE(parse_sweep_text(
       "rigc-sweep: 1\nscene: a.yaml\nvary:\n  camera.exposure.aperture: [f/4, f/4]\n"
       "  shots[0].turntable.steps: [12]\nzip: [\"shots[0].turntable.steps\", backend]"
@@ -72,7 +68,7 @@ TEST(SweepFile, ProblemsAreErrorsAtTheirLines) {
   EXPECT_THAT(text, HasSubstr("s.yaml:4:35: 'f/4' is given twice"));
   EXPECT_THAT(text, HasSubstr("zipped axes need as many values"));
   DiagnosticEngine other;
-  capture(other);
+  silence_diagnostics(other);
   EXPECT_FALSE(parse_sweep_text("rigc: 1\n", "s.yaml", other));
   EXPECT_THAT(all_diagnostics(other), HasSubstr("starts with `rigc-sweep: 1`"));
 }
@@ -84,7 +80,7 @@ TEST(SweepFile, ZippedAxesMayRepeatAValueButNotAConfiguration) {
       "  shots[0].turntable.steps: ";
   const std::string zip = "\nzip: [camera.exposure.aperture, \"shots[0].turntable.steps\"]\n";
   DiagnosticEngine diag;
-  capture(diag);
+  silence_diagnostics(diag);
   const auto spec = parse_sweep_text(head + "[18, 12, 36]" + zip, "s.yaml", diag);
   ASSERT_TRUE(spec) << all_diagnostics(diag);
   const auto variants = expand_variants(*spec);
@@ -92,7 +88,7 @@ TEST(SweepFile, ZippedAxesMayRepeatAValueButNotAConfiguration) {
   EXPECT_EQ(variants[2].name, "aperture-f-13_steps-36");
 
   DiagnosticEngine twice;
-  capture(twice);
+  silence_diagnostics(twice);
   EXPECT_FALSE(parse_sweep_text(head + "[18, 36, 36]" + zip, "s.yaml", twice));
   EXPECT_THAT(all_diagnostics(twice),
               HasSubstr("s.yaml:4:41: the zipped values (f/13, 36) are given twice"));
@@ -106,7 +102,7 @@ TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
       "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.aperture: [f/8]\n";
   auto key_with = [&](const std::string& samples_line) {
     DiagnosticEngine diag;
-    capture(diag);
+    silence_diagnostics(diag);
     const auto spec = parse_sweep_text(text + samples_line, "s.yaml", diag);
     EXPECT_TRUE(spec) << all_diagnostics(diag);
     std::vector<Variant> variants = expand_variants(*spec);
@@ -120,7 +116,7 @@ TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
 
   for (const std::string bad : {"samples: 0\n", "samples: 1.5\n", "samples: [16]\n"}) {
     DiagnosticEngine diag;
-    capture(diag);
+    silence_diagnostics(diag);
     EXPECT_FALSE(parse_sweep_text(text + bad, "s.yaml", diag));
     EXPECT_THAT(all_diagnostics(diag), HasSubstr("s.yaml:5:10: samples: must be a whole number"))
         << bad << all_diagnostics(diag);
@@ -134,7 +130,7 @@ TEST(SweepFile, SamplesThePreviewCannotTakeAreRefusedAtTheirLine) {
                            "\nvary:\n  camera.exposure.aperture: [f/8]\n";
   const auto diagnostics = [&](const std::string& rest) {
     DiagnosticEngine diag;
-    capture(diag);
+    silence_diagnostics(diag);
     const bool parsed = parse_sweep_text(head + rest, "s.yaml", diag).has_value();
     return std::make_pair(parsed, all_diagnostics(diag));
   };
@@ -163,7 +159,7 @@ TEST(SweepVariants, AVariantThatDoesNotCompileIsAnErrorAtItsValueAndTheScenesLin
   TempDir dir;
   const std::string scene = source_path("scenes/paper-turntable.yaml");
   DiagnosticEngine diag;
-  capture(diag);
+  silence_diagnostics(diag);
   const std::string sweep_text =
       "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.aperture: [f/8, f/0.5]\n";
   const auto spec = parse_sweep_text(sweep_text, dir.file("s.yaml"), diag);
@@ -181,7 +177,7 @@ TEST(SweepVariants, AVariantThatDoesNotCompileIsAnErrorAtItsValueAndTheScenesLin
 TEST(SweepVariants, AMissingPathIsAnErrorAtTheAxis) {
   const std::string scene = source_path("scenes/paper-turntable.yaml");
   DiagnosticEngine diag;
-  capture(diag);
+  silence_diagnostics(diag);
   const auto spec = parse_sweep_text(
       "rigc-sweep: 1\nscene: " + scene + "\nvary:\n  camera.exposure.isoo: [100]\n", "s.yaml",
       diag);
@@ -200,7 +196,7 @@ TEST(SweepVariants, AModelFileEditedInPlaceChangesTheVariantsKey) {
   scene_text.replace(scene_text.find(primitive), primitive.size(), "mesh: box.obj");
   write_text(dir.file("scene.yaml"), scene_text);
   DiagnosticEngine diag;
-  capture(diag);
+  silence_diagnostics(diag);
   const auto spec = parse_sweep_text(
       "rigc-sweep: 1\nscene: scene.yaml\nvary:\n  "
       "camera.exposure.aperture: [f/8, f/11]\n",
