@@ -59,4 +59,5 @@ ASAN_OPTIONS=abort_on_error=1 LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 RIGC_REQUIRE_TOOLS=1 \
   phase "sanitizer tests" ctest --test-dir build-fuzz --output-on-failure -j "$(nproc)" \
   -LE slow-external ${labels:+-L "$labels"}
-phase "fuzz run" bash scripts/fuzz.sh 5
+# Two harnesses at a time: each fuzzes on one core.
+RIGC_FUZZ_JOBS=${RIGC_FUZZ_JOBS:-2} phase "fuzz run" bash scripts/fuzz.sh 5
