@@ -105,44 +105,41 @@ dslr::DevelopResult LiveDevelop::develop(const ir::Camera& camera,
                                          std::shared_ptr<const run::RenderedShot> rendered,
                                          const ir::Shot& shot, const run::RenderSettings& settings,
                                          DevelopReport* report, std::string* error) {
-  const std::uint64_t seed = settings.seed;
-  const double scale = settings.scale;
-  std::map<std::string, double>* stage_ms = &report->stage_ms;
-  bool* reused = &report->reused_optics;
-  *reused = false;
+  report->reused_optics = false;
   if (!rendered->frame.rgb_clean) {
     // Radiance with negative or non-finite values: the full pipeline scales and cleans it first.
     dslr::ShotParams params;
     params.focus_distance_m = shot.focus_distance_m;
     params.shot_index = shot.index;
-    params.seed = seed;
+    params.seed = settings.seed;
     params.sensor_depth = false;
     params.keep_linear = false;
     ir::Camera live = camera;
     live.format = ir::ImageFormat::kJpeg;
     if (rendered->depth_of_field_rendered) live.effects.depth_of_field = false;
-    dslr::DevelopResult result = dslr::develop_frame(live, rendered->frame, params, scale, error);
+    dslr::DevelopResult result =
+        dslr::develop_frame(live, rendered->frame, params, settings.scale, error);
     if (result.encoded_bytes.empty()) {
       result.encoded_bytes.assign(result.encoded.begin(), result.encoded.end());
     }
     return result;
   }
-  OpticsKey key{std::move(rendered), camera, shot.focus_distance_m, scale};
-  *reused = kept_ && kept_->key.same_as(key);
-  if (!*reused && !develop_optics(key, error, stage_ms)) return {};
+  OpticsKey key{std::move(rendered), camera, shot.focus_distance_m, settings.scale};
+  report->reused_optics = kept_ && kept_->key.same_as(key);
+  if (!report->reused_optics && !develop_optics(key, error, &report->stage_ms)) return {};
   auto last = Clock::now();
   const dslr::SensorImage& image = kept_->image;
   std::vector<float> signal = dslr::take_floats(image.rgb.size());
   const float gain = static_cast<float>(dslr::exposure_scale(camera));
   for (size_t i = 0; i < signal.size(); ++i) signal[i] = image.rgb[i] * gain;
-  (*stage_ms)["exposure"] = lap_ms(&last);
+  report->stage_ms["exposure"] = lap_ms(&last);
   dslr::DevelopResult result;
   result.width = image.intrinsics.width;
   result.height = image.intrinsics.height;
   result.bits = 8;
-  sense_and_encode(camera, signal, {seed, shot.index}, image.mask, &result);
+  sense_and_encode(camera, signal, {settings.seed, shot.index}, image.mask, &result);
   dslr::recycle(std::move(signal));
-  (*stage_ms)["noise"] = lap_ms(&last);
+  report->stage_ms["noise"] = lap_ms(&last);
   return result;
 }
 
