@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace rigc::eval {
 
@@ -34,6 +35,12 @@ ir::Vec3 linear_pixel(const std::vector<std::uint8_t>& srgb, std::size_t i) {
 
 // Below this sum of linear R, G and B the chromaticity is mostly JPEG noise.
 constexpr double kDarkestKeyed = 0.01;
+
+// How far from the median backdrop at the borders a pixel seen through the object may be: a
+// stop (velvet's folds and the lens's flare lift it; a shaded face is further), plus the
+// sensor's noise floor in linear luminance.
+constexpr double kBackdropLevelStops = 1;
+constexpr double kBackdropNoise = 0.002;
 
 }  // namespace
 
@@ -207,6 +214,29 @@ std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop b
   return mask;
 }
 
+std::vector<std::uint8_t> at_backdrop_level(const KeyImage& image, BrightBackdrop backdrop) {
+  const int band = std::max(1, std::min(image.width, image.height) / 50);
+  std::vector<double> border;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (!(x < band || y < band || x >= image.width - band || y >= image.height - band)) continue;
+      border.push_back(luminance_of(image, static_cast<std::size_t>(y) * image.width + x));
+    }
+  }
+  std::vector<std::uint8_t> level(image.pixels(), 0);
+  if (border.empty()) return level;
+  const auto median = border.begin() + static_cast<std::ptrdiff_t>(border.size() / 2);
+  std::nth_element(border.begin(), median, border.end());
+  const bool dark = backdrop == BrightBackdrop::kDark;
+  const double stops = std::exp2(kBackdropLevelStops);
+  const double limit = dark ? *median * stops + kBackdropNoise : *median / stops;
+  for (std::size_t i = 0; i < image.pixels(); ++i) {
+    const double l = luminance_of(image, i);
+    level[i] = (dark ? l <= limit : l >= limit) ? 255 : 0;
+  }
+  return level;
+}
+
 std::vector<std::uint8_t> key_backdrop(const KeyImage& image, const Chroma& key, double tolerance) {
   std::vector<std::uint8_t> mask(image.pixels(), 255);
   for (std::size_t i = 0; i < image.pixels(); ++i) {
@@ -362,8 +392,9 @@ void keep_large_components(std::vector<std::uint8_t>& mask, int w, int h) {
   }
 }
 
-// Fills the background regions that do not reach the image's border.
-void fill_holes(std::vector<std::uint8_t>& mask, int w, int h) {
+// Fills the background regions that do not reach the image's border and are smaller than
+// `least_kept` pixels.
+void fill_holes(std::vector<std::uint8_t>& mask, int w, int h, double least_kept) {
   std::vector<int> labels;
   const auto sizes = label_regions(mask, w, h, 0, labels);
   std::vector<bool> reaches_border(sizes.size(), false);
@@ -378,8 +409,30 @@ void fill_holes(std::vector<std::uint8_t>& mask, int w, int h) {
     }
   }
   for (std::size_t i = 0; i < mask.size(); ++i) {
-    if (labels[i] && !reaches_border[labels[i] - 1]) mask[i] = 255;
+    const int l = labels[i];
+    if (!l || reaches_border[l - 1]) continue;
+    if (static_cast<double>(sizes[l - 1]) < least_kept) mask[i] = 255;
   }
+}
+
+// The share of the object's area from which a hole is the backdrop seen through the object
+// (between a temple's columns, through a handle), which a visual hull must carve and features
+// must avoid: keying noise, highlights and specks of the object's own colour are smaller.
+constexpr double kSeeThroughShare = 0.01;
+
+// Fills the holes in `mask` but for the gaps the backdrop shows through: first every hole pixel
+// `see_through` does not mark (when given), then the holes left smaller than kSeeThroughShare.
+void fill_all_but_see_through(std::vector<std::uint8_t>& mask, int w, int h,
+                              const std::vector<std::uint8_t>* see_through) {
+  const auto object = static_cast<double>(std::count(mask.begin(), mask.end(), 255));
+  if (see_through && see_through->size() == mask.size()) {
+    std::vector<std::uint8_t> filled = mask;
+    fill_holes(filled, w, h, std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+      if (filled[i] && !mask[i] && !(*see_through)[i]) mask[i] = 255;
+    }
+  }
+  fill_holes(mask, w, h, kSeeThroughShare * object);
 }
 
 }  // namespace
@@ -400,11 +453,12 @@ void drop_border_components(std::vector<std::uint8_t>& mask, int w, int h) {
 }
 
 std::vector<std::uint8_t> clean_object_mask(std::vector<std::uint8_t> mask, int w, int h,
-                                            int grow_px) {
+                                            int grow_px,
+                                            const std::vector<std::uint8_t>* see_through) {
   constexpr int kSpeck = 1;  // an opening of this radius removes noise and thin spill fringes
   mask = dilate(erode(mask, w, h, kSpeck), w, h, kSpeck);
   keep_large_components(mask, w, h);
-  fill_holes(mask, w, h);
+  fill_all_but_see_through(mask, w, h, see_through);
   return dilate(mask, w, h, grow_px);
 }
 

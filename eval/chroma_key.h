@@ -62,6 +62,11 @@ std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& ima
 // it is the backdrop's.
 std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop backdrop);
 
+// 255 where a pixel is as dark (kDark) or as bright (kBright) as the backdrop at the image's
+// borders: where a hole in the object's mask is the backdrop seen through it, and not a shaded
+// face that key_brightness's threshold, set towards the backdrop's side, also leaves out.
+std::vector<std::uint8_t> at_backdrop_level(const KeyImage& image, BrightBackdrop backdrop);
+
 // Removes the object pixels of the components that touch the image's border: with a brightness
 // key, the folds of the velvet at the frame's edge, not the object, which is in frame.
 void drop_border_components(std::vector<std::uint8_t>& mask, int width, int height);
@@ -83,10 +88,12 @@ std::optional<StillBackground> still_background(const std::vector<const KeyImage
 std::vector<std::uint8_t> key_still(const KeyImage& image, const StillBackground& still);
 
 // The object from a raw key: specks opened away, the components much smaller than the largest
-// dropped, holes filled, and the outline grown by `grow_px` so features on the silhouette keep
-// their support.
+// dropped, holes filled but for the backdrop seen through the object (a gap of at least a
+// hundredth of the object's area, of pixels that `see_through` marks 255 when it is given), and
+// the outline grown by `grow_px` so features on the silhouette keep their support.
 std::vector<std::uint8_t> clean_object_mask(std::vector<std::uint8_t> mask, int width, int height,
-                                            int grow_px);
+                                            int grow_px,
+                                            const std::vector<std::uint8_t>* see_through = nullptr);
 
 // `mask` (width x height) scaled to to_width x to_height, nearest neighbour.
 std::vector<std::uint8_t> scale_mask(const std::vector<std::uint8_t>& mask, int width, int height,

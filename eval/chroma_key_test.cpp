@@ -184,5 +184,37 @@ TEST(ChromaKey, BlackVelvetAndALightTentAreKeyedByBrightness) {
       << "a green screen is no brightness backdrop";
 }
 
+// A gap the velvet shows through stays out of the mask; a shaded pocket that a key left out
+// but that is brighter than the velvet is filled, and so is a speck of the velvet's darkness.
+TEST(ChromaKey, TheBackdropSeenThroughTheObjectStaysAHole) {
+  KeyImage im = velvet_picture(true);
+  const int w = im.width;
+  std::vector<std::uint8_t> mask(im.pixels(), 0);
+  auto set = [&](int x0, int y0, int x1, int y1, std::uint8_t v, std::uint8_t m) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        std::uint8_t* p = &im.srgb[3 * (static_cast<std::size_t>(y) * w + x)];
+        p[0] = p[1] = p[2] = v;
+        mask[static_cast<std::size_t>(y) * w + x] = m;
+      }
+    }
+  };
+  set(40, 20, 70, 60, 180, 255);  // the object, as a key found it
+  set(45, 25, 55, 33, 8, 0);      // the velvet through it: 80 pixels of the 1200
+  set(45, 45, 55, 53, 30, 0);     // a shaded pocket the key left out
+  set(62, 40, 64, 41, 8, 0);      // a speck
+  auto at_xy = [&](const std::vector<std::uint8_t>& m, int x, int y) {
+    return m[static_cast<std::size_t>(y) * w + x];
+  };
+  const auto see_through = at_backdrop_level(im, BrightBackdrop::kDark);
+  const auto clean = clean_object_mask(mask, w, im.height, 0, &see_through);
+  EXPECT_EQ(at_xy(clean, 50, 29), 0);
+  EXPECT_EQ(at_xy(clean, 50, 49), 255);
+  EXPECT_EQ(at_xy(clean, 62, 40), 255);
+  EXPECT_EQ(at_xy(clean, 42, 22), 255);
+  // Without the backdrop's level, every hole this large is the backdrop's.
+  EXPECT_EQ(at_xy(clean_object_mask(mask, w, im.height, 0), 50, 49), 0);
+}
+
 }  // namespace
 }  // namespace rigc::eval

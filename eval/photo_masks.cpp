@@ -63,7 +63,9 @@ std::vector<std::uint8_t> key_one(const KeyImage& picture, const std::optional<C
     entry["backdrop"] = *brightness == BrightBackdrop::kDark ? "dark" : "bright";
     std::vector<std::uint8_t> mask = key_brightness(picture, *brightness);
     drop_border_components(mask, picture.width, picture.height);
-    return clean_object_mask(std::move(mask), picture.width, picture.height, o.grow_px);
+    const std::vector<std::uint8_t> see_through = at_backdrop_level(picture, *brightness);
+    return clean_object_mask(std::move(mask), picture.width, picture.height, o.grow_px,
+                             &see_through);
   }
   const auto key = backdrop_at_borders(picture, hint, tolerance);
   if (!key && !still) return {};
