@@ -34,6 +34,8 @@ namespace {
 
 constexpr int kUserError = 1;
 constexpr int kToolError = 2;
+// Pixels the silhouettes are grown by before carving (twin/visual_hull.h).
+constexpr int kHullGrowPx = 1;
 
 bool check_options(const TwinOptions& o, std::string* error) {
   if (o.photos_dir.empty() || o.output_dir.empty()) {
@@ -291,9 +293,9 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   std::vector<SilhouetteView> views;
   for (const auto& p : *photos) views.push_back({p.camera, &p.silhouette});
   const auto region = hull_search_region(views, &error);
-  const auto hull = region
-                        ? carve_visual_hull(views, *region, {o.resolution, 3, o.max_misses}, &error)
-                        : std::nullopt;
+  const auto hull = region ? carve_visual_hull(views, *region,
+                                               {o.resolution, 3, o.max_misses, kHullGrowPx}, &error)
+                           : std::nullopt;
   if (!hull) return fail(log, kUserError, error);
 
   // The capture's frame to the object frame, the hull moved with it.

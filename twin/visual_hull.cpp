@@ -36,6 +36,27 @@ Silhouette blurred(const Silhouette& s, double sigma_px) {
   return b;
 }
 
+// `s` grown by `r` pixels: the largest coverage within r along each axis in turn.
+Silhouette grown(const Silhouette& s, int r) {
+  if (r <= 0) return s;
+  auto max_along = [&](const Silhouette& in, int dx, int dy) {
+    Silhouette out = in;
+    for (int y = 0; y < in.height; ++y) {
+      for (int x = 0; x < in.width; ++x) {
+        float m = 0;
+        for (int k = -r; k <= r; ++k) {
+          const int sx = std::clamp(x + k * dx, 0, in.width - 1);
+          const int sy = std::clamp(y + k * dy, 0, in.height - 1);
+          m = std::max(m, in.at(sx, sy));
+        }
+        out.coverage[static_cast<std::size_t>(y) * in.width + x] = m;
+      }
+    }
+    return out;
+  };
+  return max_along(max_along(s, 1, 0), 0, 1);
+}
+
 // Bilinear coverage at continuous pixel coordinates (COLMAP's: a pixel's centre at +0.5).
 float sample(const Silhouette& s, double u, double v) {
   const double x = u - 0.5, y = v - 0.5;
@@ -233,7 +254,8 @@ std::optional<VisualHull> carve_visual_hull(const std::vector<SilhouetteView>& v
     std::vector<Silhouette> out;
     for (const auto& view : views) {
       const double distance = (view.camera.center() - region.center()).norm();
-      out.push_back(blurred(*view.silhouette, 0.5 * voxel * view.camera.fx / distance));
+      out.push_back(blurred(grown(*view.silhouette, options.grow_px),
+                            0.5 * voxel * view.camera.fx / distance));
     }
     return out;
   };

@@ -36,6 +36,10 @@ struct HullOptions {
   // A point outside this many silhouettes is still kept: a key that cut a shaded part of the
   // object out of one photo would otherwise carve it from the hull in every view.
   int max_misses = 0;
+  // Pixels each silhouette is grown by before carving: the photos' keys put a shaded rim on
+  // either side of their thresholds, and a hull, the intersection of them all, comes out smaller
+  // than every one.
+  int grow_px = 0;
 };
 
 struct VisualHull {

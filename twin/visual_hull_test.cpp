@@ -91,6 +91,26 @@ TEST(VisualHull, ASphereIsCarvedToItsSilhouettes) {
   }
 }
 
+// Silhouettes grown by 3 pixels before carving grow the hull by about 3 pixels' width at the
+// sphere's distance: its mean radius, not more than half again.
+TEST(VisualHull, GrownSilhouettesCarveALargerHull) {
+  const Capture c = sphere_capture();
+  std::string error;
+  const auto region = hull_search_region(c.views(), &error);
+  ASSERT_TRUE(region) << error;
+  auto mean_radius = [&](int grow_px) {
+    const auto hull = carve_visual_hull(c.views(), *region, {64, 3, 0, grow_px}, &error);
+    EXPECT_TRUE(hull) << error;
+    double sum = 0;
+    for (const auto& p : hull->positions) sum += (p.cast<double>() - Vec3(0.02, -0.01, 0.1)).norm();
+    return sum / static_cast<double>(hull->positions.size());
+  };
+  const double pixel_m = (c.cameras[0].center() - Vec3(0.02, -0.01, 0.1)).norm() / c.cameras[0].fx;
+  const double growth = mean_radius(3) - mean_radius(0);
+  EXPECT_GT(growth, 2 * pixel_m);
+  EXPECT_LT(growth, 4.5 * pixel_m);
+}
+
 TEST(VisualHull, SilhouettesThatKeepEverythingFoundNoBackdrop) {
   Capture c = sphere_capture();
   for (auto& s : c.silhouettes) std::fill(s.coverage.begin(), s.coverage.end(), 1.0f);
