@@ -258,6 +258,29 @@ bool write_twin_mesh(const VisualHull& hull, const std::vector<Eigen::Vector3f>&
   return write_ply(path.string(), mesh, error);
 }
 
+std::vector<eval::ViewCamera> view_cameras_of(const std::vector<CapturedPhoto>& photos) {
+  std::vector<eval::ViewCamera> cameras;
+  for (const auto& p : photos) cameras.push_back(p.camera);
+  return cameras;
+}
+
+// How many times the hull's triangles are split for its colours: until a triangle's side is at
+// most 1.5 photo pixels on the object (the median photo's, at the hull's centre), at most
+// twice. Colours at the voxels' spacing blur the photos' fine texture, which SfM matches.
+int color_subdivisions(const VisualHull& hull, const std::vector<eval::ViewCamera>& cameras) {
+  constexpr int kMost = 2;
+  std::vector<double> pixel_m;
+  for (const auto& c : cameras) {
+    pixel_m.push_back((c.center() - hull.region.center()).norm() / c.fx);
+  }
+  if (pixel_m.empty()) return 0;
+  std::nth_element(pixel_m.begin(), pixel_m.begin() + pixel_m.size() / 2, pixel_m.end());
+  const double side_m = 1.5 * pixel_m[pixel_m.size() / 2];
+  int times = 0;
+  for (double edge = hull.voxel_m; edge > side_m && times < kMost; edge /= 2) ++times;
+  return times;
+}
+
 int fail(std::ostream& log, int code, const std::string& why) {
   log << "rigc twin: error: " << why << "\n";
   return code;
@@ -293,15 +316,16 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   std::vector<SilhouetteView> views;
   for (const auto& p : *photos) views.push_back({p.camera, &p.silhouette});
   const auto region = hull_search_region(views, &error);
-  const auto hull = region ? carve_visual_hull(views, *region,
-                                               {o.resolution, 3, o.max_misses, kHullGrowPx}, &error)
-                           : std::nullopt;
-  if (!hull) return fail(log, kUserError, error);
+  const auto carved =
+      region
+          ? carve_visual_hull(views, *region, {o.resolution, 3, o.max_misses, kHullGrowPx}, &error)
+          : std::nullopt;
+  if (!carved) return fail(log, kUserError, error);
+  const int subdivisions = color_subdivisions(*carved, view_cameras_of(*photos));
+  const std::optional<VisualHull> hull = subdivided(*carved, subdivisions);
 
   // The capture's frame to the object frame, the hull moved with it.
-  std::vector<eval::ViewCamera> view_cameras;
-  for (const auto& p : *photos) view_cameras.push_back(p.camera);
-  const Vec3 up = up_of_cameras(view_cameras, hull->region.center());
+  const Vec3 up = up_of_cameras(view_cameras_of(*photos), hull->region.center());
   eval::Similarity to_object = object_from_capture(up, hull->positions);
   VisualHull placed = *hull;
   for (auto& p : placed.positions) p = to_object.apply(p.cast<double>()).cast<float>();
@@ -332,10 +356,15 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   report["cameras"] = {{"source", o.reference_cameras.empty() ? "registration" : "reference"},
                        {"photos", cameras->size()},
                        {"with_silhouettes", photos->size()}};
-  report["hull"] = {{"vertices", placed.positions.size()}, {"triangles", placed.triangles.size()},
-                    {"voxel_mm", 1000 * placed.voxel_m},   {"resolution", o.resolution},
-                    {"filled_share", hull->filled_share},  {"size_m", vec_json(scene.object_size)},
-                    {"up_in_capture_frame", vec_json(up)}, {"scale", scale}};
+  report["hull"] = {{"vertices", placed.positions.size()},
+                    {"triangles", placed.triangles.size()},
+                    {"voxel_mm", 1000 * placed.voxel_m},
+                    {"resolution", o.resolution},
+                    {"filled_share", hull->filled_share},
+                    {"subdivisions", subdivisions},
+                    {"size_m", vec_json(scene.object_size)},
+                    {"up_in_capture_frame", vec_json(up)},
+                    {"scale", scale}};
   report["scene"] = scene_path.string();
   if (!o.quiet) {
     log << fmt::format(

@@ -329,4 +329,24 @@ double silhouette_iou(const Silhouette& a, const Silhouette& b) {
   return either ? static_cast<double>(both) / static_cast<double>(either) : 1.0;
 }
 
+VisualHull subdivided(const VisualHull& hull, int times) {
+  if (times <= 0) return hull;
+  open3d::geometry::TriangleMesh mesh;
+  for (const auto& p : hull.positions) mesh.vertices_.push_back(p.cast<double>());
+  for (const auto& t : hull.triangles) {
+    mesh.triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
+                                 static_cast<int>(t[2]));
+  }
+  const auto finer = mesh.SubdivideMidpoint(times);
+  VisualHull out = hull;
+  out.positions.clear();
+  out.triangles.clear();
+  for (const auto& v : finer->vertices_) out.positions.push_back(v.cast<float>());
+  for (const auto& t : finer->triangles_) {
+    out.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
+                             static_cast<std::uint32_t>(t.z())});
+  }
+  return out;
+}
+
 }  // namespace rigc::twin

@@ -64,6 +64,10 @@ std::optional<VisualHull> carve_visual_hull(const std::vector<SilhouetteView>& v
                                             const Eigen::AlignedBox3d& region,
                                             const HullOptions& options, std::string* error);
 
+// `hull` with every triangle split into four, `times` times over (Open3D's midpoint
+// subdivision): the same surface, with vertices closer together for the photos' colours.
+VisualHull subdivided(const VisualHull& hull, int times);
+
 // The silhouette `mesh` casts in `camera`: the share of each pixel covered, 0 or 1 at its centre.
 Silhouette render_silhouette(const eval::ViewCamera& camera, const VisualHull& hull);
 

@@ -85,8 +85,13 @@ TEST(VisualHull, ASphereIsCarvedToItsSilhouettes) {
     ASSERT_GT(r, 0.05 - hull->voxel_m);
     ASSERT_LT(r, 0.05 / std::cos(M_PI / 12) * 1.12);
   }
+  // Split for the colours: four triangles for one, the same silhouettes.
+  const VisualHull finer = subdivided(*hull, 1);
+  EXPECT_EQ(finer.triangles.size(), 4 * hull->triangles.size());
   for (std::size_t i = 0; i < c.cameras.size(); ++i) {
     EXPECT_GT(silhouette_iou(render_silhouette(c.cameras[i], *hull), c.silhouettes[i]), 0.95)
+        << "view " << i;
+    EXPECT_GT(silhouette_iou(render_silhouette(c.cameras[i], finer), c.silhouettes[i]), 0.95)
         << "view " << i;
   }
 }
