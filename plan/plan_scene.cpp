@@ -118,6 +118,17 @@ std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEn
     *error = fmt::format("{} compiled but does not check", request.scene_path);
     return nullptr;
   }
+  // The plan is written at the output path, so the scene's relative files must resolve from
+  // there: said before the minutes of analysis, not after.
+  DiagnosticEngine at_output;
+  at_output.set_handler([](const Diagnostic&, const std::string&) {});
+  if (!compile_scene_text(*text, request.output_path, folder_of(request.output_path), at_output)) {
+    *error = fmt::format(
+        "the scene would not compile at {}: {} (write the plan beside the scene, the default, "
+        "or give the scene's files absolute paths)",
+        request.output_path, first_error(at_output));
+    return nullptr;
+  }
   auto outcome = std::make_unique<PlanOutcome>();
   outcome->scene = std::move(*scene);
   const auto start = std::chrono::steady_clock::now();

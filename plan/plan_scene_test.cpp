@@ -170,6 +170,28 @@ std::string statue_scene() {
                          "{min_overlap: 0.6}");
 }
 
+// A plan written where the scene's relative mesh path does not resolve is refused before the
+// analysis, not after it.
+TEST(Plan, AnOutputWhereTheMeshDoesNotResolveIsRefusedFirst) {
+  TempDir dir;
+  write_text(dir.file("tetra.ply"),
+             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+             "end_header\n0 0 0\n0.1 0 0\n0 0.1 0\n0 0 0.1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n"
+             "3 1 2 3\n");
+  std::filesystem::create_directories(dir.path() / "elsewhere");
+  PlanRequest request;
+  request.scene_path = dir.file("scene.yaml");
+  request.output_path = dir.file("elsewhere/planned.yaml");
+  write_text(request.scene_path, primitive_scene("mesh: tetra.ply", "{min_overlap: 0.6}"));
+  DiagnosticEngine diag;
+  std::string error;
+  EXPECT_EQ(plan_scene(request, diag, &error), nullptr);
+  EXPECT_THAT(error, HasSubstr("would not compile at " + request.output_path));
+  EXPECT_THAT(error, HasSubstr("tetra.ply"));
+  EXPECT_THAT(error, HasSubstr("beside the scene"));
+}
+
 TEST(Plan, AnUnreachableTargetSaysWhatStaysUnseen) {
   TempDir dir;
   PlanRequest request;
