@@ -13,12 +13,18 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "eval/camera_files.h"
 #include "run/colmap_text.h"
+#include "studio/server.h"
+#include "studio/session.h"
 #include "tests/test_support.h"
 #include "twin/twin_render.h"
 #include "twin/visual_hull.h"
+
+// After Eigen: httplib brings in <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
 
 namespace rigc::twin {
 namespace {
@@ -100,6 +106,45 @@ void expect_a_scene_like_any_other(const fs::path& dir) {
   }
 }
 
+// What a user does with a twin: plan more shots, sweep an exposure, open it in the studio and
+// capture a view there.
+void expect_it_plans_sweeps_and_opens_in_the_studio(const fs::path& dir) {
+  const fs::path scene = dir / "scene.yaml";
+  const auto plan = run_rigc({"plan", scene.string(), "--rings", "20deg", "--azimuth-step", "90deg",
+                              "--visibility-scale", "0.05", "--target", "50%"});
+  EXPECT_EQ(plan.exit_code, 0) << plan.err;
+  const auto planned = run_rigc({"check", (dir / "scene-plan.yaml").string()});
+  EXPECT_EQ(planned.exit_code, 0) << planned.err;
+  const auto sweep =
+      run_rigc({"sweep", scene.string(), "--vary", "camera.exposure.aperture=f/4,f/16", "--scale",
+                "0.05", "-o", (dir / "sweep").string()});
+  EXPECT_EQ(sweep.exit_code, 0) << sweep.err;
+  EXPECT_THAT(sweep.out + sweep.err, HasSubstr("2/2 variants with results"));
+
+  std::string error;
+  auto session = studio::Session::open(scene, &error, dir / "studio");
+  ASSERT_TRUE(session) << error;
+  studio::StudioServer server(*session, {});
+  const int port = server.bind(&error);
+  ASSERT_GT(port, 0) << error;
+  std::thread serving([&] { server.run(); });
+  while (!server.is_running()) std::this_thread::yield();
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(120);
+  client.set_default_headers({{"X-Rigc-Token", server.token()}});
+  const auto frame = client.Get("/api/frame?width=320");
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->status, 200) << frame->body;
+  EXPECT_GT(std::stod(frame->get_header_value("X-Rigc-Mean")), 0.01) << "a black frame";
+  const auto capture = client.Post("/api/capture", "{}", "application/json");
+  ASSERT_TRUE(capture);
+  EXPECT_EQ(capture->status, 200) << capture->body;
+  const auto state = nlohmann::json::parse(client.Get("/api/state")->body);
+  EXPECT_EQ(state["shots"].get<int>(), 17);
+  server.stop();
+  serving.join();
+}
+
 // One test, so that one process makes the twin (ctest runs each test in its own): half a minute,
 // two and a half under the sanitizers.
 TEST(TwinTemple, TheTwinsSilhouettesAreThePhotosAndItIsASceneLikeAnyOther) {
@@ -108,8 +153,12 @@ TEST(TwinTemple, TheTwinsSilhouettesAreThePhotosAndItIsASceneLikeAnyOther) {
     SCOPED_TRACE("the silhouettes");
     expect_silhouettes_are_the_photos(dir);
   }
-  SCOPED_TRACE("a scene like any other");
-  expect_a_scene_like_any_other(dir);
+  {
+    SCOPED_TRACE("a scene like any other");
+    expect_a_scene_like_any_other(dir);
+  }
+  SCOPED_TRACE("planned, swept and in the studio");
+  expect_it_plans_sweeps_and_opens_in_the_studio(dir);
 }
 
 TEST(TwinCommand, BadInputsAreClearErrors) {
