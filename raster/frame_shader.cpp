@@ -204,7 +204,7 @@ Lighting FrameShader::lighting_at(const SurfacePoint& sp) const {
   Vector3f diffuse = Vector3f::Constant(ambient_lx_ / kPi);
   Vector3f specular_sum = Vector3f::Zero();
   const float n_dot_v = std::max(sp.n.dot(sp.v), 1e-3f);
-  const float f0 = 0.04f * (1 - metallic) + metallic;
+  const float f0 = 0.08f * material.specular * (1 - metallic) + metallic;
   for (size_t l = 0; l < lights_.size(); ++l) {
     LightSample sample;
     if (!sample_light(lights_[l], sp.p, &sample)) continue;

@@ -559,16 +559,18 @@ void add_object(const ir::Scene& scene, StudioScene& out) {
 // The studio in the world frame: the turntable on its stand (closed solids, first), the floor
 // and the green screen, with their materials.
 void add_studio(const ir::Studio& studio, StudioScene& out) {
-  auto add_material = [&](const ir::Vec3& color, float roughness) {
+  auto add_material = [&](const ir::Vec3& color, float roughness, float specular = 0.5f) {
     ShadedMaterial m;
     m.base_color = color.cast<float>();
     m.roughness = roughness;
+    m.specular = specular;
     out.materials.push_back(m);
     return static_cast<int>(out.materials.size()) - 1;
   };
   const int table_material = add_material(studio.turntable.color, 0.6f);
   out.materials[table_material].casts_shadow = true;
-  const int floor_material = add_material(studio.floor_color, 0.9f);
+  // The floor and the backdrop are matte cloth or paper.
+  const int floor_material = add_material(studio.floor_color, 0.9f, 0.0f);
   const float top = static_cast<float>(studio.turntable.height_m);
   const float radius = static_cast<float>(studio.turntable.diameter_m / 2);
   add_cylinder(out.studio, radius, top - static_cast<float>(studio.turntable.thickness_m), top,
@@ -579,7 +581,7 @@ void add_studio(const ir::Studio& studio, StudioScene& out) {
   out.closed_studio_triangles = static_cast<int>(out.studio.triangles.size());
   add_quad(out.studio, Vector3f(-6, -6, 0), Vector3f(12, 0, 0), Vector3f(0, 12, 0), floor_material);
   if (studio.backdrop.green_screen) {
-    const int backdrop_material = add_material(studio.backdrop.color, 0.95f);
+    const int backdrop_material = add_material(studio.backdrop.color, 0.95f, 0.0f);
     const Vector3f toward = studio.backdrop.direction.cast<float>().normalized();
     const Vector3f across = Vector3f::UnitZ().cross(toward).normalized();
     const float half_width = static_cast<float>(studio.backdrop.width_m / 2);

@@ -29,6 +29,10 @@ struct ShadedMaterial {
   int texture = -1;                              // index into StudioScene::textures
   float roughness = 0.7f;
   float metallic = 0.0f;
+  // The Principled BSDF's specular level: 0.5 is a dielectric's 4 % reflectance at normal
+  // incidence (F0 = 0.08 x specular); 0 is a cloth with no sheen, as a backdrop of velvet or
+  // muslin is, which reflects neither the lights nor the room.
+  float specular = 0.5f;
   ir::SurfacePattern pattern;
   bool casts_shadow = false;  // the object and the turntable; the room only receives
 };

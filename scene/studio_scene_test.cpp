@@ -194,6 +194,22 @@ TEST(Studio, PatternBoxFilterOfOneSampleIsThePointFaded) {
 // The rasterizer lets the triangles of one convex face cover a tile together (a tile with a
 // corner in none of them, or an edge crossing it, is rasterized per sample): each face must be
 // flat, and its triangles must tile a convex polygon, their areas summing to its hull's.
+// The floor and the backdrop are matte cloth: no specular layer to reflect the lights or, in
+// Cycles, the ambient room (a black backdrop rendered as a grey wall); the turntable keeps one.
+TEST(Studio, TheFloorAndBackdropAreMatteAndTheTurntableIsNot) {
+  const scene::StudioScene studio = scene::prepare_studio_scene(paper_scene());
+  const scene::Geometry& room = studio.studio;
+  ASSERT_GT(room.triangles.size(), static_cast<std::size_t>(studio.closed_studio_triangles));
+  for (std::size_t t = 0; t < room.triangles.size(); ++t) {
+    const float specular = studio.materials[room.triangle_material[t]].specular;
+    if (static_cast<int>(t) < studio.closed_studio_triangles) {
+      ASSERT_EQ(specular, 0.5f) << "turntable triangle " << t;
+    } else {
+      ASSERT_EQ(specular, 0.0f) << "floor or backdrop triangle " << t;
+    }
+  }
+}
+
 TEST(Studio, StudioConvexFacesAreFlatAndConvex) {
   const scene::StudioScene studio = scene::prepare_studio_scene(paper_scene());
   const scene::Geometry& room = studio.studio;

@@ -124,6 +124,7 @@ json material_json(const ir::Scene& scene, const scene::ShadedMaterial& material
                {"base_color", vec3(material.base_color.cast<double>())},
                {"roughness", material.roughness},
                {"metallic", material.metallic},
+               {"specular", material.specular},
                {"texture",
                 material.texture >= 0 ? json(texture_file_name(material.texture)) : json(nullptr)},
                {"pattern", nullptr},

@@ -224,10 +224,14 @@ std::string noise_functions_text() {
 // 1/(π α²), so specular = F0 / (4 α²).
 std::string finish_text(const scene::ShadedMaterial& material) {
   const double metallic = material.metallic;
-  const double f0 = 0.04 * (1 - metallic) + metallic;
+  const double f0 = 0.08 * material.specular * (1 - metallic) + metallic;
   const double alpha = std::max(static_cast<double>(material.roughness) * material.roughness, 0.05);
   const double exponent = std::max(2 / (alpha * alpha) - 2, 1.0);
   const double specular = f0 / (4 * alpha * alpha);
+  if (f0 == 0) {
+    return fmt::format("finish {{ ambient {0} diffuse {0} brilliance 1 }}",
+                       number_text(1 - metallic));
+  }
   return fmt::format("finish {{ ambient {} diffuse {} brilliance 1 specular {} roughness {}{} }}",
                      number_text(1 - metallic), number_text(1 - metallic), number_text(specular),
                      number_text(1 / exponent), metallic > 0.5 ? " metallic" : "");
