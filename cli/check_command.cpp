@@ -52,6 +52,9 @@ nlohmann::json diagnostics_json(const DiagnosticEngine& diag,
 
 int run_check_command(std::vector<std::string> args) {
   CLI::App app{"Check a scene: report every error and capture warning, like a compiler."};
+  app.footer(
+      "\nExample:\n  rigc check scenes/paper-turntable.yaml            # or --format json for "
+      "editors");
   std::string scene_path, format = "text";
   bool json = false;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
@@ -110,6 +113,7 @@ int run_check_command(std::vector<std::string> args) {
 
 int run_version_command(std::vector<std::string> args) {
   CLI::App app{"Print the version of rigc and of the scene language."};
+  app.footer("\nExample:\n  rigc version");
   if (auto code = parse_options(app, args)) return *code;
   std::cout << fmt::format("rigc {} (scene language 1, IR 1)\n", RIGC_VERSION);
   return kExitOk;

@@ -261,6 +261,10 @@ TEST(Cli, VersionAndHelp) {
   auto top = run_rigc({"--help"});
   EXPECT_EQ(top.exit_code, 0);
   EXPECT_THAT(top.out, HasSubstr("compile"));
+  // The verbs under their tasks, the capture's planning after the photos.
+  EXPECT_THAT(top.out, HasSubstr("plan the capture:\n  coverage"));
+  EXPECT_LT(top.out.find("see its photos:"), top.out.find("plan the capture:"));
+  EXPECT_THAT(top.out, HasSubstr("A start: rigc check"));
 }
 
 TEST(Cli, RenderCommandRejectsBadShotSelection) {

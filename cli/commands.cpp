@@ -53,6 +53,8 @@ int emit_scripts(const ir::Scene& scene, const std::string& target, const std::s
 
 int run_compile(std::vector<std::string> args) {
   CLI::App app{"Compile a scene for a target: the IR as JSON, or a backend's scripts."};
+  app.footer(
+      "\nExample:\n  rigc compile scenes/paper-turntable.yaml --target cycles -o out/paper-cycles");
   std::string scene_path, target = "ir", output;
   bool no_geometry = false;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();
@@ -103,6 +105,9 @@ int run_compile(std::vector<std::string> args) {
 
 int run_render(std::vector<std::string> args) {
   CLI::App app{"Render every shot of a scene with a backend, in RigC's output layout."};
+  app.footer(
+      "\nExample:\n  rigc render scenes/paper-turntable.yaml --backend preview --scale 0.25 "
+      "--shots 0-3");
   std::string scene_path, backend = "preview", output, shot_text = "all";
   double scale = 1.0;
   std::uint64_t seed = 1;
@@ -164,6 +169,7 @@ int run_render(std::vector<std::string> args) {
 
 int run_coverage(std::vector<std::string> args) {
   CLI::App app{"Which faces each shot sees, whether SfM can use them, and pictures of it."};
+  app.footer("\nExample:\n  rigc coverage scenes/paper-turntable.yaml");
   std::string scene_path, output;
   int picture_width = 960;
   double visibility_scale = 0;

@@ -278,6 +278,9 @@ int run_compare_command(std::vector<std::string> args) {
   CLI::App app{
       "Render a scene with several backends, evaluate each reconstruction against the scene's "
       "mesh, and print the paper's Table 1 extended (compare.md has the pictures)."};
+  app.footer(
+      "\nExample:\n  rigc compare scenes/paper-turntable.yaml --backends preview,cycles --scale "
+      "0.25");
   std::string scene_path, backends_text = "preview", output, photos;
   double scale = 0.25;
   EvalOptions base;

@@ -89,6 +89,8 @@ int run_eval_command(std::vector<std::string> args) {
       "Reconstruct a run's images with COLMAP (CPU) and measure the result against the ground "
       "truth: signed point-to-mesh distance (mm), F-score, camera errors; eval.json, a coloured "
       "PLY, a histogram and a heat map."};
+  app.footer(
+      "\nExample:\n  rigc eval out/paper-turntable/preview        # or --photos DIR --scene SCENE");
   EvalOptions o;
   app.add_option("run", o.run_dir, "run folder (images/, sparse/, manifest.json)");
   app.add_option("--photos", o.photos_dir,

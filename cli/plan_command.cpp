@@ -125,6 +125,7 @@ int run_plan_command(std::vector<std::string> args) {
   CLI::App app{
       "Plan the fewest shots that reach a share of reconstructable surface, and write "
       "the scene with them."};
+  app.footer("\nExample:\n  rigc plan scenes/paper-turntable.yaml --target 90%");
   plan::PlanRequest request;
   PlanArguments arguments;
   app.add_option("scene", request.scene_path, "scene file (.yaml)")->required();

@@ -32,6 +32,7 @@ int run_studio_command(std::vector<std::string> args) {
   CLI::App app{
       "Open the interactive capture studio in a browser: move the camera, change the "
       "settings, capture, watch the coverage, save back into the scene file."};
+  app.footer("\nExample:\n  rigc studio scenes/paper-turntable.yaml");
   std::string scene_path;
   studio::ServerOptions options;
   app.add_option("scene", scene_path, "scene file (.yaml)")->required();

@@ -164,6 +164,9 @@ int run_sweep_command(std::vector<std::string> args) {
   CLI::App app{
       "Compare capture configurations: run variants of a scene (a sweep file, or a "
       "scene with --vary) locally or on Slurm, and tabulate and plot their results."};
+  app.footer(
+      "\nExample:\n  rigc sweep scenes/paper-turntable.yaml --vary "
+      "camera.exposure.aperture=f/4,f/16");
   SweepArguments a;
   add_sweep_options(app, a);
   if (auto code = parse_options(app, args)) return *code;
