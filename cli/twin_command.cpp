@@ -16,9 +16,6 @@ int run_twin_command(std::vector<std::string> args) {
       "a visual hull coloured from the photos, and a scene whose shots are the real cameras "
       "(docs/twin.md).\n\nExample:\n  rigc twin tests/real/templeSparseRing --reference-cameras "
       "tests/real/templeSparseRing/templeSR_par.txt -o out/temple-twin"};
-  app.footer(
-      "\nExample:\n  rigc twin PHOTOS --reference-cameras CAMERAS.txt -o twin   # or "
-      "--object-height 20cm");
   twin::TwinOptions o;
   std::string height;
   app.add_option("photos", o.photos_dir, "the folder of photos")->required();
