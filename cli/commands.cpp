@@ -223,6 +223,7 @@ const std::vector<Command>& commands() {
       {"studio", run_studio_command},
       {"sweep", run_sweep_command},
       {"twin", run_twin_command},
+      {"new", run_new_command},
       {"version", run_version_command},
   });
   return table;

@@ -12,6 +12,7 @@ const std::vector<VerbSummary>& verb_summaries() {
   static const std::string kReal = "real captures";
   static const std::string kOther = "other";
   static const std::vector<VerbSummary> verbs = {
+      {"new", "write a commented starting scene for a model file, its shots planned", kScene},
       {"check", "check a scene and report errors and capture warnings", kScene},
       {"compile", "compile a scene to the IR or to a backend's scripts", kScene},
       {"render", "render every shot with a backend (rigc render --help lists them)", kPhotos},

@@ -18,6 +18,7 @@ int run_plan_command(std::vector<std::string> args);
 int run_studio_command(std::vector<std::string> args);
 int run_sweep_command(std::vector<std::string> args);
 int run_twin_command(std::vector<std::string> args);
+int run_new_command(std::vector<std::string> args);
 
 // The reconstruction options `eval` and `compare` share.
 void add_eval_options(CLI::App& app, eval::EvalOptions& options);
