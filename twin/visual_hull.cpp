@@ -146,6 +146,17 @@ double kept_share(const Grid& g) {
   return static_cast<double>(kept) / static_cast<double>(g.field.size());
 }
 
+// `mesh`'s vertices and triangles as `hull`'s.
+void take_mesh(const open3d::geometry::TriangleMesh& mesh, VisualHull& hull) {
+  hull.positions.clear();
+  hull.triangles.clear();
+  for (const auto& v : mesh.vertices_) hull.positions.push_back(v.cast<float>());
+  for (const auto& t : mesh.triangles_) {
+    hull.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
+                              static_cast<std::uint32_t>(t.z())});
+  }
+}
+
 // Open3D's marching cubes over the field (negative inside, as a TSDF is behind a surface).
 void mesh_grid(const Grid& g, VisualHull& hull) {
   open3d::pipelines::integration::UniformTSDFVolume volume(
@@ -159,13 +170,7 @@ void mesh_grid(const Grid& g, VisualHull& hull) {
   const auto mesh = volume.ExtractTriangleMesh();
   mesh->RemoveDuplicatedVertices();
   mesh->RemoveDegenerateTriangles();
-  hull.positions.clear();
-  hull.triangles.clear();
-  for (const auto& v : mesh->vertices_) hull.positions.push_back(v.cast<float>());
-  for (const auto& t : mesh->triangles_) {
-    hull.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
-                              static_cast<std::uint32_t>(t.z())});
-  }
+  take_mesh(*mesh, hull);
 }
 
 // A closed mesh's signed volume: positive when its triangles wind counter-clockwise outside.
@@ -337,15 +342,8 @@ VisualHull subdivided(const VisualHull& hull, int times) {
     mesh.triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
                                  static_cast<int>(t[2]));
   }
-  const auto finer = mesh.SubdivideMidpoint(times);
   VisualHull out = hull;
-  out.positions.clear();
-  out.triangles.clear();
-  for (const auto& v : finer->vertices_) out.positions.push_back(v.cast<float>());
-  for (const auto& t : finer->triangles_) {
-    out.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
-                             static_cast<std::uint32_t>(t.z())});
-  }
+  take_mesh(*mesh.SubdivideMidpoint(times), out);
   return out;
 }
 
