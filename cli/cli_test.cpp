@@ -267,6 +267,24 @@ TEST(Cli, VersionAndHelp) {
   EXPECT_THAT(top.out, HasSubstr("A start: rigc check"));
 }
 
+// scripts/completion.sh writes bash completion from rigc's help: verbs, a verb's options and
+// the values an option lists.
+TEST(Cli, BashCompletionIsMadeFromTheHelp) {
+  testing::TempDir dir;
+  const auto made =
+      testing::run_process({"bash", source_path("scripts/completion.sh"), RIGC_BINARY});
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  testing::write_text(dir.file("rigc.bash"), made.out);
+  const std::string script =
+      "source " + dir.file("rigc.bash") +
+      "; complete_of() { COMP_WORDS=(\"$@\"); COMP_CWORD=$(($# - 1)); _rigc; "
+      "echo \"${COMPREPLY[*]}\"; }; complete_of rigc pl; complete_of rigc render --ba; "
+      "complete_of rigc render --backend c; complete_of rigc new --hei";
+  const auto completed = testing::run_process({"bash", "-c", script});
+  ASSERT_EQ(completed.exit_code, 0) << completed.err;
+  EXPECT_EQ(completed.out, "plan\n--backend\ncycles\n--height\n");
+}
+
 TEST(Cli, RenderCommandRejectsBadShotSelection) {
   auto result = ::rigc::testing::run_rigc(
       {"render", ::rigc::testing::source_path("scenes/paper-turntable.yaml"), "--shots", "3,40",
