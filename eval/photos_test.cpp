@@ -2,7 +2,6 @@
 // Cycles, its images copied as a photographer's card would hold them (no sparse/, masks/ or
 // manifest), and evaluated like the run folder they came from, or keyed into masks as eval keys
 // photos. SLOW and EXTERNAL (COLMAP, Blender).
-#include <OpenImageIO/imagebuf.h>
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -18,6 +17,7 @@
 
 #include "eval/inputs.h"
 #include "eval/photo_masks.h"
+#include "eval/silhouette.h"
 #include "tests/test_support.h"
 
 using ::testing::HasSubstr;
@@ -142,25 +142,6 @@ TEST(EvalEndToEnd, SlowPaperScenePhotosRegisterLikeTheRunFolder) {
   expect_photos_register_like_the_run_folder({"--backend", "preview", "--scale", "0.15"});
 }
 
-// Intersection over union of two masks of one size (255 = object); -1 when either cannot be read
-// or their sizes differ.
-double mask_iou(const fs::path& a, const fs::path& b) {
-  OIIO::ImageBuf ma(a.string()), mb(b.string());
-  if (!ma.read(0, 0, true, OIIO::TypeDesc::UINT8) || !mb.read(0, 0, true, OIIO::TypeDesc::UINT8))
-    return -1;
-  const OIIO::ImageSpec &sa = ma.spec(), &sb = mb.spec();
-  if (sa.width != sb.width || sa.height != sb.height) return -1;
-  double both = 0, either = 0;
-  for (int y = 0; y < sa.height; ++y) {
-    for (int x = 0; x < sa.width; ++x) {
-      const bool in_a = ma.getchannel(x, y, 0, 0) > 0.5f, in_b = mb.getchannel(x, y, 0, 0) > 0.5f;
-      both += in_a && in_b;
-      either += in_a || in_b;
-    }
-  }
-  return either > 0 ? both / either : -1;
-}
-
 // Cycles' renders as photos: its pixel filter softens the speckle, which the still-background key
 // must not take for the turntable (it once did: 52 times the run folder's std). Six shots of the
 // ring, the fewest the key takes, keyed as eval --photos keys them, against the masks Cycles
@@ -191,7 +172,11 @@ TEST(EvalEndToEnd, CyclesRendersAsPhotosKeyToTheirObject) {
   EXPECT_EQ(masks->report["masked_photos"], 6) << log.str();
   for (const std::string& name : photos.names) {
     const std::string stem = fs::path(name).stem().string();
-    const double iou = mask_iou(masks->dir / (stem + ".png"), run / "masks" / (stem + ".png"));
+    const auto keyed = read_silhouette(masks->dir / (stem + ".png"), &error);
+    const auto rendered = read_silhouette(run / "masks" / (stem + ".png"), &error);
+    ASSERT_TRUE(keyed && rendered) << error;
+    ASSERT_EQ(keyed->coverage.size(), rendered->coverage.size()) << stem;
+    const double iou = silhouette_iou(*keyed, *rendered);
     std::cout << "[ photos   ] cycles " << stem << ": keyed mask IoU " << iou << "\n";
     EXPECT_GT(iou, 0.9) << stem;
   }

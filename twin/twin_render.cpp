@@ -20,21 +20,6 @@ namespace rigc::twin {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::optional<Silhouette> read_silhouette(const fs::path& path, std::string* error) {
-  OIIO::ImageBuf in(path.string());
-  if (!in.read(0, 0, true, OIIO::TypeDesc::FLOAT)) {
-    *error = fmt::format("cannot read the mask {}: {}", path.string(), in.geterror());
-    return std::nullopt;
-  }
-  Silhouette s;
-  s.width = in.spec().width;
-  s.height = in.spec().height;
-  s.coverage.resize(static_cast<std::size_t>(s.width) * s.height);
-  in.get_pixels(OIIO::ROI(0, s.width, 0, s.height, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT,
-                s.coverage.data());
-  return s;
-}
-
 namespace {
 
 // The photos' and the renders' mean luminance over where both show the object.

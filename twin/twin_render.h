@@ -25,9 +25,6 @@ struct CapturedPhoto {
   std::vector<Eigen::Vector3f> linear;
 };
 
-// A mask file as a silhouette (its first channel, 0..1); nullopt with `error`.
-std::optional<Silhouette> read_silhouette(const std::filesystem::path& path, std::string* error);
-
 // Renders the twin at `scene_path` (written from `scene`, in shot order of `photos`) into
 // OUT/render, rewriting the scene with its lights scaled to the photos' brightness; writes
 // OUT/contact_sheet.png and report["comparison"]. 0, or 2 with `error` (the scene did not

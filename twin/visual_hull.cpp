@@ -324,16 +324,6 @@ Silhouette render_silhouette(const ViewCamera& camera, const VisualHull& hull) {
   return s;
 }
 
-double silhouette_iou(const Silhouette& a, const Silhouette& b) {
-  std::size_t both = 0, either = 0;
-  for (std::size_t i = 0; i < a.coverage.size() && i < b.coverage.size(); ++i) {
-    const bool in_a = a.coverage[i] >= 0.5f, in_b = b.coverage[i] >= 0.5f;
-    both += in_a && in_b;
-    either += in_a || in_b;
-  }
-  return either ? static_cast<double>(both) / static_cast<double>(either) : 1.0;
-}
-
 VisualHull subdivided(const VisualHull& hull, int times) {
   if (times <= 0) return hull;
   open3d::geometry::TriangleMesh mesh;

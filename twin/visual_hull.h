@@ -15,15 +15,14 @@
 #include <vector>
 
 #include "eval/geometry.h"
+#include "eval/silhouette.h"
 
 namespace rigc::twin {
 
-// A silhouette: per pixel, how much of it is the object (0..1), row-major.
-struct Silhouette {
-  int width = 0, height = 0;
-  std::vector<float> coverage;
-  float at(int x, int y) const { return coverage[static_cast<std::size_t>(y) * width + x]; }
-};
+// The photos' silhouettes are eval's (eval/silhouette.h).
+using eval::read_silhouette;
+using eval::Silhouette;
+using eval::silhouette_iou;
 
 struct SilhouetteView {
   eval::ViewCamera camera;  // its width and height are the silhouette's
@@ -70,8 +69,5 @@ VisualHull subdivided(const VisualHull& hull, int times);
 
 // The silhouette `mesh` casts in `camera`: the share of each pixel covered, 0 or 1 at its centre.
 Silhouette render_silhouette(const eval::ViewCamera& camera, const VisualHull& hull);
-
-// Intersection over union of two silhouettes of one size, each thresholded at half.
-double silhouette_iou(const Silhouette& a, const Silhouette& b);
 
 }  // namespace rigc::twin
