@@ -285,6 +285,24 @@ TEST(Cli, BashCompletionIsMadeFromTheHelp) {
   EXPECT_EQ(completed.out, "plan\n--backend\ncycles\n--height\n");
 }
 
+// docs/guide.md is written by scripts/guide.sh, which runs every command it shows: here into a
+// folder of its own, comparing the preview alone (Cycles takes three minutes of it, POV-Ray five).
+TEST(EvalEndToEnd, TheGuideRuns) {
+  testing::TempDir dir;
+  const auto guide = testing::run_process(
+      {"env", std::string("RIGC=") + RIGC_BINARY, "GUIDE_REFERENCE=", "bash",
+       source_path("scripts/guide.sh"), dir.file("out"), dir.file("guide.md")});
+  ASSERT_EQ(guide.exit_code, 0) << guide.err;
+  const std::string text = testing::read_text(dir.file("guide.md"));
+  EXPECT_THAT(text, HasSubstr("$ rigc new scenes/assets/spot/spot.obj"));
+  EXPECT_THAT(text, HasSubstr("0 warnings"));
+  EXPECT_THAT(text, HasSubstr("| preview | 16 |"));
+  EXPECT_THAT(text, HasSubstr("relative-pose AUC"));
+  for (const char* picture : {"guide-preview.jpg", "guide-coverage.jpg", "guide-twin.jpg"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "guide" / picture)) << picture;
+  }
+}
+
 TEST(Cli, RenderCommandRejectsBadShotSelection) {
   auto result = ::rigc::testing::run_rigc(
       {"render", ::rigc::testing::source_path("scenes/paper-turntable.yaml"), "--shots", "3,40",

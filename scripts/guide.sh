@@ -5,13 +5,15 @@
 #
 # Usage: bash scripts/guide.sh [OUT_DIR] [GUIDE]   (defaults: out/guide, docs/guide.md; its
 # pictures go beside GUIDE in guide/). Needs ./build/rigc, COLMAP and Blender; about 5 minutes,
-# 3 of them Cycles' (GUIDE_REFERENCE=povray compares against POV-Ray instead, as the test does).
+# 3 of them Cycles' (GUIDE_REFERENCE= compares the preview alone, as the test does; POV-Ray at
+# this scale took 5 minutes). RIGC names the binary (default ./build/rigc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/guide}
 guide=${2:-docs/guide.md}
 pictures=$(dirname "$guide")/guide
 rigc=${RIGC:-./build/rigc}
+reference=${GUIDE_REFERENCE-cycles}  # set empty: the preview alone
 rm -rf "$out"
 mkdir -p "$out" "$pictures"
 doc=$(mktemp "$guide.XXXXXX")
@@ -22,7 +24,7 @@ say() { printf '%s\n' "$@" >>"$doc"; }
 # (EXIT_ALLOWED: an exit code besides 0 that is the command's answer, as plan's 1).
 show() {
   local command="$*"
-  say '```console' "\$ $(sed -e "s|^\./build/||" -e "s|$out/|out/guide/|g" <<<"$command")"
+  printf '```console\n$ rigc %s\n' "${command#"$rigc "}" | sed -e "s|$out/|out/guide/|g" >>"$doc"
   local log="$out/last.log"
   local code=0
   "$@" >"$log" 2>&1 || code=$?
@@ -92,7 +94,7 @@ say ''
 
 say '## 8. The preview against Cycles' '' \
   '`rigc compare` renders with each backend and reconstructs each: the paper'"'"'s Table 1.' ''
-LINES_SHOWN=6 show "$rigc" compare "$scene" --backends "preview,${GUIDE_REFERENCE:-cycles}" --scale 0.1 \
+LINES_SHOWN=6 show "$rigc" compare "$scene" --backends "preview${reference:+,$reference}" --scale 0.1 \
   -o "$out/compare"
 
 say '## 9. Real photos' '' \
