@@ -27,11 +27,22 @@ namespace fs = std::filesystem;
 // Surface samples tested against the shots for points3D.txt and bundle.out.
 constexpr int kGroundTruthSamples = 20000;
 
-std::string progress_line(int done, int total, const std::string& name, double seconds) {
+std::string time_left_text(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  if (s < 60) return fmt::format("{} s", s);
+  if (s < 3600) return fmt::format("{} min {} s", s / 60, s % 60);
+  return fmt::format("{} h {} min", s / 3600, s % 3600 / 60);
+}
+
+std::string progress_line(int done, int total, const std::string& name, double seconds,
+                          double seconds_left) {
   constexpr int kWidth = 30;
   const int filled = total > 0 ? done * kWidth / total : kWidth;
-  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s", std::string(filled, '#'),
-                     std::string(kWidth - filled, ' '), done, total, name, seconds);
+  const std::string left =
+      done < total ? fmt::format(", about {} left", time_left_text(seconds_left)) : "";
+  // Trailing spaces wipe a longer line drawn before.
+  return fmt::format("\r[{}{}] {}/{} {} {:.2f} s{}    ", std::string(filled, '#'),
+                     std::string(kWidth - filled, ' '), done, total, name, seconds, left);
 }
 
 bool prepare_run_folder(const fs::path& run_dir, const std::vector<fs::path>& extra,

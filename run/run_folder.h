@@ -66,8 +66,13 @@ bool remove_unrecorded_outputs(const Manifest& manifest, const ir::Scene& scene,
 bool check_one_scale(const Manifest& manifest, const ir::Scene& scene,
                      const std::vector<int>& selected, double scale, std::ostream& log);
 
-// "\r[#####     ] 5/18 shot_004 0.42 s": the progress bar a run redraws on a terminal.
-std::string progress_line(int done, int total, const std::string& name, double seconds);
+// "\r[#####     ] 5/18 shot_004 0.42 s, about 6 s left": the progress bar a run redraws on a
+// terminal.
+std::string progress_line(int done, int total, const std::string& name, double seconds,
+                          double seconds_left);
+
+// "6 s", "2 min 10 s", "1 h 5 min": a time left, as a person reads it.
+std::string time_left_text(double seconds);
 
 // Writes the ground truth for every shot that has its image in the run folder: sparse/ (with
 // points on the surface the shots see, run/ground_truth_points.h), transforms.json, bundle.out

@@ -128,7 +128,8 @@ class RunLoop {
   std::optional<scene::StudioScene> studio_;
   std::optional<PendingWrite> pending_;
   tbb::task_group writers_;  // the writes run as tasks of the renderer's own threads
-  int failures_ = 0, done_ = 0;
+  int failures_ = 0, done_ = 0, rendered_ = 0;
+  const Clock::time_point started_ = Clock::now();
   bool manifest_failed_ = false, write_failed_ = false, unsaved_ = false;
   Clock::time_point last_save_ = Clock::now() - std::chrono::hours(1);
 };
@@ -356,14 +357,18 @@ void RunLoop::report_skipped(const ir::Shot& shot) {
 }
 
 void RunLoop::report_rendered(const ir::Shot& shot, const ShotTiming& timing) {
+  // The time left at the pace of the shots rendered so far (those skipped took none).
+  ++rendered_;
+  const int total = static_cast<int>(shots_.size());
+  const double left = io::ms_since(started_) / 1000 / rendered_ * (total - done_);
   if (options_.progress_bar) {
-    log_ << progress_line(done_, static_cast<int>(shots_.size()), shot.name, timing.total_ms / 1000)
-         << std::flush;
+    log_ << progress_line(done_, total, shot.name, timing.total_ms / 1000, left) << std::flush;
     return;
   }
-  log_ << fmt::format("{}: rendered with {} in {:.2f} s ({} sub-frame{})\n", shot.name,
+  log_ << fmt::format("{}: rendered with {} in {:.2f} s ({} sub-frame{}); {}/{}{}\n", shot.name,
                       backend_.name(), timing.total_ms / 1000, timing.subframes,
-                      timing.subframes == 1 ? "" : "s");
+                      timing.subframes == 1 ? "" : "s", done_, total,
+                      done_ < total ? ", about " + time_left_text(left) + " left" : "");
 }
 
 }  // namespace
