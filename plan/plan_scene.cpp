@@ -119,10 +119,11 @@ std::unique_ptr<PlanOutcome> plan_scene(const PlanRequest& request, DiagnosticEn
     return nullptr;
   }
   // The plan is written at the output path, so the scene's relative files must resolve from
-  // there: said before the minutes of analysis, not after.
+  // there: said before the minutes of analysis, not after. Beside the scene they do (it compiled).
   DiagnosticEngine at_output;
   at_output.set_handler([](const Diagnostic&, const std::string&) {});
-  if (!compile_scene_text(*text, request.output_path, folder_of(request.output_path), at_output)) {
+  if (folder_of(request.output_path) != folder_of(request.scene_path) &&
+      !compile_scene_text(*text, request.output_path, folder_of(request.output_path), at_output)) {
     *error = fmt::format(
         "the scene would not compile at {}: {} (write the plan beside the scene, the default, "
         "or give the scene's files absolute paths)",
