@@ -36,25 +36,15 @@ Silhouette blurred(const Silhouette& s, double sigma_px) {
   return b;
 }
 
-// `s` grown by `r` pixels: the largest coverage within r along each axis in turn.
+// `s` grown by `r` pixels: the largest coverage within r, OIIO's square dilation.
 Silhouette grown(const Silhouette& s, int r) {
   if (r <= 0) return s;
-  auto max_along = [&](const Silhouette& in, int dx, int dy) {
-    Silhouette out = in;
-    for (int y = 0; y < in.height; ++y) {
-      for (int x = 0; x < in.width; ++x) {
-        float m = 0;
-        for (int k = -r; k <= r; ++k) {
-          const int sx = std::clamp(x + k * dx, 0, in.width - 1);
-          const int sy = std::clamp(y + k * dy, 0, in.height - 1);
-          m = std::max(m, in.at(sx, sy));
-        }
-        out.coverage[static_cast<std::size_t>(y) * in.width + x] = m;
-      }
-    }
-    return out;
-  };
-  return max_along(max_along(s, 1, 0), 0, 1);
+  const OIIO::ImageSpec spec(s.width, s.height, 1, OIIO::TypeDesc::FLOAT);
+  OIIO::ImageBuf in(spec, const_cast<float*>(s.coverage.data()));
+  const OIIO::ImageBuf out = OIIO::ImageBufAlgo::dilate(in, 2 * r + 1, 2 * r + 1);
+  Silhouette g = s;
+  out.get_pixels(OIIO::ROI(0, s.width, 0, s.height), OIIO::TypeDesc::FLOAT, g.coverage.data());
+  return g;
 }
 
 // Bilinear coverage at continuous pixel coordinates (COLMAP's: a pixel's centre at +0.5).
@@ -255,12 +245,14 @@ std::optional<VisualHull> carve_visual_hull(const std::vector<SilhouetteView>& v
     *error = fmt::format("{} silhouettes: at least 3 are needed to carve a hull", views.size());
     return std::nullopt;
   }
+  std::vector<Silhouette> grown_silhouettes;  // once, for both passes
+  for (const auto& view : views)
+    grown_silhouettes.push_back(grown(*view.silhouette, options.grow_px));
   auto smoothed = [&](double voxel) {
     std::vector<Silhouette> out;
-    for (const auto& view : views) {
-      const double distance = (view.camera.center() - region.center()).norm();
-      out.push_back(blurred(grown(*view.silhouette, options.grow_px),
-                            0.5 * voxel * view.camera.fx / distance));
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const double distance = (views[v].camera.center() - region.center()).norm();
+      out.push_back(blurred(grown_silhouettes[v], 0.5 * voxel * views[v].camera.fx / distance));
     }
     return out;
   };
