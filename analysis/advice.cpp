@@ -456,6 +456,17 @@ const char* setting_name(Setting setting) {
   return "";
 }
 
+double advice_visibility_scale(const ir::Camera& camera) {
+  return std::min(1.0, 700.0 / camera.width_px);
+}
+
+std::vector<Advice> check_advice(const ir::Scene& scene) {
+  const scene::StudioScene studio = scene::prepare_studio_scene(scene);
+  CoverageOptions options;
+  options.visibility_scale = advice_visibility_scale(scene.camera);
+  return capture_advice(scene, studio, analyse_coverage(scene, studio, options));
+}
+
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag) {
   for (const Advice& advice : capture_advice(scene, studio, coverage)) {

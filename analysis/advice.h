@@ -45,6 +45,14 @@ struct Advice {
 std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                                    const CoverageResult& coverage);
 
+// The resolution the advice's coverage analysis runs at: about 700 px across, the visibility
+// scale for `camera` (check, the studio and `rigc new` give the same advice).
+double advice_visibility_scale(const ir::Camera& camera);
+
+// The advice `rigc check` gives for `scene`: its studio prepared and its coverage analysed at
+// advice_visibility_scale.
+std::vector<Advice> check_advice(const ir::Scene& scene);
+
 // capture_advice as warnings.
 void report_capture_advice(const ir::Scene& scene, const scene::StudioScene& studio,
                            const CoverageResult& coverage, DiagnosticEngine& diag);

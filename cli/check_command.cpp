@@ -5,14 +5,12 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/advice.h"
-#include "analysis/coverage.h"
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "compiler/units.h"
 #include "ir/ir_json.h"
-#include "scene/studio_scene.h"
 
 namespace rigc::cli {
 namespace {
@@ -75,12 +73,7 @@ int run_check_command(std::vector<std::string> args) {
   std::vector<analysis::Advice> advice;
   const std::size_t first_advice = diag.diagnostics().size();
   if (scene && !no_advice) {
-    // Capture advice from a coverage analysis at reduced resolution (about 700 px across).
-    const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
-    analysis::CoverageOptions options;
-    options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-    const analysis::CoverageResult coverage = analysis::analyse_coverage(*scene, studio, options);
-    advice = analysis::capture_advice(*scene, studio, coverage);
+    advice = analysis::check_advice(*scene);
     for (const analysis::Advice& a : advice) diag.warning(a.loc, a.message);
   }
   if (json) {

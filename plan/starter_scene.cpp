@@ -8,12 +8,10 @@
 #include <iterator>
 
 #include "analysis/advice.h"
-#include "analysis/coverage.h"
 #include "compiler/frontend.h"
 #include "dslr/optics.h"
 #include "dslr/stops.h"
 #include "plan/plan_scene.h"
-#include "scene/studio_scene.h"
 
 namespace rigc::plan {
 
@@ -190,11 +188,7 @@ bool settle_exposure(const StarterOptions& o, Choices& c, DiagnosticEngine& diag
       *error = "the starting scene does not compile";
       return false;
     }
-    const scene::StudioScene studio = scene::prepare_studio_scene(*scene);
-    analysis::CoverageOptions options;
-    options.visibility_scale = std::min(1.0, 700.0 / scene->camera.width_px);
-    const auto advice = analysis::capture_advice(
-        *scene, studio, analysis::analyse_coverage(*scene, studio, options));
+    const auto advice = analysis::check_advice(*scene);
     const double iso = suggested(advice, analysis::Setting::kIso);
     const double light = suggested(advice, analysis::Setting::kLight);
     const double aperture = suggested(advice, analysis::Setting::kFNumber);

@@ -145,7 +145,7 @@ std::optional<nlohmann::json> Analyses::advice(const AnalysedScene& what,
                    {"rendered", rendered}});
   });
   analysis::CoverageOptions options;
-  options.visibility_scale = std::min(1.0, 700.0 / scene.camera.width_px);
+  options.visibility_scale = analysis::advice_visibility_scale(scene.camera);
   options.visibility_cache = visibility_cache_;
   const auto coverage = analyse(advice_kept_, what, options, true);
   if (!coverage) return std::nullopt;
