@@ -160,6 +160,18 @@ void frame_the_object(const ir::Scene& scene, Choices& c) {
       c.f_number, length_text(across), length_text(c.distance_m));
 }
 
+// `c`'s scene compiled where it will be written. Its diagnostics reach `diag` only when it does
+// not compile: a draft's warnings are the draft's.
+std::optional<ir::Scene> compile_draft(const Choices& c, const StarterOptions& o,
+                                       DiagnosticEngine& diag) {
+  const std::string folder = fs::absolute(o.output_path).parent_path().string();
+  DiagnosticEngine quiet;
+  quiet.set_handler([](const Diagnostic&, const std::string&) {});
+  auto scene = compile_scene_text(scene_text(c), o.output_path, folder, quiet);
+  if (!scene) compile_scene_text(scene_text(c), o.output_path, folder, diag);
+  return scene;
+}
+
 // The value an advice works out for `setting` (0 when it works none out).
 double suggested(const std::vector<analysis::Advice>& advice, analysis::Setting setting) {
   for (const auto& a : advice) {
@@ -178,13 +190,8 @@ bool settle_exposure(const StarterOptions& o, Choices& c, DiagnosticEngine& diag
     c.exposure_why = "The exposure: `rigc check` gives no advice on it for these lights.";
   }
   for (int round = 0; round < kAdviceRounds; ++round) {
-    DiagnosticEngine quiet;
-    quiet.set_handler([](const Diagnostic&, const std::string&) {});
-    const auto scene = compile_scene_text(scene_text(c), o.output_path,
-                                          fs::path(o.output_path).parent_path().string(), quiet);
+    const auto scene = compile_draft(c, o, diag);
     if (!scene) {
-      compile_scene_text(scene_text(c), o.output_path,
-                         fs::path(o.output_path).parent_path().string(), diag);
       *error = "the starting scene does not compile";
       return false;
     }
@@ -226,12 +233,9 @@ std::optional<std::string> starter_scene_text(const StarterOptions& o, Diagnosti
   c.height_m = o.height_m;
   c.size_why = o.height_m ? "as given (--height)" : "the model file's own size, in metres";
 
-  // The object as the file gives it, in a first draft (its warnings are the draft's).
-  DiagnosticEngine quiet;
-  quiet.set_handler([](const Diagnostic&, const std::string&) {});
-  const auto draft = compile_scene_text(scene_text(c), o.output_path, folder.string(), quiet);
+  // The object as the file gives it, in a first draft.
+  const auto draft = compile_draft(c, o, diag);
   if (!draft) {
-    compile_scene_text(scene_text(c), o.output_path, folder.string(), diag);
     *error = "the starting scene does not compile (its diagnostics above)";
     return std::nullopt;
   }
@@ -257,8 +261,9 @@ std::optional<std::string> starter_scene_text(const StarterOptions& o, Diagnosti
   request.target = o.target;
   request.visibility_scale = o.visibility_scale;
   // The planner's rings and one below the table's top, for what faces down.
-  for (const double deg : {-10.0, 0.0, 20.0, 40.0, 60.0, 80.0}) {
-    request.candidates.ring_elevations_rad.push_back(deg * M_PI / 180);
+  request.candidates.ring_elevations_rad.push_back(-10 * kDegree);
+  for (const double deg : kDefaultRingsDeg) {
+    request.candidates.ring_elevations_rad.push_back(deg * kDegree);
   }
   std::string plan_error;
   const auto outcome = plan_scene(request, diag, &plan_error);
