@@ -47,12 +47,12 @@ int run_new_command(std::vector<std::string> args) {
     if (!quantity(height, QuantityKind::kLength, "--height", &h)) return kExitUserError;
     o.height_m = h;
   }
-  const double percent = std::atof(target.c_str());
-  if (percent <= 0 || percent > 100) {
-    std::cerr << "rigc new: error: --target " << target << " is not a share of 0 to 100 %\n";
+  const auto share = parse_target(target);
+  if (!share) {
+    std::cerr << "rigc new: error: --target '" << target << "' is not a share like 90% or 0.9\n";
     return kExitUserError;
   }
-  o.target = percent / 100;
+  o.target = *share;
   if (!fs::is_regular_file(o.model_path)) {
     std::cerr << fmt::format("rigc new: error: {} is not a model file\n", o.model_path);
     return kExitUserError;

@@ -19,17 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// "95%" or "0.95": a share in (0, 1].
-std::optional<double> parse_target(const std::string& text) {
-  const bool percent = text.ends_with('%');
-  const auto quantity =
-      parse_quantity(percent ? text.substr(0, text.size() - 1) : text, QuantityKind::kNumber);
-  if (!quantity.value) return std::nullopt;
-  const double share = percent ? *quantity.value / 100 : *quantity.value;
-  if (!(share > 0 && share <= 1)) return std::nullopt;
-  return share;
-}
-
 // A comma-separated list of quantities of one kind, each within [lowest, highest] (SI).
 std::optional<std::vector<double>> parse_list(const std::string& text, QuantityKind kind,
                                               double lowest, double highest, std::string* error) {
@@ -120,6 +109,17 @@ bool choose_output(plan::PlanRequest& request) {
 }
 
 }  // namespace
+
+// "95%" or "0.95": a share in (0, 1].
+std::optional<double> parse_target(const std::string& text) {
+  const bool percent = text.ends_with('%');
+  const auto quantity =
+      parse_quantity(percent ? text.substr(0, text.size() - 1) : text, QuantityKind::kNumber);
+  if (!quantity.value) return std::nullopt;
+  const double share = percent ? *quantity.value / 100 : *quantity.value;
+  if (!(share > 0 && share <= 1)) return std::nullopt;
+  return share;
+}
 
 int run_plan_command(std::vector<std::string> args) {
   CLI::App app{

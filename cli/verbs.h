@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ int run_studio_command(std::vector<std::string> args);
 int run_sweep_command(std::vector<std::string> args);
 int run_twin_command(std::vector<std::string> args);
 int run_new_command(std::vector<std::string> args);
+
+// "95%" or "0.95": a share in (0, 1], as --target takes it (plan, new).
+std::optional<double> parse_target(const std::string& text);
 
 // The reconstruction options `eval` and `compare` share.
 void add_eval_options(CLI::App& app, eval::EvalOptions& options);

@@ -72,6 +72,9 @@ TEST(StarterScene, BadInputsAreClearErrors) {
   r = run_rigc({"new", source_path(kSpot), "--lens", "fifty", "-o", dir.file("d.yaml")});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("--lens"));
+  r = run_rigc({"new", source_path(kSpot), "--target", "95x", "-o", dir.file("e.yaml")});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--target"));
 }
 
 // The photos of the new scene, rendered by the preview, all register in COLMAP.
