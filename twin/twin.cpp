@@ -321,13 +321,14 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
           ? carve_visual_hull(views, *region, {o.resolution, 3, o.max_misses, kHullGrowPx}, &error)
           : std::nullopt;
   if (!carved) return fail(log, kUserError, error);
-  const int subdivisions = color_subdivisions(*carved, view_cameras_of(*photos));
-  const std::optional<VisualHull> hull = subdivided(*carved, subdivisions);
+  const std::vector<eval::ViewCamera> cameras_of_photos = view_cameras_of(*photos);
+  const int subdivisions = color_subdivisions(*carved, cameras_of_photos);
+  const VisualHull hull = subdivided(*carved, subdivisions);
 
   // The capture's frame to the object frame, the hull moved with it.
-  const Vec3 up = up_of_cameras(view_cameras_of(*photos), hull->region.center());
-  eval::Similarity to_object = object_from_capture(up, hull->positions);
-  VisualHull placed = *hull;
+  const Vec3 up = up_of_cameras(cameras_of_photos, hull.region.center());
+  eval::Similarity to_object = object_from_capture(up, hull.positions);
+  VisualHull placed = hull;
   for (auto& p : placed.positions) p = to_object.apply(p.cast<double>()).cast<float>();
   Eigen::AlignedBox3d box;
   for (const auto& p : placed.positions) box.extend(p.cast<double>());
@@ -344,7 +345,7 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
   }
   std::vector<ColorPhoto> color_photos;
   for (const auto& p : *photos) color_photos.push_back({p.camera, p.linear});
-  const auto colors = color_vertices(*hull, color_photos);
+  const auto colors = color_vertices(hull, color_photos);
   if (!write_twin_mesh(placed, colors, out / "object.ply", &error)) {
     return fail(log, kToolError, error);
   }
@@ -360,7 +361,7 @@ int make_twin(const TwinOptions& o, std::ostream& log) {
                     {"triangles", placed.triangles.size()},
                     {"voxel_mm", 1000 * placed.voxel_m},
                     {"resolution", o.resolution},
-                    {"filled_share", hull->filled_share},
+                    {"filled_share", hull.filled_share},
                     {"subdivisions", subdivisions},
                     {"size_m", vec_json(scene.object_size)},
                     {"up_in_capture_frame", vec_json(up)},
