@@ -173,20 +173,28 @@ double otsu_threshold(const std::vector<double>& values) {
   return (best_bin + 1.0) / kBins;
 }
 
-}  // namespace
-
-std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& image) {
+// The luminance of the pixels in a band at the image's borders, a fiftieth of its shorter side.
+std::vector<double> border_luminances(const KeyImage& image) {
   const int band = std::max(1, std::min(image.width, image.height) / 50);
-  std::size_t border = 0, dark = 0, bright = 0;
+  std::vector<double> border;
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
       if (!(x < band || y < band || x >= image.width - band || y >= image.height - band)) continue;
-      const double l = luminance_of(image, static_cast<std::size_t>(y) * image.width + x);
-      ++border;
-      dark += l < 0.05;
-      bright += l > 0.8;
+      border.push_back(luminance_of(image, static_cast<std::size_t>(y) * image.width + x));
     }
   }
+  return border;
+}
+
+}  // namespace
+
+std::optional<BrightBackdrop> backdrop_brightness_at_borders(const KeyImage& image) {
+  const std::vector<double> luminances = border_luminances(image);
+  const std::size_t border = luminances.size();
+  const auto dark = static_cast<std::size_t>(
+      std::count_if(luminances.begin(), luminances.end(), [](double l) { return l < 0.05; }));
+  const auto bright = static_cast<std::size_t>(
+      std::count_if(luminances.begin(), luminances.end(), [](double l) { return l > 0.8; }));
   if (border == 0) return std::nullopt;
   if (10 * dark >= 9 * border) return BrightBackdrop::kDark;
   if (10 * bright >= 9 * border) return BrightBackdrop::kBright;
@@ -215,14 +223,7 @@ std::vector<std::uint8_t> key_brightness(const KeyImage& image, BrightBackdrop b
 }
 
 std::vector<std::uint8_t> at_backdrop_level(const KeyImage& image, BrightBackdrop backdrop) {
-  const int band = std::max(1, std::min(image.width, image.height) / 50);
-  std::vector<double> border;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      if (!(x < band || y < band || x >= image.width - band || y >= image.height - band)) continue;
-      border.push_back(luminance_of(image, static_cast<std::size_t>(y) * image.width + x));
-    }
-  }
+  std::vector<double> border = border_luminances(image);
   std::vector<std::uint8_t> level(image.pixels(), 0);
   if (border.empty()) return level;
   const auto median = border.begin() + static_cast<std::ptrdiff_t>(border.size() / 2);
