@@ -32,8 +32,24 @@ namespace {
 namespace fs = std::filesystem;
 
 using cli::finite_number;
-using cli::non_negative_number;
 using cli::parse_options;
+
+}  // namespace
+
+CLI::Option* add_samples_option(CLI::App& app, int& samples, const std::string& what) {
+  const CLI::Validator samples_text(
+      [](std::string& text) -> std::string {
+        return run::parse_samples(text) ? "" : "'" + text + "' is not a count 0..65536 or auto";
+      },
+      "N|auto");
+  return app
+      .add_option_function<std::string>(
+          "--samples", [&samples](const std::string& text) { samples = *run::parse_samples(text); },
+          what)
+      ->check(samples_text);
+}
+
+namespace {
 
 // `compile --target BACKEND`: the backend's scripts for the whole scene in `output`.
 int emit_scripts(const ir::Scene& scene, const std::string& target, const std::string& output,
@@ -42,8 +58,10 @@ int emit_scripts(const ir::Scene& scene, const std::string& target, const std::s
   run::RenderSettings settings;
   settings.scale = scale;
   settings.samples = samples;
+  settings = run::settings_for(*backend, settings);
   std::string error;
-  if (!backend->emit(scene, scene::prepare_studio_scene(scene), output, settings, &error)) {
+  if (!backend->check_settings(settings, &error) ||
+      !backend->emit(scene, scene::prepare_studio_scene(scene), output, settings, &error)) {
     std::cerr << "rigc: error: " << error << '\n';
     return kExitUserError;
   }
@@ -72,8 +90,9 @@ int run_compile(std::vector<std::string> args) {
       ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
-  app.add_option("--samples", samples, "renderer samples per pixel (0: the backend's default)")
-      ->check(non_negative_number());
+  add_samples_option(app, samples,
+                     "renderer samples per pixel (0: the backend's default; auto: until the "
+                     "renderer's noise is a quarter of the sensor's)");
   app.add_flag("--no-geometry", no_geometry, "leave vertex and triangle arrays out of the IR");
   if (auto code = parse_options(app, args)) return *code;
 
@@ -116,10 +135,10 @@ int run_render(std::vector<std::string> args) {
   app.add_option("--backend", backend, "renderer")
       ->check(CLI::IsMember(backends::backend_names()))
       ->capture_default_str();
-  app.add_option("--samples", samples,
-                 "samples per pixel (0: the backend's default; the preview's: 1, 4, 9, ... as "
-                 "a square grid, default 1)")
-      ->check(non_negative_number());
+  add_samples_option(app, samples,
+                     "samples per pixel (0: the backend's default; the preview's: 1, 4, 9, ... as "
+                     "a square grid, default 1; auto: until the renderer's noise is a quarter of "
+                     "the sensor's, docs/fidelity.md)");
   app.add_option("-o,--output", output, "run folder (default: out/<scene>/<backend>)");
   app.add_option("--shots", shot_text, "shots to render, e.g. 0,3,5-7 or all")
       ->capture_default_str();

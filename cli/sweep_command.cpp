@@ -48,10 +48,9 @@ void add_sweep_options(CLI::App& app, SweepArguments& a) {
       ->check(finite_number())
       ->check(CLI::Range(0.01, 4.0))
       ->capture_default_str();
-  app.add_option("--samples", a.samples,
-                 "with --vary: samples per pixel for every backend (0: each backend's default)")
-      ->check(CLI::Range(0, 65536))
-      ->capture_default_str();
+  add_samples_option(app, a.samples,
+                     "with --vary: samples per pixel for every backend (0: each backend's "
+                     "default; auto: each converged)");
   app.add_option("--measure", a.measure, "with --vary: coverage, eval or coverage,eval")
       ->capture_default_str();
   app.add_option("-o,--output", a.output, "sweep folder (default: out/<sweep>)");

@@ -24,6 +24,10 @@ int run_new_command(std::vector<std::string> args);
 // "95%" or "0.95": a share in (0, 1], as --target takes it (plan, new).
 std::optional<double> parse_target(const std::string& text);
 
+// --samples N|auto into `samples` (run::parse_samples: a count 0..65536, or auto for
+// run::kConvergedSamples); `what` is the option's help.
+CLI::Option* add_samples_option(CLI::App& app, int& samples, const std::string& what);
+
 // The reconstruction options `eval` and `compare` share.
 void add_eval_options(CLI::App& app, eval::EvalOptions& options);
 

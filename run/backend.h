@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "dslr/frame.h"
@@ -16,15 +17,31 @@
 
 namespace rigc::run {
 
+// RenderSettings::samples that asks a renderer to sample each pixel until its own noise is at
+// most a quarter of the simulated sensor's noise variance (`--samples auto`; docs/fidelity.md).
+inline constexpr int kConvergedSamples = -1;
+
+// `text` as RenderSettings::samples: a whole number within 0..65536, or "auto" for
+// kConvergedSamples; nullopt otherwise.
+std::optional<int> parse_samples(const std::string& text);
+// RenderSettings::samples as parse_samples reads it back ("auto" or the count).
+std::string samples_text(int samples);
+
 // What a run asks of every backend.
 struct RenderSettings {
   double scale = 1.0;      // multiplies the sensor resolution
   std::uint64_t seed = 1;  // sensor noise (and an external renderer's sampling seed)
-  int samples = 0;         // renderer samples per pixel; 0 = the backend's default
+  int samples = 0;  // renderer samples per pixel; 0 = the backend's default; kConvergedSamples
 
   // False with a one-line `error` when a field is out of its domain.
   bool check(std::string* error) const;
 };
+
+class Backend;
+
+// `settings` as `backend` takes them: kConvergedSamples is the default samples of a backend
+// without noise of its own (Backend::converges).
+RenderSettings settings_for(const Backend& backend, RenderSettings settings);
 
 // One shot in linear light, as a backend rendered it.
 struct RenderedShot {
@@ -73,6 +90,9 @@ class Backend {
   // The samples a pixel that RenderSettings::samples = 0 stands for, when one count says it (0
   // when the default is no count): asking for the default by number keeps the shot keys.
   virtual int default_samples() const { return 0; }
+  // Whether kConvergedSamples samples differently from the default: a renderer with Monte Carlo
+  // noise of its own. One without takes it as its default.
+  virtual bool converges() const { return false; }
   // The backend's own options that change its output, as text for the shot key ("" when none
   // differs from the default).
   virtual std::string options_key() const { return ""; }

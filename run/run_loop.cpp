@@ -5,6 +5,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <future>
@@ -85,7 +86,7 @@ class RunLoop {
       : scene_(scene),
         backend_(backend),
         options_(options),
-        settings_(options.settings),
+        settings_(settings_for(backend, options.settings)),
         log_(log),
         timings_(timings),
         run_dir_(options.output_dir),
@@ -100,7 +101,7 @@ class RunLoop {
   bool open_run_folder();
   // The samples a pixel the run renders with: the settings', or the backend's default for 0.
   int samples() const {
-    return settings_.samples > 0 ? settings_.samples : backend_.default_samples();
+    return settings_.samples != 0 ? settings_.samples : backend_.default_samples();
   }
   std::string key_of(const ir::Shot& shot) const;
   bool prepare_backend();
@@ -116,7 +117,7 @@ class RunLoop {
   const ir::Scene& scene_;
   Backend& backend_;
   const RunOptions& options_;
-  const RenderSettings& settings_;
+  const RenderSettings settings_;
   std::ostream& log_;
   std::vector<ShotTiming>* timings_;
   const fs::path run_dir_, manifest_path_;
@@ -173,7 +174,7 @@ bool RunLoop::open_run_folder() {
 
 std::string RunLoop::key_of(const ir::Shot& shot) const {
   std::vector<std::string> extra;
-  if (backend_.takes_samples()) extra.push_back(fmt::format("samples={}", samples()));
+  if (backend_.takes_samples()) extra.push_back("samples=" + samples_text(samples()));
   if (const std::string options = backend_.options_key(); !options.empty()) {
     extra.push_back(options);
   }
@@ -208,7 +209,10 @@ int RunLoop::run() {
                            {"object_sha256", object_geometry_hash(scene_)},
                            {"scale", settings_.scale},
                            {"seed", settings_.seed}};
-  if (backend_.takes_samples()) inputs["samples"] = samples();
+  if (backend_.takes_samples()) {
+    inputs["samples"] =
+        samples() == kConvergedSamples ? nlohmann::json("auto") : nlohmann::json(samples());
+  }
   manifest_.set_inputs(std::move(inputs));
 
   for (int index : shots_) {
@@ -383,11 +387,31 @@ bool RenderSettings::check(std::string* error) const {
     *error = "the render scale must be a positive number";
     return false;
   }
-  if (samples < 0) {
+  if (samples < 0 && samples != kConvergedSamples) {
     *error = "the samples per pixel must not be negative";
     return false;
   }
   return true;
+}
+
+std::optional<int> parse_samples(const std::string& text) {
+  if (text == "auto") return kConvergedSamples;
+  int value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || value < 0 ||
+      value > 65536) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::string samples_text(int samples) {
+  return samples == kConvergedSamples ? "auto" : std::to_string(samples);
+}
+
+RenderSettings settings_for(const Backend& backend, RenderSettings settings) {
+  if (settings.samples == kConvergedSamples && !backend.converges()) settings.samples = 0;
+  return settings;
 }
 
 bool Backend::available(std::string* /*error*/) const {

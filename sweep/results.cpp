@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "io/atomic_file.h"
+#include "run/backend.h"
 #include "sweep/task.h"
 
 namespace rigc::sweep {
@@ -145,7 +146,9 @@ std::string markdown_text(const SweepSpec& spec, const std::vector<ResultRow>& r
   std::string md = fmt::format(
       "# Sweep {}\n\nScene `{}`, render scale {}{}, measured: {}{}.\n\n", spec.name,
       spec.scene_path, spec.scale,
-      spec.samples > 0 ? fmt::format(", {} samples a pixel", spec.samples) : "",
+      spec.samples == run::kConvergedSamples ? ", converged sampling"
+      : spec.samples > 0                     ? fmt::format(", {} samples a pixel", spec.samples)
+                                             : "",
       spec.coverage ? "coverage" : "", spec.eval ? (spec.coverage ? ", eval" : "eval") : "");
   md += markdown_table(spec, rows);
   const int best = best_variant(rows);

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "io/atomic_file.h"
+#include "run/backend.h"
 #include "run/manifest.h"
 #include "sweep/slurm_executor.h"
 
@@ -39,7 +40,7 @@ std::string submit_shots(const fs::path& parts, const std::vector<int>& shots,
   argv.insert(argv.end(), {(parts / "render.sh").string(), fs::absolute(split.rigc).string(),
                            fs::absolute(split.scene_path).string(), parts.string(), "--backend",
                            split.backend, "--scale", fmt::format("{}", options.settings.scale),
-                           "--samples", std::to_string(options.settings.samples), "--seed",
+                           "--samples", run::samples_text(options.settings.samples), "--seed",
                            std::to_string(options.settings.seed)});
   std::string output;
   const int status = run_slurm_tool(parts, argv, &output);

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -123,9 +125,10 @@ void read_scale(const YAML::Node& node, const std::string& file, SweepSpec& spec
 
 void read_samples(const YAML::Node& node, const std::string& file, SweepSpec& spec,
                   DiagnosticEngine& diag) {
-  const auto samples = number_within(node, 1, 65536);
-  if (!samples) {
-    diag.error(loc_of(node, file), "samples: must be a whole number within 1..65536");
+  const std::optional<int> samples =
+      node.IsScalar() ? run::parse_samples(node.Scalar()) : std::nullopt;
+  if (!samples || *samples == 0) {
+    diag.error(loc_of(node, file), "samples: must be a whole number within 1..65536, or auto");
     return;
   }
   spec.samples = *samples;
@@ -147,7 +150,8 @@ void check_samples_for_backends(const YAML::Node& node, const std::string& file,
   for (const std::string& name : names) {
     const backends::BackendEntry* entry = backends::find_backend(name);
     std::string error;
-    if (entry && !entry->make()->check_settings(settings, &error)) {
+    const std::unique_ptr<run::Backend> backend = entry ? entry->make() : nullptr;
+    if (backend && !backend->check_settings(run::settings_for(*backend, settings), &error)) {
       diag.error(loc_of(node, file), fmt::format("samples: {} (backend {})", error, name));
     }
   }
@@ -184,7 +188,7 @@ void read_top_level(const YAML::Node& root, const std::string& file, SweepSpec& 
   if (const YAML::Node n = root["scale"]) read_scale(n, file, spec, diag);
   if (const YAML::Node n = root["samples"]) {
     read_samples(n, file, spec, diag);
-    if (spec.samples > 0) check_samples_for_backends(n, file, spec, diag);
+    if (spec.samples != 0) check_samples_for_backends(n, file, spec, diag);
   }
   if (const YAML::Node n = root["measure"]) read_measure(n, file, spec, diag);
 }

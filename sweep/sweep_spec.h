@@ -31,7 +31,8 @@ struct SweepSpec {
   std::vector<std::vector<int>> zip_groups;  // axes (indices) paired value by value
   std::string backend = "preview";           // when the backend is no axis
   double scale = 0.25;
-  int samples = 0;  // every backend's samples per pixel; 0 = each backend's default
+  // Every backend's samples per pixel; 0 = each backend's default; run::kConvergedSamples.
+  int samples = 0;
   bool coverage = true, eval = false;
 };
 

@@ -113,6 +113,10 @@ TEST(SweepFile, SamplesReachTheVariantsAndTheirKeys) {
   const std::string by_default = key_with(""), sixteen = key_with("samples: 16\n");
   EXPECT_NE(sixteen, by_default);
   EXPECT_EQ(key_with("samples: 16\n"), sixteen);
+  // Converged sampling is a setting of its own.
+  const std::string converged = key_with("samples: auto\n");
+  EXPECT_NE(converged, by_default);
+  EXPECT_NE(converged, sixteen);
 
   for (const std::string bad : {"samples: 0\n", "samples: 1.5\n", "samples: [16]\n"}) {
     DiagnosticEngine diag;

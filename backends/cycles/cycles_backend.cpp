@@ -14,8 +14,10 @@
 
 #include "backends/external/process.h"
 #include "backends/external/script_text.h"
+#include "dslr/exposure.h"
 #include "dslr/image_io.h"
 #include "dslr/lens.h"
+#include "dslr/sensor.h"
 #include "io/files.h"
 #include "scene/speckle.h"
 #include "scene/studio_scene.h"
@@ -201,13 +203,28 @@ std::string script_text(const json& data) {
   const std::string header = fmt::format(
       "# RigC: Blender Cycles scene '{}' (object {}).\n"
       "# Run: blender -b --factory-startup --python scene.py [-- --shot N[,N...] --samples N "
-      "--out DIR]\n",
+      "--seed N --out DIR]\n",
       external::comment_text(data["scene"].get<std::string>()),
       external::comment_text(data["object_source"].get<std::string>()));
   return header + script;
 }
 
 }  // namespace
+
+double converged_noise_threshold(const ir::Camera& camera) {
+  // The measured form of 0.69/sqrt(g) (docs/fidelity.md, "Converged references").
+  constexpr double kThresholdTimesRootElectrons = 0.45;
+  const double electrons_per_unit = dslr::exposure_scale(camera) *
+                                    dslr::electrons_at_clipping(camera.noise, camera.iso) *
+                                    external::kCandelaPerBlenderUnit;
+  return kThresholdTimesRootElectrons / std::sqrt(electrons_per_unit);
+}
+
+int cycles_seed(std::uint64_t run_seed, int shot_index) {
+  constexpr std::uint64_t kSeedsPerRun = 1000003;  // a prime above any run's shot count
+  return static_cast<int>(((run_seed - 1) * kSeedsPerRun + static_cast<std::uint64_t>(shot_index)) %
+                          (1ull << 31));
+}
 
 std::string CyclesBackend::options_key() const {
   std::vector<std::string> changed;
@@ -234,7 +251,11 @@ bool CyclesBackend::emit(const ir::Scene& scene, const scene::StudioScene& studi
   data["source_file"] = scene.source_file;
   data["width"] = canvas.width;
   data["height"] = canvas.height;
-  data["samples"] = samples > 0 ? samples : CyclesBackend::kDefaultSamples;
+  const bool converged = samples == run::kConvergedSamples;
+  data["samples"] = converged     ? CyclesBackend::kConvergedMaxSamples
+                    : samples > 0 ? samples
+                                  : CyclesBackend::kDefaultSamples;
+  data["noise_threshold"] = converged ? converged_noise_threshold(camera) : 0.0;
   data["shutter_s"] = camera.shutter_s;
   data["ambient_radiance"] = scene.studio.ambient_lx / external::kCandelaPerBlenderUnit / kPi;
   // The sensor width that gives the canvas's fx at the true focal length, so that Cycles' pupil
@@ -341,6 +362,8 @@ bool CyclesBackend::render(const ir::Scene& scene, const scene::StudioScene& /*s
     argv.push_back("--samples");
     argv.push_back(std::to_string(samples));
   }
+  argv.push_back("--seed");
+  argv.push_back(std::to_string(cycles_seed(settings.seed, shot.index)));
   const external::ProgramResult result = external::run_program(argv, dir, files.log);
   if (!result.started) {
     *error = result.error;

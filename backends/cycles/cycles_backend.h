@@ -9,6 +9,7 @@
 // W/(m²·sr) = cd/m² / 683.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ class CyclesBackend : public external::ExternalBackend {
   std::string options_key() const override;
   static constexpr int kDefaultSamples = 64;
   int default_samples() const override { return kDefaultSamples; }
+  // kConvergedSamples: adaptive sampling to converged_noise_threshold, at most this many.
+  bool converges() const override { return true; }
+  static constexpr int kConvergedMaxSamples = 4096;
   // 2: area lights given their full power on Blender before 4.0.
   int output_version() const override { return 2; }
   // Writes scene.py, geometry.bin and the textures into `dir` (created if missing). `samples` is
@@ -46,5 +50,15 @@ class CyclesBackend : public external::ExternalBackend {
               const run::RenderSettings& settings, const run::ShotFiles& files,
               run::RenderedShot* out, std::string* error) override;
 };
+
+// Cycles' adaptive-sampling noise threshold that holds its noise variance on the object at most a
+// quarter of the camera's sensor noise: Cycles stops a pixel when sum|mean - half-mean| over the
+// channels, over the square root of the sum of the means, is below it, which puts a pixel's
+// standard deviation near threshold·sqrt(m)/1.38 at mean m; the sensor's shot noise there is
+// sqrt(m/g) for g electrons per unit of Cycles' radiance (docs/fidelity.md).
+double converged_noise_threshold(const ir::Camera& camera);
+
+// The seed Cycles samples a shot with: the shot's index, offset by the run's seed.
+int cycles_seed(std::uint64_t run_seed, int shot_index);
 
 }  // namespace rigc::cycles

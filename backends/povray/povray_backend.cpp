@@ -499,6 +499,12 @@ void remove_stale_shot_files(const ir::Scene& scene, const fs::path& dir) {
 
 }  // namespace
 
+bool PovrayBackend::check_settings(const run::RenderSettings& settings, std::string* error) const {
+  if (settings.samples != run::kConvergedSamples) return true;
+  *error = "POV-Ray has no converged sampling (samples auto) yet: give a count";
+  return false;
+}
+
 bool PovrayBackend::emit(const ir::Scene& scene, const scene::StudioScene& studio,
                          const fs::path& dir, const run::RenderSettings& settings,
                          std::string* error) {

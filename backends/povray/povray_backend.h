@@ -36,6 +36,10 @@ class PovrayBackend : public external::ExternalBackend {
   // 2: the highlight's peak that of the preview's GGX lobe; 3: area lights light from their
   // whole panel; 4: the whole diffuse under the highlight.
   int output_version() const override { return 4; }
+  // POV-Ray's sampling is deterministic (no seed to measure its noise by): kConvergedSamples is
+  // refused until a converged setting is measured against it (docs/fidelity.md).
+  bool converges() const override { return true; }
+  bool check_settings(const run::RenderSettings& settings, std::string* error) const override;
   // Writes scene.inc, and shot_NNN.pov / .ini / _mask.ini for every shot, into `dir` (created if
   // missing), and the textures beside them as PNG. `samples` sets antialiasing and focal blur
   // samples (0: defaults).

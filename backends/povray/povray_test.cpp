@@ -65,6 +65,18 @@ class ScopedEnv {
   std::optional<std::string> old_;
 };
 
+// POV-Ray samples deterministically, so no converged setting is measured for it yet: asking for
+// one is an error, not a silent default.
+TEST(PovrayEmit, ConvergedSamplingIsRefusedWithAReason) {
+  run::RenderSettings settings;
+  settings.samples = run::kConvergedSamples;
+  std::string error;
+  EXPECT_FALSE(PovrayBackend().check_settings(settings, &error));
+  EXPECT_THAT(error, HasSubstr("POV-Ray has no converged sampling"));
+  settings.samples = 16;
+  EXPECT_TRUE(PovrayBackend().check_settings(settings, &error));
+}
+
 TEST(PovrayEmit, WritesSceneAndOneIniPerShot) {
   const ir::Scene scene = paper_scene();
   TempDir dir;
