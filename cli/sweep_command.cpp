@@ -3,6 +3,7 @@
 // results.csv, results.md and plots side by side.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -42,7 +43,9 @@ struct SweepArguments {
 void add_sweep_options(CLI::App& app, SweepArguments& a) {
   app.add_option("input", a.input, "sweep file (rigc-sweep: 1), or a scene file with --vary");
   app.add_option("--vary", a.vary, "PATH=V1,V2,... : an axis on the scene file (repeatable)");
-  app.add_option("--backend", a.backend, "with --vary: renderer, or a list (an axis)")
+  app.add_option("--backend", a.backend,
+                 "with --vary: renderer, or a list (an axis); with a sweep file: run only these "
+                 "backends' variants (local)")
       ->capture_default_str();
   app.add_option("--scale", a.scale, "with --vary: render scale")
       ->check(finite_number())
@@ -132,6 +135,25 @@ std::optional<std::string> read_scene_text(const std::string& path, DiagnosticEn
   return text;
 }
 
+// The backends of `--backend A,B` on a sweep file, each one the sweep renders with; empty (and
+// the error said) otherwise.
+std::vector<std::string> chosen_backends(const std::string& text,
+                                         const std::vector<sweep::Variant>& variants) {
+  std::vector<std::string> names;
+  std::stringstream list(text);
+  for (std::string name; std::getline(list, name, ',');) {
+    const bool swept = std::any_of(variants.begin(), variants.end(),
+                                   [&](const sweep::Variant& v) { return v.backend == name; });
+    if (!swept) {
+      std::cerr << fmt::format("rigc: error: --backend: the sweep renders nothing with '{}'\n",
+                               name);
+      return {};
+    }
+    names.push_back(name);
+  }
+  return names;
+}
+
 int print_failures(const std::vector<sweep::FailedTask>& failed) {
   for (const auto& f : failed) {
     std::cerr << fmt::format("rigc sweep: variant {} failed{}: {} (log: {})\n", f.variant,
@@ -201,6 +223,11 @@ int run_sweep_command(std::vector<std::string> args) {
     return write_and_summarise(out, *spec, variants);
   }
   if (a.executor == Executor::slurm) {
+    if (a.vary.empty() && app.count("--backend") > 0) {
+      std::cerr << "rigc: error: --backend on a sweep file picks variants for the local executor "
+                   "only\n";
+      return kExitUserError;
+    }
     sweep::SlurmOptions slurm;
     slurm.rigc = rigc;
     slurm.wait = !a.no_wait;
@@ -222,7 +249,12 @@ int run_sweep_command(std::vector<std::string> args) {
                  "rerun redoes the failed variants by itself)\n";
     return kExitUserError;
   }
-  const auto failed = sweep::run_local(out, *spec, variants, {rigc, a.jobs}, std::cerr);
+  sweep::LocalOptions local{rigc, a.jobs, {}};
+  if (a.vary.empty() && app.count("--backend") > 0) {
+    local.backends = chosen_backends(a.backend, variants);
+    if (local.backends.empty()) return kExitUserError;
+  }
+  const auto failed = sweep::run_local(out, *spec, variants, local, std::cerr);
   const int written = write_and_summarise(out, *spec, variants);
   return std::max(written, print_failures(failed));
 }

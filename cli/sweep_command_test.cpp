@@ -207,6 +207,27 @@ TEST(CliSweep, VaryingTheBackendIsTheBackendsAxis) {
   EXPECT_THAT(r.err, HasSubstr("the renderers are given twice"));
 }
 
+// `--backend` on a sweep file runs only that backend's variants (the fast half first); the others
+// stay to run, and a backend the sweep does not render is an error.
+TEST(CliSweep, ABackendOnASweepFileRunsOnlyItsVariants) {
+  TempDir dir;
+  write_text(dir.file("scene.yaml"), small_scene());
+  write_text(dir.file("sweep.yaml"),
+             "rigc-sweep: 1\nscene: scene.yaml\nvary:\n  camera.exposure.aperture: [f/8]\n"
+             "backend: [preview, povray]\nscale: 0.05\n");
+  auto r =
+      run_rigc({"sweep", dir.file("sweep.yaml"), "-o", dir.file("out"), "--backend", "preview"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("1 to run (0 done already, 1 of other backends left out)"));
+  EXPECT_TRUE(fs::exists(dir.file("out/aperture-f-8_backend-preview/result.json")));
+  EXPECT_FALSE(fs::exists(dir.file("out/aperture-f-8_backend-povray/result.json")));
+  r = run_rigc({"sweep", dir.file("sweep.yaml"), "-o", dir.file("out"), "--status"});
+  EXPECT_THAT(r.out, HasSubstr("1/2 variants done"));
+  r = run_rigc({"sweep", dir.file("sweep.yaml"), "-o", dir.file("out"), "--backend", "cycles"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--backend: the sweep renders nothing with 'cycles'"));
+}
+
 // True when a Slurm cluster answers (scripts/slurm_cluster.sh start; its slurm.conf is used when
 // SLURM_CONF is not set).
 bool slurm_cluster_up() {

@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
 #include <ostream>
 #include <thread>
 
+#include "backends/registry.h"
 #include "io/child_processes.h"
 #include "sweep/task.h"
 
@@ -55,14 +57,26 @@ std::vector<FailedTask> run_local(const fs::path& sweep_dir, const SweepSpec& sp
                                   const std::vector<Variant>& variants, const LocalOptions& options,
                                   std::ostream& log) {
   std::vector<int> todo;
+  std::size_t left_out = 0;  // variants of backends not chosen
   for (int i = 0; i < static_cast<int>(variants.size()); ++i) {
-    if (variant_needs_run(sweep_dir / variants[i].name, variants[i].key, spec.coverage,
-                          spec.eval)) {
+    if (!options.backends.empty() && std::find(options.backends.begin(), options.backends.end(),
+                                               variants[i].backend) == options.backends.end()) {
+      ++left_out;
+    } else if (variant_needs_run(sweep_dir / variants[i].name, variants[i].key, spec.coverage,
+                                 spec.eval)) {
       todo.push_back(i);
     }
   }
-  log << fmt::format("rigc sweep: {} variants, {} to run ({} done already), {} at a time\n",
-                     variants.size(), todo.size(), variants.size() - todo.size(), options.jobs);
+  // The in-process renderer's variants (seconds each) before the ray tracers' (minutes a shot),
+  // so that a sweep over both backends has the fast half of its table early.
+  std::stable_partition(todo.begin(), todo.end(), [&](int i) {
+    const backends::BackendEntry* entry = backends::find_backend(variants[i].backend);
+    return entry && !entry->make()->emits_scripts();
+  });
+  log << fmt::format("rigc sweep: {} variants, {} to run ({} done already{}), {} at a time\n",
+                     variants.size(), todo.size(), variants.size() - todo.size() - left_out,
+                     left_out ? fmt::format(", {} of other backends left out", left_out) : "",
+                     options.jobs);
   Progress progress(static_cast<int>(todo.size()), options.jobs, log);
   std::vector<FailedTask> failed;
   std::mutex failed_mutex;

@@ -16,6 +16,8 @@ struct LocalOptions {
   // Variants at once. 1 by default: a variant's renderer, coverage and COLMAP each use every core
   // already, so two at once only share the cores and double the memory.
   int jobs = 1;
+  // The backends whose variants run (`rigc sweep FILE --backend preview`); empty: every one.
+  std::vector<std::string> backends;
 };
 
 // A task that did not finish with its numbers.
