@@ -30,15 +30,22 @@ std::uint8_t to_srgb8(float linear) {
   return static_cast<std::uint8_t>(std::lround(encoded * 255));
 }
 
-// Binary PLY with one colour per face (CloudCompare and MeshLab read face colours).
+// Binary PLY with one colour per face (CloudCompare and MeshLab read face colours). With
+// `coverage`, each face also carries its prediction as scalar fields: the shots that see it, of
+// those the ones SfM can use, and whether it is reconstructable (bench/calibration_table reads
+// them against a reconstruction).
 bool write_face_color_ply(const fs::path& path, const scene::Geometry& mesh,
-                          const std::vector<Vector3f>& colors, std::string* error) {
+                          const std::vector<Vector3f>& colors, const CoverageResult* coverage,
+                          std::string* error) {
   std::string data = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment RigC coverage\nelement vertex {}\n"
       "property float x\nproperty float y\nproperty float z\nelement face {}\n"
       "property list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
-      "property uchar blue\nend_header\n",
-      mesh.positions.size(), mesh.triangles.size());
+      "property uchar blue\n{}end_header\n",
+      mesh.positions.size(), mesh.triangles.size(),
+      coverage ? "property ushort views\nproperty ushort usable_views\n"
+                 "property uchar reconstructable\n"
+               : "");
   auto append = [&](const void* bytes, size_t size) {
     data.append(static_cast<const char*>(bytes), size);
   };
@@ -53,6 +60,11 @@ bool write_face_color_ply(const fs::path& path, const scene::Geometry& mesh,
     const std::uint8_t rgb[3] = {to_srgb8(colors[f].x()), to_srgb8(colors[f].y()),
                                  to_srgb8(colors[f].z())};
     append(rgb, 3);
+    if (coverage) {
+      append(&coverage->views[f], sizeof(std::uint16_t));
+      append(&coverage->usable_views[f], sizeof(std::uint16_t));
+      append(&coverage->reconstructable[f], 1);
+    }
   }
   return rigc::write_file_atomically(path, data, error);
 }
@@ -210,12 +222,14 @@ FaceColors face_colors(const CoverageResult& coverage) {
   return colors;
 }
 
-// coverage.ply/.glb in paper colours, views.ply/.glb as the heat map.
+// coverage.ply/.glb in paper colours (the PLY with each face's prediction), views.ply/.glb as the
+// heat map.
 bool write_coverage_meshes(const fs::path& dir, const scene::Geometry& mesh,
-                           const FaceColors& colors, std::string* error) {
-  return write_face_color_ply(dir / "coverage.ply", mesh, colors.paper, error) &&
+                           const CoverageResult& coverage, const FaceColors& colors,
+                           std::string* error) {
+  return write_face_color_ply(dir / "coverage.ply", mesh, colors.paper, &coverage, error) &&
          write_face_color_glb(dir / "coverage.glb", mesh, colors.paper, error) &&
-         write_face_color_ply(dir / "views.ply", mesh, colors.heat, error) &&
+         write_face_color_ply(dir / "views.ply", mesh, colors.heat, nullptr, error) &&
          write_face_color_glb(dir / "views.glb", mesh, colors.heat, error);
 }
 
@@ -371,7 +385,7 @@ bool write_coverage_outputs(const ir::Scene& scene, const scene::StudioScene& st
   remove_abandoned_temporaries(dir / "pictures");
   const FaceColors colors = face_colors(coverage);
   const PictureFrame frame(scene, picture_width);
-  return write_coverage_meshes(dir, studio.object, colors, error) &&
+  return write_coverage_meshes(dir, studio.object, coverage, colors, error) &&
          write_view_pictures(dir / "pictures", scene, studio, frame, colors.paper, error) &&
          write_progress_pictures(dir / "pictures", scene, studio, coverage, frame, error) &&
          rigc::write_file_atomically(dir / "coverage.json",

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <regex>
 #include <stdexcept>
@@ -290,6 +291,19 @@ TEST(Coverage, WritesColouredMeshesPicturesAndJson) {
   EXPECT_EQ(glb->mesh.triangles.size(), a.coverage.face_area_m2.size());
   const std::string ply = testing::read_text((dir.path() / "coverage.ply").string());
   EXPECT_THAT(ply, HasSubstr("property uchar red"));
+  // Each face's prediction as scalar fields, in the order of the header, after its colour.
+  EXPECT_THAT(ply, HasSubstr("property uchar blue\nproperty ushort views\nproperty ushort "
+                             "usable_views\nproperty uchar reconstructable\nend_header\n"));
+  const std::size_t faces = a.coverage.views.size();
+  const std::size_t face_record = 1 + 3 * 4 + 3 + 2 + 2 + 1;
+  ASSERT_GE(ply.size(), faces * face_record);
+  const char* last = ply.data() + ply.size() - face_record;
+  std::uint16_t views = 0, usable = 0;
+  std::memcpy(&views, last + 16, 2);
+  std::memcpy(&usable, last + 18, 2);
+  EXPECT_EQ(views, a.coverage.views[faces - 1]);
+  EXPECT_EQ(usable, a.coverage.usable_views[faces - 1]);
+  EXPECT_EQ(static_cast<std::uint8_t>(last[20]), a.coverage.reconstructable[faces - 1]);
   EXPECT_EQ(paper_color(0), Eigen::Vector3f(1, 1, 1));
   EXPECT_GT(paper_color(1).x(), 0.5f);
   EXPECT_GT(paper_color(2).y(), 0.5f);
