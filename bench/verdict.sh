@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Issue #55's verdict benchmark (measured, not asserted; bench/verdict/README.md): does the
+# preview fail where the converged Cycles reference fails, and does `rigc check` say so at the
+# responsible line? Runs every sweep file bench/verdict/SCENE-*.yaml (the preview and Cycles at
+# --samples auto, coverage and eval), evaluates each variant EVALS times in all (eval, eval2, ...:
+# COLMAP is not deterministic), runs `rigc check --json` on each variant's scene, and prints the
+# verdict table and the targets' figures. Everything resumes where it stopped.
+#
+# Usage: bench/verdict.sh [OUT_DIR] [EVALS] [SCENES] [BACKENDS]
+#   defaults: out/verdict, 3, "paper spot", "preview cycles" (BACKENDS: which variants to run
+#   now, e.g. "preview" for the fast half; the table shows whatever has results).
+#   RIGC: the rigc binary (default ./build/rigc); CALIBRATION: build/bench/calibration_table. SWEEPS: the folder of sweep files and scenes
+#   (default bench/verdict; a copy at another scale for the scale study).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+rigc=${RIGC:-./build/rigc}
+calibration=${CALIBRATION:-./build/bench/calibration_table}
+out=${1:-out/verdict}
+evals=${2:-3}
+scenes=${3:-paper spot}
+backends=${4:-preview cycles}
+sweeps=${SWEEPS:-bench/verdict}
+
+# Evaluates every variant of a sweep folder until it has `evals` evaluations (eval, eval2, ...),
+# each kept while it is newer than the render.
+evaluate_again() {
+  local dir=$1 variant k
+  for variant in "$dir"/*/; do
+    [[ -f $variant/eval/eval.json ]] || continue
+    for ((k = 2; k <= evals; k++)); do
+      [[ -f $variant/eval$k/eval.json && ! $variant/manifest.json -nt $variant/eval$k/eval.json ]] &&
+        continue
+      "$rigc" eval "$variant" -o "$variant/eval$k" >"$variant/eval$k.log" 2>&1 || true
+    done
+  done
+}
+
+# `rigc check --json` of each variant's scene, once per scene text.
+check_variants() {
+  local dir=$1 variant
+  for variant in "$dir"/*/; do
+    [[ -f $variant/scene.yaml ]] || continue
+    [[ -f $variant/check.json && ! $variant/scene.yaml -nt $variant/check.json ]] && continue
+    "$rigc" check --json "$variant/scene.yaml" >"$variant/check.json.tmp" 2>/dev/null || true
+    mv "$variant/check.json.tmp" "$variant/check.json"
+  done
+}
+
+folders=()
+for scene in $scenes; do
+  for file in "$sweeps/$scene"-*.yaml; do
+    dir=$out/$(basename "$file" .yaml)
+    folders+=("$scene=$dir=$sweeps/$scene.yaml")
+    # A variant that fails is reported by the sweep and shown as failed in the table.
+    "$rigc" sweep "$file" -o "$dir" --backend "${backends// /,}" || true
+    evaluate_again "$dir"
+    check_variants "$dir"
+  done
+done
+
+python3 bench/verdict_table.py "$evals" "${folders[@]}"
+
+# Coverage calibration: each evaluated variant's prediction against its reconstruction, in 20 mm
+# patches (a sparse cloud confirms no single triangle; bench/calibration_table.cpp).
+evaluated=()
+for entry in "${folders[@]}"; do
+  dir=${entry#*=}
+  dir=${dir%%=*}
+  for variant in "$dir"/*/; do
+    [[ -f $variant/eval/cloud_signed_distance.ply ]] && evaluated+=("$variant")
+  done
+done
+if ((${#evaluated[@]})); then
+  echo
+  "$calibration" --patch 20 "${evaluated[@]}"
+fi
