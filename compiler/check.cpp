@@ -441,7 +441,10 @@ void Checker::read_object(const YAML::Node& node, spec::SceneSpec& scene) {
       object.translate = *t;
     }
   }
-  if (node["surface"]) read_surface(node["surface"], object);
+  if (node["surface"]) {
+    object.surface_loc = loc(node["surface"]);
+    read_surface(node["surface"], object);
+  }
 }
 
 void Checker::read_mesh(const YAML::Node& node, spec::ObjectSpec& object) {

@@ -261,6 +261,13 @@ TEST(Frontend, UntexturedObjectGetsACaptureWarning) {
   ASSERT_TRUE(compiled.scene);
   EXPECT_EQ(compiled.warnings, 1);
   EXPECT_THAT(compiled.diagnostics, HasSubstr("warning: the object has no texture"));
+  // Where the scene writes a surface without a pattern, the warning is at that surface.
+  text = kMinimalScene;
+  text.replace(text.find("{pattern: speckle}"), 18, "{pattern: none}");
+  compiled = compile_text(text);
+  ASSERT_TRUE(compiled.scene);
+  EXPECT_THAT(compiled.diagnostics,
+              HasSubstr("test.yaml:5:12: warning: the object has no texture"));
 }
 
 // A scan's vertex colours are its base colour in the IR (red on the cube's top, blue below):

@@ -288,7 +288,9 @@ void Lowering::warn_about_object() {
     textured |= m.base_color_texture >= 0 || m.pattern.kind != ir::PatternKind::kNone;
   }
   if (!textured) {
-    diag_.warning(out.loc,
+    // At the surface that has no pattern, when the scene writes one.
+    const SourceLoc& surface = spec_.object.surface_loc;
+    diag_.warning(surface.line > 0 ? surface : out.loc,
                   "the object has no texture and no surface pattern: SfM will find few features; "
                   "add surface: {pattern: speckle}");
   }

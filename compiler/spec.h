@@ -41,6 +41,7 @@ struct ObjectSpec {
   std::optional<ir::Vec3> surface_color;
   std::optional<double> roughness, metallic;
   SourceLoc loc;
+  SourceLoc surface_loc;  // the `surface:` key, when written
 };
 
 struct TurntableCameraSpec {
