@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ namespace rigc::analysis {
 namespace {
 
 constexpr double kWavelengthM = 550e-9;
+// The widest angle between a view and its nearest neighbour (about the object's centre) across
+// which SfM's features still match reliably: the verdict benchmark's single ring passes at 20
+// degree steps and degrades at 30 (bench/verdict/README.md).
+constexpr double kMaxNeighbourAngleDeg = 25;
 // Shares of the seen surface above which a problem is worth a warning.
 constexpr double kWarnShare = 0.05;
 
@@ -401,6 +406,33 @@ void advise_overlap_and_framing(const ir::Scene& scene, const CoverageResult& co
   }
 }
 
+// A shot whose nearest other view is more than kMaxNeighbourAngleDeg away about the object's
+// centre: its features have no close view to match, whatever the overlap of the seen surface.
+void advise_view_spacing(const ir::Scene& scene, std::vector<Advice>& out) {
+  const Eigen::Vector3d center =
+      (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
+  std::vector<Eigen::Vector3d> directions;
+  for (const ir::Shot& shot : scene.shots) {
+    directions.push_back((shot.object_from_camera.block<3, 1>(0, 3) - center).normalized());
+  }
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    double nearest = 180;
+    for (std::size_t j = 0; j < directions.size(); ++j) {
+      if (j == i) continue;
+      const double cosine = std::clamp(directions[i].dot(directions[j]), -1.0, 1.0);
+      nearest = std::min(nearest, std::acos(cosine) * 180 / std::numbers::pi);
+    }
+    if (directions.size() < 2 || nearest <= kMaxNeighbourAngleDeg) continue;
+    out.push_back({scene.shots[i].loc,
+                   fmt::format("{}'s nearest other view is {:.0f} deg away; SfM matches features "
+                               "between views up to about {:.0f} deg apart: take smaller steps "
+                               "(20 deg or less) or add views between",
+                               scene.shots[i].name, nearest, kMaxNeighbourAngleDeg),
+                   {}});
+    return;
+  }
+}
+
 }  // namespace
 
 double next_faster_standard_shutter(double seconds) {
@@ -439,6 +471,7 @@ std::vector<Advice> capture_advice(const ir::Scene& scene, const scene::StudioSc
   out.insert(out.end(), motion_blur.begin(), motion_blur.end());
   advise_unseen_faces(scene, studio, coverage, out);
   advise_overlap_and_framing(scene, coverage, out);
+  advise_view_spacing(scene, out);
   return out;
 }
 
