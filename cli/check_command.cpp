@@ -10,6 +10,7 @@
 #include "cli/verbs.h"
 #include "compiler/frontend.h"
 #include "compiler/units.h"
+#include "dslr/lens.h"
 #include "ir/ir_json.h"
 
 namespace rigc::cli {
@@ -64,6 +65,13 @@ int run_check_command(std::vector<std::string> args) {
       ->check(CLI::IsMember({"text", "json"}));
   app.add_flag("--json", json, "the same as --format json");
   app.add_flag("--no-advice", no_advice, "skip the capture advice (coverage, focus, exposure)");
+  double scale = 1;
+  app.add_option("--scale", scale,
+                 "judge the photos of a render at this scale (`render --scale`): pixels 1/scale "
+                 "as wide, so blur in pixels and resolution on the surface are theirs")
+      ->check(finite_number())
+      ->check(CLI::Range(0.01, 4.0))
+      ->capture_default_str();
   if (auto code = parse_options(app, args)) return *code;
   json = json || format == "json";
 
@@ -72,6 +80,7 @@ int run_check_command(std::vector<std::string> args) {
   auto scene = compile_scene_file(scene_path, diag);
   std::vector<analysis::Advice> advice;
   const std::size_t first_advice = diag.diagnostics().size();
+  if (scene && scale != 1) scene->camera = dslr::camera_at_scale(scene->camera, scale);
   if (scene && !no_advice) {
     advice = analysis::check_advice(*scene);
     for (const analysis::Advice& a : advice) diag.warning(a.loc, a.message);

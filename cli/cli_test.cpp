@@ -28,6 +28,23 @@ TEST(Cli, CheckAcceptsThePaperScene) {
   EXPECT_THAT(result.out, HasSubstr("ok: 'paper-turntable', 18 shots"));
 }
 
+// `check --scale` judges the photos of a render at that scale: the paper scene at f/8 blurs 27 % of
+// the statue beyond the advice's limit at full size, and 4x less in pixels at 0.25.
+TEST(Cli, CheckAtARenderScaleJudgesThatScalesPixels) {
+  std::string scene = testing::read_text(source_path("scenes/paper-turntable.yaml"));
+  scene.replace(scene.find("aperture: f/13, shutter: 1/125"), 30, "aperture: f/8, shutter: 1/320");
+  testing::TempDir dir;
+  testing::write_text(dir.file("scene.yaml"), scene);
+  auto full = run_rigc({"check", dir.file("scene.yaml")});
+  EXPECT_EQ(full.exit_code, 0) << full.err;
+  EXPECT_THAT(full.out + full.err, HasSubstr("depth of field at f/8 is shallower"));
+  auto quarter = run_rigc({"check", dir.file("scene.yaml"), "--scale", "0.25"});
+  EXPECT_EQ(quarter.exit_code, 0) << quarter.err;
+  EXPECT_THAT(quarter.out + quarter.err, Not(HasSubstr("depth of field")));
+  auto bad = run_rigc({"check", dir.file("scene.yaml"), "--scale", "0"});
+  EXPECT_EQ(bad.exit_code, 1);
+}
+
 // The command itself (not only the libraries the tests link) reads meshes in every format:
 // linking the system libraries in another order once let libdraco's copy of tinygltf's file
 // functions take over, and every glTF scene failed with "FS callback not set".

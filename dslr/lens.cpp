@@ -37,6 +37,18 @@ Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale) {
   return k;
 }
 
+ir::Camera camera_at_scale(const ir::Camera& camera, double scale) {
+  const Intrinsics k = sensor_intrinsics(camera, scale);
+  ir::Camera scaled = camera;
+  scaled.width_px = k.width;
+  scaled.height_px = k.height;
+  scaled.fx = k.fx;
+  scaled.fy = k.fy;
+  scaled.cx = k.cx;
+  scaled.cy = k.cy;
+  return scaled;
+}
+
 ir::Vec2 distort_normalized(const ir::Distortion& d, double x, double y) {
   return d.apply(x, y);
 }

@@ -15,6 +15,11 @@ namespace rigc::dslr {
 // no pixel intrinsics.
 Intrinsics sensor_intrinsics(const ir::Camera& camera, double scale);
 
+// The camera a render at `scale` simulates: the sensor's size and every setting kept, its pixel
+// grid and intrinsics those of sensor_intrinsics (so its pixels are 1/scale as wide, each with
+// the noise of one of the camera's own, as the run develops it).
+ir::Camera camera_at_scale(const ir::Camera& camera, double scale);
+
 // Undistorted -> distorted normalised coordinates (docs/camera-model.md, OpenCV).
 ir::Vec2 distort_normalized(const ir::Distortion& d, double x, double y);
 
