@@ -23,6 +23,10 @@ constexpr double kWavelengthM = 550e-9;
 // which SfM's features still match reliably: the verdict benchmark's single ring passes at 20
 // degree steps and degrades at 30 (bench/verdict/README.md).
 constexpr double kMaxNeighbourAngleDeg = 25;
+// The signal-to-noise ratio of the seen surface's median pixel below which the sensor's noise
+// costs SfM its features: between the verdict benchmark's ISO 800 (38, passes) and ISO 25600 at
+// the same exposure (6, degrades).
+constexpr double kMinMedianSnr = 15;
 // Shares of the seen surface above which a problem is worth a warning.
 constexpr double kWarnShare = 0.05;
 
@@ -278,6 +282,26 @@ void advise_brightness_range(const ir::Scene& scene, const SeenSurface& seen,
        {{Setting::kLight, +1}}});
 }
 
+// A well-exposed surface whose pixels still collect too few electrons (a high ISO making up for
+// little light): the shot and read noise of the median pixel against its signal.
+void advise_sensor_noise(const ir::Scene& scene, const SeenSurface& seen,
+                         std::vector<Advice>& out) {
+  const ir::Camera& camera = scene.camera;
+  if (!camera.effects.noise) return;
+  const double median_signal =
+      std::exp2(signal_percentile_stops(seen.signal_histogram, seen.visible, 0.5));
+  const double electrons = median_signal * dslr::electrons_at_clipping(camera.noise, camera.iso);
+  const double read = dslr::read_noise_electrons(camera.noise, camera.iso);
+  const double snr = electrons / std::sqrt(electrons + read * read);
+  if (snr >= kMinMedianSnr) return;
+  out.push_back({first_known(camera.iso_loc, camera.loc),
+                 fmt::format("sensor noise at ISO {:g}: the seen surface's median pixel collects "
+                             "about {:.0f} electrons, a signal-to-noise ratio of {:.0f} (SfM's "
+                             "features want {:.0f} or more); give more light and lower the ISO",
+                             camera.iso, electrons, snr, kMinMedianSnr),
+                 {{Setting::kLight, +1}}});
+}
+
 // Clipped or too dark surface, with how many stops of light would fix it; both at once are a
 // brightness range no exposure fits. `given`: the advice that pins settings (motion blur,
 // aperture), which the exposure remedies must not reverse.
@@ -291,6 +315,8 @@ void advise_exposure(const ir::Scene& scene, const SeenSurface& seen,
     advise_over_exposure(scene, seen, given, out);
   } else if (dark) {
     advise_under_exposure(scene, seen, given, out);
+  } else {
+    advise_sensor_noise(scene, seen, out);
   }
 }
 
