@@ -35,13 +35,17 @@ evaluate_again() {
   done
 }
 
-# `rigc check --json` of each variant's scene, once per scene text.
+# `rigc check --json` of each variant's scene at the sweep's render scale (the camera whose photos
+# the variants are), once per scene text.
 check_variants() {
-  local dir=$1 variant
+  local dir=$1 variant scale
+  scale=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["scale"])' \
+    "$dir/sweep.json")
   for variant in "$dir"/*/; do
     [[ -f $variant/scene.yaml ]] || continue
     [[ -f $variant/check.json && ! $variant/scene.yaml -nt $variant/check.json ]] && continue
-    "$rigc" check --json "$variant/scene.yaml" >"$variant/check.json.tmp" 2>/dev/null || true
+    "$rigc" check --json --scale "$scale" "$variant/scene.yaml" >"$variant/check.json.tmp" \
+      2>/dev/null || true
     mv "$variant/check.json.tmp" "$variant/check.json"
   done
 }
