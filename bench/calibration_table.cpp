@@ -66,7 +66,9 @@ std::map<Cell, Patch> patches_of(const fs::path& run, double patch_m, std::strin
   }
   std::ifstream eval_json(run / "eval" / "eval.json");
   const nlohmann::json report = nlohmann::json::parse(eval_json, nullptr, false);
-  const double tau_m = report.is_object() ? report["fscore"].value("tau_mm", 1.0) / 1000 : 1e-3;
+  const bool has_fscore =
+      report.is_object() && report.contains("fscore") && report["fscore"].is_object();
+  const double tau_m = has_fscore ? report["fscore"].value("tau_mm", 1.0) / 1000 : 1e-3;
   const auto cloud =
       rigc::eval::load_reconstruction(run / "eval" / "cloud_signed_distance.ply", error);
   if (!cloud) return {};
@@ -80,6 +82,11 @@ std::map<Cell, Patch> patches_of(const fs::path& run, double patch_m, std::strin
   return patches;
 }
 
+// "sweep/variant": the run folder with its parent's name.
+std::string run_name(const fs::path& run) {
+  return (run.parent_path().filename() / run.filename()).string();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -90,7 +97,9 @@ int main(int argc, char** argv) {
     if (arg == "--patch" && i + 1 < argc) {
       patch_mm = std::atof(argv[++i]);
     } else {
-      runs.emplace_back(arg);
+      fs::path run = fs::path(arg).lexically_normal();
+      if (run.filename().empty()) run = run.parent_path();  // "DIR/" names DIR
+      runs.push_back(run);
     }
   }
   if (runs.empty() || !(patch_mm > 0)) {
@@ -107,7 +116,7 @@ int main(int argc, char** argv) {
     std::string error;
     const auto patches = patches_of(run, patch_mm / 1000, &error);
     if (patches.empty()) {
-      std::cout << fmt::format("{} | {}\n", run.filename().string(), error);
+      std::cout << fmt::format("{} | {}\n", run_name(run), error);
       continue;
     }
     long predicted = 0, observed = 0, both = 0;
@@ -128,7 +137,7 @@ int main(int argc, char** argv) {
                   ? fmt::format(" {:.2f} ({})", double(observed_in_bin[b]) / in_bin[b], in_bin[b])
                   : " -";
     }
-    std::cout << fmt::format("{} | {} | {} | {} | {:.3f} | {:.3f} |{}\n", run.filename().string(),
+    std::cout << fmt::format("{} | {} | {} | {} | {:.3f} | {:.3f} |{}\n", run_name(run),
                              patches.size(), predicted, observed,
                              predicted ? double(both) / predicted : 0.0,
                              observed ? double(both) / observed : 0.0, bins);

@@ -19,19 +19,8 @@ rigc=${RIGC:-./build/rigc}
 out=${1:-out/rank-agreement}
 evals=${2:-3}
 
-# Evaluates every variant of a sweep folder until it has `evals` evaluations (eval, eval2, ...).
-evaluate_again() {
-  local dir=$1 variant k
-  for variant in "$dir"/*/; do
-    [[ -f $variant/eval/eval.json ]] || continue
-    for ((k = 2; k <= evals; k++)); do
-      # Kept while it is newer than the render (a rerun sweep may have rendered again).
-      [[ -f $variant/eval$k/eval.json && ! $variant/manifest.json -nt $variant/eval$k/eval.json ]] &&
-        continue
-      "$rigc" eval "$variant" -o "$variant/eval$k" >"$variant/eval$k.log" 2>&1 || true
-    done
-  done
-}
+# shellcheck source=bench/evaluate_again.sh
+source bench/evaluate_again.sh
 
 # Per variant: each evaluation's std, points and F-score and their means; then Spearman's rho
 # between the backends' rankings of the configurations by each mean.

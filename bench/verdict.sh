@@ -21,19 +21,8 @@ scenes=${3:-paper spot}
 backends=${4:-preview cycles}
 sweeps=${SWEEPS:-bench/verdict}
 
-# Evaluates every variant of a sweep folder until it has `evals` evaluations (eval, eval2, ...),
-# each kept while it is newer than the render.
-evaluate_again() {
-  local dir=$1 variant k
-  for variant in "$dir"/*/; do
-    [[ -f $variant/eval/eval.json ]] || continue
-    for ((k = 2; k <= evals; k++)); do
-      [[ -f $variant/eval$k/eval.json && ! $variant/manifest.json -nt $variant/eval$k/eval.json ]] &&
-        continue
-      "$rigc" eval "$variant" -o "$variant/eval$k" >"$variant/eval$k.log" 2>&1 || true
-    done
-  done
-}
+# shellcheck source=bench/evaluate_again.sh
+source bench/evaluate_again.sh
 
 # `rigc check --json` of each variant's scene at the sweep's render scale (the camera whose photos
 # the variants are), once per scene text.
