@@ -5,11 +5,12 @@
 # run folder is evaluated RUNS times.
 #
 # Usage: bench/fidelity_table.sh [OUT_DIR] [SCALE] [CYCLES_SAMPLES] [RUNS] [SCENES]
-#   defaults: out/fidelity-table, 0.25, 0 (Cycles' default, 64), 2, "paper spot".
+#   defaults: out/fidelity-table, 0.25, auto (Cycles converged: its noise a quarter of the
+#   sensor's, docs/fidelity.md; 0 is Cycles' default 64), 2, "paper spot".
 #   RIGC: the rigc binary (default ./build/rigc).
 #   SCENES: paper (scenes/paper-turntable.yaml) and/or spot (scenes/spot-turntable.yaml: Spot
 #   with a photographed texture). The Cycles renders of the paper scene take about 20 minutes at
-#   0.25 with 64 samples on 2 quiet cores.
+#   0.25 with 64 samples on 2 quiet cores, about 5 hours converged.
 # Prints one row per scene, backend and evaluation: registered images, points, signed distance
 # mean ± std (mm), F-score at 1 mm, and per scene the preview/Cycles ratios of std and points.
 set -euo pipefail
@@ -17,7 +18,7 @@ cd "$(dirname "$0")/.."
 rigc=${RIGC:-./build/rigc}
 out=${1:-out/fidelity-table}
 scale=${2:-0.25}
-samples=${3:-0}
+samples=${3:-auto}
 runs=${4:-2}
 scenes=${5:-paper spot}
 mkdir -p "$out"
@@ -41,8 +42,8 @@ print(f'{r["registered_images"]}/{r["images"]}\t{r["points"]}\t{d["mean"]:+.3f} 
 PY
 }
 
-printf 'settings: scale %s, cycles samples %s (0 = 64), seed 1, %s evaluations per run\n' \
-  "$scale" "$samples" "$runs"
+printf 'settings: scale %s, cycles samples %s (0 = 64, auto = converged), seed 1, %s %s\n' \
+  "$scale" "$samples" "$runs" "evaluations per run"
 printf 'scene\tbackend\trender s\teval\tregistered\tpoints\tmean ± std (mm)\tF(1mm)\n'
 for name in $scenes; do
   scene=$(scene_file "$name")
