@@ -15,6 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 rigc=${RIGC:-./build/rigc}
 calibration=${CALIBRATION:-./build/bench/calibration_table}
+rigc_binary=$(command -v "$rigc")
 out=${1:-out/verdict}
 evals=${2:-3}
 scenes=${3:-paper spot}
@@ -25,14 +26,16 @@ sweeps=${SWEEPS:-bench/verdict}
 source bench/evaluate_again.sh
 
 # `rigc check --json` of each variant's scene at the sweep's render scale (the camera whose photos
-# the variants are), once per scene text.
+# the variants are), once per scene text and rigc.
 check_variants() {
   local dir=$1 variant scale
   scale=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["scale"])' \
     "$dir/sweep.json")
   for variant in "$dir"/*/; do
     [[ -f $variant/scene.yaml ]] || continue
-    [[ -f $variant/check.json && ! $variant/scene.yaml -nt $variant/check.json ]] && continue
+    # Kept while newer than the scene and the rigc that wrote it (advice changes with rigc).
+    [[ -f $variant/check.json && ! $variant/scene.yaml -nt $variant/check.json &&
+      ! $rigc_binary -nt $variant/check.json ]] && continue
     "$rigc" check --json --scale "$scale" "$variant/scene.yaml" >"$variant/check.json.tmp" \
       2>/dev/null || true
     mv "$variant/check.json.tmp" "$variant/check.json"
