@@ -10,7 +10,7 @@
 #   RIGC: the rigc binary (default ./build/rigc).
 #   SCENES: paper (scenes/paper-turntable.yaml) and/or spot (scenes/spot-turntable.yaml: Spot
 #   with a photographed texture). The Cycles renders of the paper scene take about 20 minutes at
-#   0.25 with 64 samples on 2 quiet cores, about 5 hours converged.
+#   0.25 with 64 samples on 2 quiet cores, about 4 hours converged.
 # Prints one row per scene, backend and evaluation: registered images, points, signed distance
 # mean ± std (mm), F-score at 1 mm, and per scene the preview/Cycles ratios of std and points.
 set -euo pipefail
