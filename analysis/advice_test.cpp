@@ -183,7 +183,7 @@ TEST(Advice, NoAdviceReversesAnotherOverAFamilyOfScenes) {
 // near enough for its features to match (the verdict benchmark's 8 steps fail, 18 pass): the
 // advice names the shot at its line; 18 steps of 20 degrees get none.
 TEST(Advice, AViewWithoutANearNeighbourIsPointedOut) {
-  const std::string wide = scene_text({400, 20, "1/125"});
+  const std::string wide = scene_text({400, 20, "1/125", "f/8", ""});
   const Advised a = advise(wide);
   EXPECT_THAT(a.text, HasSubstr("shot_000's nearest other view is 44 deg away"));  // 30 cm up
   const auto spacing = std::find_if(a.advice.begin(), a.advice.end(), [](const Advice& advice) {
