@@ -32,8 +32,8 @@ std::uint8_t to_srgb8(float linear) {
 
 // Binary PLY with one colour per face (CloudCompare and MeshLab read face colours). With
 // `coverage`, each face also carries its prediction as scalar fields: the shots that see it, of
-// those the ones SfM can use, and whether it is reconstructable (bench/calibration_table reads
-// them against a reconstruction).
+// those the ones SfM can use, and whether it is reconstructable (for a user's viewer; the
+// calibration bench computes them from the scene itself).
 bool write_face_color_ply(const fs::path& path, const scene::Geometry& mesh,
                           const std::vector<Vector3f>& colors, const CoverageResult* coverage,
                           std::string* error) {
