@@ -435,6 +435,7 @@ void advise_overlap_and_framing(const ir::Scene& scene, const CoverageResult& co
 // A shot whose nearest other view is more than kMaxNeighbourAngleDeg away about the object's
 // centre: its features have no close view to match, whatever the overlap of the seen surface.
 void advise_view_spacing(const ir::Scene& scene, std::vector<Advice>& out) {
+  if (scene.shots.size() < 2) return;
   const Eigen::Vector3d center =
       (scene.object.bounds_min_object + scene.object.bounds_max_object) / 2;
   std::vector<Eigen::Vector3d> directions;
@@ -448,7 +449,7 @@ void advise_view_spacing(const ir::Scene& scene, std::vector<Advice>& out) {
       const double cosine = std::clamp(directions[i].dot(directions[j]), -1.0, 1.0);
       nearest = std::min(nearest, std::acos(cosine) * 180 / std::numbers::pi);
     }
-    if (directions.size() < 2 || nearest <= kMaxNeighbourAngleDeg) continue;
+    if (nearest <= kMaxNeighbourAngleDeg) continue;
     out.push_back({scene.shots[i].loc,
                    fmt::format("{}'s nearest other view is {:.0f} deg away; SfM matches features "
                                "between views up to about {:.0f} deg apart: take smaller steps "
