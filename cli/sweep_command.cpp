@@ -222,8 +222,10 @@ int run_sweep_command(std::vector<std::string> args) {
     std::cout << sweep::status_text(out, *spec, variants);
     return write_and_summarise(out, *spec, variants);
   }
+  // `--backend` on a sweep file picks which of its variants run.
+  const bool backends_chosen = a.vary.empty() && app.count("--backend") > 0;
   if (a.executor == Executor::slurm) {
-    if (a.vary.empty() && app.count("--backend") > 0) {
+    if (backends_chosen) {
       std::cerr << "rigc: error: --backend on a sweep file picks variants for the local executor "
                    "only\n";
       return kExitUserError;
@@ -250,7 +252,7 @@ int run_sweep_command(std::vector<std::string> args) {
     return kExitUserError;
   }
   sweep::LocalOptions local{rigc, a.jobs, {}};
-  if (a.vary.empty() && app.count("--backend") > 0) {
+  if (backends_chosen) {
     local.backends = chosen_backends(a.backend, variants);
     if (local.backends.empty()) return kExitUserError;
   }
